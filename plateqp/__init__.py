@@ -1,0 +1,55 @@
+"""plateqp: thin Kirchhoff plates on one-sided supports, contact solved as a convex QP.
+
+>>> import plateqp as pq
+>>> scene = pq.Scene.from_toml("scene.toml")
+>>> result = pq.solve(scene, backend="lemke", formulation="condensed", accuracy="high")
+>>> result.reactions, result.active, result.kkt.ok
+
+Conventions: the plate occupies [0, a] × [0, b]; w, loads and support compression are
+positive downward; a gap g0 > 0 is settlement, g0 < 0 heave; reactions R ≥ 0 push the plate up.
+"""
+
+from .backends import available_backends, get_backend, registry
+from .backends.base import Status
+from .driver import solve
+from .errors import (
+    MechanismError,
+    NoEquilibriumError,
+    PlateQPError,
+    PlateQPWarning,
+    ProblemError,
+    SceneError,
+    SolverError,
+)
+from .results import KKTReport, Result
+from .scene import (
+    Edge,
+    Foundation,
+    MeshSpec,
+    Opening,
+    PatchLoad,
+    Pin,
+    Plate,
+    PointLoad,
+    Scene,
+    Support,
+    UniformLoad,
+)
+
+__version__ = "0.1.0"
+
+
+def solve_bilateral(scene: Scene) -> Result:
+    """The paper's comparison: the same scene with every one-sided support made two-sided."""
+    from .assembly import build_model
+    from .contact import solve_bilateral as _sb
+
+    return _sb(build_model(scene))
+
+
+__all__ = [
+    "Edge", "Foundation", "KKTReport", "MechanismError", "MeshSpec", "NoEquilibriumError", "Opening",
+    "PatchLoad", "Pin", "Plate", "PlateQPError", "PlateQPWarning", "PointLoad", "ProblemError", "Result",
+    "Scene", "SceneError", "SolverError", "Status", "Support", "UniformLoad", "available_backends",
+    "get_backend", "registry", "solve", "solve_bilateral",
+]

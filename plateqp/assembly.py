@@ -1,0 +1,309 @@
+"""From a Scene to a Model: dof map, vectorised sparse assembly, loads, two-sided supports.
+
+Dofs: node n carries ``ndof_node`` dofs numbered ``n·ndof_node + k`` on the full grid.
+Two-sided supports prescribe some of them (``fixed`` with ``values``); the rest of the plate's
+dofs are ``free``. The Model holds, on the free dofs,
+
+    K u = f − K_fc u_c          (the two-sided problem; u_c the prescribed values)
+
+and the one-sided support operator B (deflection at each contact point, through the
+element's interpolation) with the gaps g0 shifted by the prescribed dofs' contribution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from .elements import ELEMENTS, RectElement
+from .errors import SceneError
+from .mesh import Grid
+from .scene import PatchLoad, PointLoad, Scene, UniformLoad
+
+# derivative orders of the nodal dofs, shared by ACM and BFS (BFS adds (1, 1))
+W, WX, WY, WXY = (0, 0), (1, 0), (0, 1), (1, 1)
+
+
+@dataclass
+class Contacts:
+    """The one-sided contact points of a model, in the order: discrete supports, then bed nodes.
+
+    ``B``: (m, n_free) sparse, deflection at each point; ``g0``: initial gaps, already shifted by
+    the prescribed dofs; ``rho``: flexibility 1/c (0 for rigid); ``xy``: (m, 2) positions;
+    ``source``: "support" or "bed"; ``index``: the support's index in the scene, or the node.
+    """
+
+    B: sp.csr_matrix
+    g0: np.ndarray
+    rho: np.ndarray
+    xy: np.ndarray
+    source: np.ndarray
+    index: np.ndarray
+
+    @property
+    def m(self) -> int:
+        return self.g0.shape[0]
+
+    @property
+    def rigid(self) -> np.ndarray:
+        return self.rho == 0.0
+
+
+@dataclass
+class Model:
+    scene: Scene
+    grid: Grid
+    element: RectElement
+    K: sp.csr_matrix  # free × free
+    f: np.ndarray  # free loads, prescribed-dof contribution included
+    free: np.ndarray  # full dof indices of the free dofs
+    fixed: np.ndarray  # full dof indices of the prescribed dofs
+    values: np.ndarray  # their prescribed values
+    n_full: int
+    cell_dofs: np.ndarray  # (n_kept_cells, ndof) full dof indices
+    cells: np.ndarray  # kept cell indices
+    f_full: np.ndarray  # consistent loads on all dofs (for reactions at prescribed dofs)
+    K_full: sp.csr_matrix = field(repr=False)
+    contacts: Contacts | None = None
+
+    @property
+    def n_free(self) -> int:
+        return self.free.shape[0]
+
+    def expand(self, u_free: np.ndarray) -> np.ndarray:
+        """Full dof vector (prescribed values in place, dofs off the plate zero)."""
+        u = np.zeros(self.n_full if u_free.ndim == 1 else (self.n_full, u_free.shape[1]))
+        u[self.free] = u_free
+        u[self.fixed] = self.values if u_free.ndim == 1 else self.values[:, None]
+        return u
+
+    def rigid_modes(self) -> np.ndarray:
+        """(n_free, k) basis of the rigid motions the two-sided supports leave free (k = 0..3 per piece).
+
+        A rigid motion w = α + βx + γy (slopes β, γ, twist 0) of each connected piece of the
+        plate, restricted to the free dofs, with the prescribed dofs held at zero.
+        """
+        return _rigid_modes(self)
+
+    def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
+        """(npts, n_full) sparse operator: derivative of w at points, from full dofs."""
+        cell, xi, eta = self.grid.locate(x, y)
+        if np.any(cell < 0):
+            bad = np.flatnonzero(cell < 0)[0]
+            raise SceneError(f"point ({np.atleast_1d(x)[bad]}, {np.atleast_1d(y)[bad]}) is not on the plate")
+        N = self.element.shape(xi, eta, self.grid.hx, self.grid.hy, dx, dy)
+        dofs = self.grid_cell_dofs(cell)
+        rows = np.repeat(np.arange(len(cell)), N.shape[1])
+        return sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(cell), self.n_full))
+
+    def grid_cell_dofs(self, cell: np.ndarray) -> np.ndarray:
+        nd = self.element.ndof_node
+        nodes = self.grid.cell_nodes()[cell]
+        return (nodes[:, :, None] * nd + np.arange(nd)).reshape(len(cell), -1)
+
+
+def build_model(scene: Scene) -> Model:
+    """Assemble the stiffness, loads, two-sided constraints and contact operator of a scene."""
+    grid = Grid.from_scene(scene)
+    el = ELEMENTS[scene.mesh.element]()
+    nd = el.ndof_node
+    p = scene.plate
+    hx, hy = grid.hx, grid.hy
+    n_full = grid.n_nodes * nd
+
+    cells = np.flatnonzero(grid.cell_mask)
+    nodes = grid.cell_nodes()[cells]
+    cell_dofs = (nodes[:, :, None] * nd + np.arange(nd)).reshape(len(cells), -1)
+
+    # stiffness: every cell has the same element matrix; COO → CSR sums duplicates
+    Ke = el.stiffness(hx, hy, p.D, p.nu)
+    ne = el.ndof
+    rows = np.repeat(cell_dofs, ne, axis=1).ravel()
+    cols = np.tile(cell_dofs, (1, ne)).ravel()
+    vals = np.tile(Ke.ravel(), len(cells))
+    K_full = sp.csr_matrix((vals, (rows, cols)), shape=(n_full, n_full))
+
+    f_full = _loads(scene, grid, el, cells, cell_dofs, n_full)
+
+    fixed, values = _prescribed(scene, grid, el)
+    node_mask = grid.node_mask()
+    on_plate = np.repeat(node_mask, nd)
+    is_fixed = np.zeros(n_full, dtype=bool)
+    is_fixed[fixed] = True
+    free = np.flatnonzero(on_plate & ~is_fixed)
+
+    K = K_full[free][:, free].tocsr()
+    f = f_full[free] - K_full[free][:, fixed] @ values
+    model = Model(scene, grid, el, K, f, free, fixed, values, n_full, cell_dofs, cells, f_full, K_full)
+    model.contacts = _contacts(scene, model)
+    return model
+
+
+def _loads(scene, grid, el, cells, cell_dofs, n_full) -> np.ndarray:
+    hx, hy = grid.hx, grid.hy
+    f = np.zeros(n_full)
+    for ld in scene.loads:
+        if isinstance(ld, UniformLoad):
+            fe = el.load(hx, hy)
+            np.add.at(f, cell_dofs, ld.q * fe[None, :])
+        elif isinstance(ld, PatchLoad):
+            ci = cells % grid.nx
+            cj = cells // grid.nx
+            x0 = np.clip((ld.x0 - ci * hx) / hx, 0, 1)
+            x1 = np.clip((ld.x1 - ci * hx) / hx, 0, 1)
+            y0 = np.clip((ld.y0 - cj * hy) / hy, 0, 1)
+            y1 = np.clip((ld.y1 - cj * hy) / hy, 0, 1)
+            hit = (x1 > x0) & (y1 > y0)
+            if np.any(hit):
+                fe = el.load(hx, hy, np.column_stack([x0, x1, y0, y1])[hit])
+                np.add.at(f, cell_dofs[hit], ld.q * fe)
+        elif isinstance(ld, PointLoad):
+            cell, xi, eta = grid.locate(ld.x, ld.y)
+            N = el.shape(xi, eta, hx, hy)[0]
+            nodes = grid.cell_nodes()[cell[0]]
+            dofs = (nodes[:, None] * el.ndof_node + np.arange(el.ndof_node)).ravel()
+            np.add.at(f, dofs, ld.P * N)
+    return f
+
+
+def _prescribed(scene, grid, el):
+    """Prescribed dofs and values from edges and pins; conflicts at corners are errors."""
+    nd = el.ndof_node
+    kinds = list(el.node_dofs)
+    node_mask = grid.node_mask()
+    presc: dict[int, tuple[float, str]] = {}
+
+    def put(node, order, value, who):
+        if order not in kinds or not node_mask[node]:
+            return
+        dof = node * nd + kinds.index(order)
+        if dof in presc and abs(presc[dof][0] - value) > 1e-14 * max(1.0, abs(value)):
+            raise SceneError(f"{who} and {presc[dof][1]} prescribe different values of "
+                             f"{el.dof_names[kinds.index(order)]} at their common node; make them agree")
+        presc[dof] = (value, who)
+
+    nx, ny = grid.nx, grid.ny
+    edge_nodes = {
+        "left": [j * (nx + 1) for j in range(ny + 1)],
+        "right": [j * (nx + 1) + nx for j in range(ny + 1)],
+        "bottom": list(range(nx + 1)),
+        "top": [ny * (nx + 1) + i for i in range(nx + 1)],
+    }
+    # (tangential slope order, normal slope order, sign of ∂/∂n relative to the slope dof)
+    geometry = {"left": (WY, WX, -1.0), "right": (WY, WX, 1.0), "bottom": (WX, WY, -1.0), "top": (WX, WY, 1.0)}
+    for name, e in scene.edges.items():
+        if e.kind == "free":
+            continue
+        tang, normal, sign = geometry[name]
+        who = f"edges.{name}"
+        for n in edge_nodes[name]:
+            put(n, W, e.w, who)
+            put(n, tang, 0.0, who)  # w constant along the edge
+            if e.kind == "clamped":
+                put(n, normal, sign * e.slope, who)
+                put(n, WXY, 0.0, who)  # the normal slope is constant along the edge
+    for i, pin in enumerate(scene.pins):
+        put(grid.node_at(pin.x, pin.y), W, pin.w, f"pins.{i}")
+    fixed = np.array(sorted(presc), dtype=int)
+    values = np.array([presc[d][0] for d in fixed], dtype=float)
+    return fixed, values
+
+
+def _rigid_modes(model: Model) -> np.ndarray:
+    grid, el = model.grid, model.element
+    nd = el.ndof_node
+    kinds = list(el.node_dofs)
+    cn = grid.cell_nodes()[model.cells]
+    n = grid.n_nodes
+    # connectivity of nodes through kept cells
+    r = np.repeat(cn, 4, axis=1).ravel()
+    c = np.tile(cn, (1, 4)).ravel()
+    A = sp.csr_matrix((np.ones(r.size), (r, c)), shape=(n, n))
+    _, label = connected_components(A, directed=False)
+    node_mask = grid.node_mask()
+    xy = grid.node_xy()
+    fixed_node = model.fixed // nd
+    fixed_kind = model.fixed % nd
+    free_pos = -np.ones(model.n_full, dtype=int)
+    free_pos[model.free] = np.arange(model.n_free)
+    modes = []
+    for comp in np.unique(label[node_mask]):
+        in_comp = label[model.fixed // nd] == comp
+        rows = []
+        for node, k in zip(fixed_node[in_comp], fixed_kind[in_comp]):
+            order = kinds[k]
+            if order == W:
+                rows.append([1.0, xy[node, 0], xy[node, 1]])
+            elif order == WX:
+                rows.append([0.0, 1.0, 0.0])
+            elif order == WY:
+                rows.append([0.0, 0.0, 1.0])
+        R = np.array(rows).reshape(-1, 3)
+        # null space of the constraints on (α, β, γ)
+        _, s, vt = np.linalg.svd(R if len(R) else np.zeros((1, 3)))
+        s_full = np.zeros(3)
+        s_full[: len(s)] = s
+        null = vt[s_full <= 1e-10 * max(1.0, s_full.max())]
+        comp_nodes = np.flatnonzero((label == comp) & node_mask)
+        for a, b, g in null:
+            v = np.zeros(model.n_full)
+            v[comp_nodes * nd + kinds.index(W)] = a + b * xy[comp_nodes, 0] + g * xy[comp_nodes, 1]
+            v[comp_nodes * nd + kinds.index(WX)] = b
+            v[comp_nodes * nd + kinds.index(WY)] = g
+            modes.append(v[model.free])
+    return np.array(modes).T.reshape(model.n_free, len(modes))
+
+
+def _contacts(scene: Scene, model: Model) -> Contacts | None:
+    if not scene.one_sided:
+        return None
+    grid = model.grid
+    nd = model.element.ndof_node
+    free_pos = -np.ones(model.n_full, dtype=int)
+    free_pos[model.free] = np.arange(model.n_free)
+    u_c = np.zeros(model.n_full)
+    u_c[model.fixed] = model.values
+    blocks, g0, rho, xy, source, index = [], [], [], [], [], []
+    if scene.supports:
+        sx = np.array([s.x for s in scene.supports])
+        sy = np.array([s.y for s in scene.supports])
+        Bf = model.interpolation(sx, sy)
+        blocks.append(Bf)
+        g0.append(np.array([s.gap for s in scene.supports]))
+        rho.append(np.array([0.0 if s.rigid else 1.0 / s.stiffness for s in scene.supports]))
+        xy.append(np.column_stack([sx, sy]))
+        source += ["support"] * len(sx)
+        index.append(np.arange(len(sx)))
+    if scene.foundation is not None:
+        fnd = scene.foundation
+        x0, x1, y0, y1 = fnd.region if fnd.region is not None else (0.0, grid.a, 0.0, grid.b)
+        cc = model.cells
+        cx = (cc % grid.nx + 0.5) * grid.hx
+        cy = (cc // grid.nx + 0.5) * grid.hy
+        inside = (cx >= x0) & (cx <= x1) & (cy >= y0) & (cy <= y1)
+        area = np.zeros(grid.n_nodes)
+        np.add.at(area, grid.cell_nodes()[cc[inside]].ravel(), 0.25 * grid.hx * grid.hy)
+        nodes = np.flatnonzero(area > 0)
+        wdof = nodes * nd
+        nodes = nodes[free_pos[wdof] >= 0]  # a node whose w is prescribed gives its bed force to that support
+        pts = grid.node_xy()[nodes]
+        blocks.append(sp.csr_matrix((np.ones(len(nodes)), (np.arange(len(nodes)), nodes * nd)),
+                                    shape=(len(nodes), model.n_full)))
+        g0.append(fnd.gap_at(pts[:, 0], pts[:, 1]))
+        rho.append(1.0 / (fnd.k * area[nodes]))
+        xy.append(pts)
+        source += ["bed"] * len(nodes)
+        index.append(nodes)
+    Bfull = sp.vstack(blocks).tocsr()
+    g0 = np.concatenate(g0) - Bfull @ u_c
+    B = Bfull[:, model.free].tocsr()
+    B.eliminate_zeros()
+    empty = np.flatnonzero(np.diff(B.indptr) == 0)
+    if empty.size:
+        i = empty[0]
+        raise SceneError(f"supports.{i}: lies on a two-sided support (w is prescribed there), "
+                         "so it can never act; remove it or the two-sided support")
+    return Contacts(B, g0, np.concatenate(rho), np.vstack(xy), np.array(source), np.concatenate(index))

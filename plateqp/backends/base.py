@@ -1,0 +1,163 @@
+"""Standard-form problems, raw solutions and the backend protocol.
+
+A backend knows QPs and LCPs, never plates. The problem forms are:
+
+QP (the qpsolvers convention)::
+
+    minimise    ½ xᵀ P x + qᵀ x
+    subject to  G x ≤ h,   A x = b,   lb ≤ x ≤ ub
+
+LCP::
+
+    find z ≥ 0 such that w = M z + q ≥ 0 and zᵀ w = 0
+
+Multiplier sign conventions of :class:`RawSolution` (those of qpsolvers):
+``z`` ≥ 0 for ``G x ≤ h``; ``y`` free for ``A x = b``; ``z_box`` one entry per
+variable, ``z_box < 0`` where the lower bound is active, ``> 0`` where the upper
+bound is, so that stationarity reads ``P x + q + Gᵀ z + Aᵀ y + z_box = 0``.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import ProblemError
+
+ACCURACIES = ("low", "default", "high")
+
+
+class Status(enum.Enum):
+    """Outcome of a solve. ``INACCURATE`` marks an answer that missed the asked accuracy."""
+
+    OPTIMAL = "optimal"
+    INACCURATE = "inaccurate"
+    INFEASIBLE = "infeasible"  # no equilibrium (primal infeasible / LCP ray termination)
+    UNBOUNDED = "unbounded"  # dual infeasible: the load cannot be carried
+    MAX_ITER = "max_iter"
+    ERROR = "error"
+
+    @property
+    def solved(self) -> bool:
+        return self in (Status.OPTIMAL, Status.INACCURATE)
+
+
+def _as_vec(v, n: int, name: str) -> np.ndarray | None:
+    if v is None:
+        return None
+    a = np.asarray(v, dtype=float).reshape(-1)
+    if a.shape[0] != n:
+        raise ProblemError(f"{name} has length {a.shape[0]}, expected {n}")
+    return a
+
+
+@dataclass
+class QP:
+    """A convex QP in standard form; checks its own shapes on construction."""
+
+    P: Any  # sparse or dense (n, n), symmetric positive semidefinite
+    q: np.ndarray
+    G: Any = None
+    h: np.ndarray | None = None
+    A: Any = None
+    b: np.ndarray | None = None
+    lb: np.ndarray | None = None
+    ub: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        self.q = np.asarray(self.q, dtype=float).reshape(-1)
+        n = self.q.shape[0]
+        if self.P.shape != (n, n):
+            raise ProblemError(f"P has shape {self.P.shape}, expected ({n}, {n})")
+        for M, v, name in ((self.G, self.h, "G"), (self.A, self.b, "A")):
+            if (M is None) != (v is None):
+                raise ProblemError(f"{name} and its right-hand side must be given together")
+            if M is not None and (M.ndim != 2 or M.shape[1] != n or M.shape[0] != np.size(v)):
+                raise ProblemError(f"{name} has shape {M.shape}, incompatible with n={n}")
+        if self.h is not None:
+            self.h = np.asarray(self.h, dtype=float).reshape(-1)
+        if self.b is not None:
+            self.b = np.asarray(self.b, dtype=float).reshape(-1)
+        self.lb = _as_vec(self.lb, n, "lb")
+        self.ub = _as_vec(self.ub, n, "ub")
+        for name in ("q", "h", "b"):
+            v = getattr(self, name)
+            if v is not None and not np.all(np.isfinite(v)):
+                raise ProblemError(f"{name} has non-finite entries")
+
+    @property
+    def n(self) -> int:
+        return self.q.shape[0]
+
+    @property
+    def sparse(self) -> bool:
+        return sp.issparse(self.P)
+
+
+@dataclass
+class LCP:
+    """A linear complementarity problem LCP(M, q); M dense (n, n)."""
+
+    M: np.ndarray
+    q: np.ndarray
+
+    def __post_init__(self) -> None:
+        self.M = np.asarray(self.M.toarray() if sp.issparse(self.M) else self.M, dtype=float)
+        self.q = np.asarray(self.q, dtype=float).reshape(-1)
+        n = self.q.shape[0]
+        if self.M.shape != (n, n):
+            raise ProblemError(f"M has shape {self.M.shape}, expected ({n}, {n})")
+        if not (np.all(np.isfinite(self.M)) and np.all(np.isfinite(self.q))):
+            raise ProblemError("LCP data has non-finite entries")
+
+    @property
+    def n(self) -> int:
+        return self.q.shape[0]
+
+    def as_qp(self) -> QP:
+        """The bound-constrained QP ½ zᵀMz + qᵀz, z ≥ 0 (valid for symmetric PSD M)."""
+        return QP(P=self.M, q=self.q, lb=np.zeros(self.n))
+
+
+@dataclass
+class RawSolution:
+    """What a backend returns, before any plate-level interpretation.
+
+    For a QP: ``x``, ``z``, ``y``, ``z_box`` (see module docstring for signs).
+    For an LCP: ``x`` is z and ``w`` is M z + q.
+    """
+
+    status: Status
+    x: np.ndarray | None = None
+    z: np.ndarray | None = None
+    y: np.ndarray | None = None
+    z_box: np.ndarray | None = None
+    w: np.ndarray | None = None
+    obj: float | None = None
+    iterations: int | None = None
+    solve_time: float = 0.0
+    solver_status: str = ""
+    extras: dict = field(default_factory=dict)
+
+
+class Backend(Protocol):
+    """What every backend module provides (one file per backend, one line in the registry).
+
+    ``name``: registry name; ``accepts``: subset of {"qp", "lcp"};
+    ``available()``: importable here; ``version()``;
+    ``solve(problem, accuracy, options)`` → :class:`RawSolution`.
+    Options are passed to the solver untouched and override the preset.
+    """
+
+    name: str
+    accepts: frozenset[str]
+
+    def available(self) -> bool: ...
+
+    def version(self) -> str | None: ...
+
+    def solve(self, problem: QP | LCP, accuracy: str = "default", options: dict | None = None) -> RawSolution: ...

@@ -1,0 +1,143 @@
+"""The contact solve: scale, formulate, hand to a backend, recover, check.
+
+Also the two-sided comparison of the source paper: the same scene with every one-sided
+support made two-sided (each support holds the plate at its gap, in both directions).
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .assembly import Model
+from .backends import ACCURACIES, get_backend, registry
+from .backends.base import Status
+from .errors import NoEquilibriumError, ProblemError, SolverError
+from .errors import PlateQPWarning
+from .formulations import FORMULATIONS, Contact, Scaled, formulate
+from .kkt import kkt_report
+from .results import Result
+
+NO_EQUILIBRIUM = ("the one-sided supports cannot carry this load: net uplift, or the load "
+                  "resultant lies outside the supports' reach, so the plate would lift off")
+
+# formulation="auto": condense while the dense condensed matrix stays small
+AUTO_CONDENSED_MAX = 400
+# backend="auto": first installed of these for QPs; Lemke for LCPs
+AUTO_QP_BACKENDS = ("clarabel", "qpsolvers:clarabel", "osqp", "cvxpy")
+
+
+def _choose(data: Scaled, backend: str, formulation: str) -> tuple[str, str]:
+    if formulation == "auto":
+        if data.m <= AUTO_CONDENSED_MAX and (backend == "auto" or "lcp" in _accepts(backend)):
+            formulation = "condensed"
+        else:
+            formulation = "primal"
+    if formulation not in FORMULATIONS:
+        raise ProblemError(f"unknown formulation {formulation!r}; choose one of {FORMULATIONS}")
+    if backend == "auto":
+        if formulation in ("condensed", "dual"):
+            backend = "lemke"
+        else:
+            avail = [b for b in AUTO_QP_BACKENDS if b in registry() and registry()[b].available()]
+            if not avail:
+                raise SolverError("the primal formulation needs a QP backend; none is installed "
+                                  "(pip install 'plateqp[solvers]')")
+            backend = avail[0]
+    return backend, formulation
+
+
+def _accepts(backend: str) -> frozenset[str]:
+    return get_backend(backend).accepts
+
+
+def formulations_for(accepts: frozenset[str]) -> list[str]:
+    """The formulations a backend that takes ``accepts`` can solve."""
+    return [f for f in FORMULATIONS if "qp" in accepts or (f != "primal" and "lcp" in accepts)]
+
+
+def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto",
+                  accuracy: str = "default", options: dict | None = None) -> Result:
+    """Solve the contact problem of a built model; see :func:`plateqp.solve`."""
+    if accuracy not in ACCURACIES:
+        raise ProblemError(f"unknown accuracy {accuracy!r}; choose one of {ACCURACIES}")
+    t0 = time.perf_counter()
+    data = Scaled.from_model(model)
+    backend, formulation = _choose(data, backend, formulation)
+    b = get_backend(backend)
+    if formulation not in formulations_for(b.accepts):
+        raise ProblemError(f"backend {backend!r} does not take the {formulation} formulation; "
+                           f"it takes: {', '.join(formulations_for(b.accepts))}")
+    form = formulate(data, formulation)
+    problem = form.problem(b.accepts)
+    t1 = time.perf_counter()
+    try:
+        raw = b.solve(problem, accuracy=accuracy, options=options or {})
+    except NoEquilibriumError as exn:
+        raise NoEquilibriumError(f"{backend} on the {formulation} problem: {NO_EQUILIBRIUM} ({exn})") from exn
+    t2 = time.perf_counter()
+    if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED):
+        raise NoEquilibriumError(f"{backend} on the {formulation} problem ended {raw.status.value} "
+                                 f"({raw.solver_status}): {NO_EQUILIBRIUM}")
+    if raw.x is None:
+        raise SolverError(f"{backend} on the {formulation} problem returned no solution: "
+                          f"{raw.status.value} ({raw.solver_status})")
+    c = form.recover(raw)
+    rep = kkt_report(data, c, accuracy)
+    status = raw.status
+    if status.solved:
+        status = Status.OPTIMAL if rep.ok else Status.INACCURATE
+    if status != Status.OPTIMAL:
+        warnings.warn(f"{backend} on the {formulation} problem: {status.value} "
+                      f"(worst KKT residual {rep.worst:.2e}, asked {rep.tol:.0e})", PlateQPWarning, stacklevel=3)
+    t3 = time.perf_counter()
+    res = _result(model, data, c, status, backend, formulation, accuracy)
+    res.kkt = rep
+    res.iterations = raw.iterations
+    res.extras = {"solver_status": raw.solver_status, **raw.extras}
+    res.times.update(formulate=t1 - t0, solve=t2 - t1, recover=t3 - t2)
+    return res
+
+
+def _result(model: Model, data: Scaled, c: Contact, status, backend, formulation, accuracy) -> Result:
+    """Back to the user's units."""
+    u = data.dof_scale * c.u
+    R = data.F0 * c.R
+    s = data.W * c.s
+    w = model.contacts.B @ u
+    gaps = model.contacts.g0 + s - w
+    stat = model.K @ u - model.f + model.contacts.B.T @ R
+    res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))
+    # in contact: the reaction carries load, or the support touches (gap ≈ 0)
+    active = (R > 1e-9 * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= 1e-9 * max(data.W, 1e-300))
+    return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
+                  accuracy=accuracy, reactions=R, gaps=gaps, compressions=s, active=active, residual=res)
+
+
+def solve_bilateral(model: Model) -> Result:
+    """Every one-sided support made two-sided: B u − ρ R = g0 exactly, R of either sign.
+
+    Solves the sparse saddle-point system [K Bᵀ; B −ρ] (u, R) = (f, g0), which works for a
+    floating plate too (as long as the supports hold it).
+    """
+    t0 = time.perf_counter()
+    data = Scaled.from_model(model)
+    n, m = data.n, data.m
+    A = sp.bmat([[data.K, data.B.T], [data.B, -sp.diags(data.rho)]], format="csc")
+    rhs = np.concatenate([data.f, data.g0])
+    try:
+        lu = spla.splu(A)
+        x = lu.solve(rhs)
+    except RuntimeError as exn:
+        raise ProblemError("the two-sided comparison is singular: the supports do not hold the plate") from exn
+    for _ in range(2):  # refinement
+        x = x + lu.solve(rhs - A @ x)
+    c = Contact(x[:n], x[n:], data.rho * x[n:])
+    res = _result(model, data, c, Status.OPTIMAL, "direct", "bilateral", "high")
+    res.active = np.ones(m, dtype=bool)
+    res.times = {"solve": time.perf_counter() - t0}
+    return res

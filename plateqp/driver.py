@@ -1,0 +1,72 @@
+"""``solve(scene, ...)``: build the model, pick the route, solve, recover, check.
+
+A scene without one-sided supports is solved directly (one sparse factorisation). A scene
+with them goes through a formulation (primal, condensed or dual) and a backend; see
+:mod:`plateqp.contact`.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .assembly import Model, build_model
+from .errors import MechanismError
+from .linalg import Factor
+from .results import Result
+from .scene import Scene
+
+
+def describe_modes(model: Model, modes: np.ndarray) -> str:
+    """Words for the rigid motions a set of two-sided supports leaves free."""
+    k = modes.shape[1]
+    what = {1: "one rigid motion", 2: "two rigid motions", 3: "three rigid motions"}.get(k, f"{k} rigid motions")
+    return (f"the two-sided supports leave {what} of the plate free (vertical translation and/or "
+            "rotation about a line); add pins or edge supports, or one-sided supports that hold it")
+
+
+def solve_two_sided(model: Model, factor: Factor | None = None) -> tuple[np.ndarray, float, Factor]:
+    """u_free and ‖K u − f‖/‖f‖ for the two-sided problem; MechanismError if K is singular."""
+    modes = model.rigid_modes()
+    if modes.shape[1]:
+        raise MechanismError(describe_modes(model, modes))
+    factor = factor or Factor(model.K)
+    u = factor.solve(model.f)
+    return u, factor.residual(u, model.f), factor
+
+
+def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accuracy: str = "default",
+          options: dict | None = None, model: Model | None = None) -> Result:
+    """Solve a scene.
+
+    Parameters
+    ----------
+    scene : the :class:`~plateqp.scene.Scene`
+    backend : a name from :func:`plateqp.available_backends` ("auto": Lemke on the condensed
+        problem when it is small, else the best installed QP backend)
+    formulation : "primal", "condensed", "dual" or "auto"
+    accuracy : "low", "default" or "high" (each backend maps it to its own tolerances)
+    options : passed to the backend untouched
+    model : a model built before from the same scene (skips the assembly)
+
+    Returns
+    -------
+    Result, whose ``status`` says whether the KKT residuals meet the asked accuracy.
+    """
+    t0 = time.perf_counter()
+    model = model or build_model(scene)
+    t_build = time.perf_counter() - t0
+    if not scene.one_sided:
+        t1 = time.perf_counter()
+        u, res, _ = solve_two_sided(model)
+        t2 = time.perf_counter()
+        return Result(scene, model, model.expand(u), residual=res, accuracy=accuracy,
+                      times={"build": t_build, "solve": t2 - t1, "total": t2 - t0})
+    from .contact import solve_contact
+
+    result = solve_contact(model, backend=backend, formulation=formulation, accuracy=accuracy,
+                           options=options)
+    result.times["build"] = t_build
+    result.times["total"] = time.perf_counter() - t0
+    return result

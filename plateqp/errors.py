@@ -1,0 +1,40 @@
+"""The exception tree of plateqp.
+
+Every error plateqp raises on purpose derives from :class:`PlateQPError`, so one
+``except pq.PlateQPError`` catches them all. Backend failures are wrapped with
+``raise ... from exn`` so the solver's own message is kept.
+"""
+
+from __future__ import annotations
+
+
+class PlateQPError(Exception):
+    """Base class of every plateqp error."""
+
+
+class SceneError(PlateQPError, ValueError):
+    """A scene is invalid: the message names the field (and the file, if any)."""
+
+
+class MechanismError(PlateQPError):
+    """The plate is a mechanism: its supports cannot prevent a rigid motion."""
+
+
+class ProblemError(PlateQPError, ValueError):
+    """A QP or LCP is malformed, or a formulation cannot be built for a scene."""
+
+
+class SolverError(PlateQPError):
+    """A backend failed, is unknown, is not installed, or rejected the problem."""
+
+
+class NoEquilibriumError(PlateQPError):
+    """The one-sided supports cannot carry the load (the contact problem has no solution).
+
+    Physically: net uplift, or a load resultant outside the reach of the supports,
+    so the plate would lift off as a rigid body.
+    """
+
+
+class PlateQPWarning(UserWarning):
+    """Warnings raised by plateqp (e.g. an inaccurate solve)."""

@@ -1,0 +1,287 @@
+r"""The contact problem in three standard forms: primal, condensed, dual.
+
+All three start from the same nondimensional data (see :class:`Scaled`): the free-dof
+stiffness K, load f, contact operator B, initial gaps g0 and flexibilities ρ = 1/c
+(ρ = 0 for a rigid support). They must give the same reactions.
+
+**Primal** (sparse, all dofs; works for a floating plate):
+
+.. math::
+
+    \min_{u,t}\ \tfrac12 u^T K u + \tfrac12 t^T t - f^T u
+    \quad\text{s.t.}\quad B u - \sqrt{\rho}\, t \le g_0 .
+
+The spring compression is s = √ρ t, so the spring energy ½ c s² = ½ t²: stiffness enters as
+1/√c, never as c, and a very stiff support does not spoil the Hessian. The multipliers of
+the constraints are the reactions R; stationarity in t gives t = √ρ R.
+
+**Condensed** (the source paper's route): every dof other than the contact deflections
+w_c = B u is eliminated by static condensation (one sparse factorisation of the non-contact
+block, right-hand sides solved together in blocks). With the condensed stiffness S and load r,
+the gaps z = g0 + ρR − w_c and the reactions satisfy the LCP
+
+.. math::
+
+    R = M z + q,\quad z \ge 0,\ R \ge 0,\ z^T R = 0,\qquad
+    M = (I + S\rho)^{-1} S,\quad q = (I + S\rho)^{-1}(r - S g_0),
+
+the KKT system of the bound-constrained QP  min ½ zᵀMz + qᵀz, z ≥ 0. For supports at nodes
+S is the Schur complement K_cc − K_cn K_nn⁻¹ K_nc; off-node supports first change variables
+so that one "master" dof per support is replaced by the support's deflection.
+
+**Dual** (reactions only; needs two-sided supports that hold the plate, K nonsingular):
+with the flexibility G = B K⁻¹ Bᵀ and F = G + diag(ρ),
+
+.. math::
+
+    \min_{R \ge 0}\ \tfrac12 R^T F R + d^T R,\qquad d = g_0 - B K^{-1} f,
+
+whose KKT conditions are the LCP gap = F R + d ≥ 0, R ≥ 0, Rᵀgap = 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from .assembly import Model
+from .backends.base import LCP, QP, RawSolution
+from .errors import MechanismError, ProblemError
+from .linalg import Factor
+
+FORMULATIONS = ("primal", "condensed", "dual")
+_BLOCK = 256  # right-hand sides solved together
+
+
+@dataclass
+class Scaled:
+    """Nondimensional contact data: lengths by L, deflections by W, forces by F0 = W D / L².
+
+    Dofs u = S ũ with S = W (deflection), W/L (slopes), W/L² (twist); energies by F0·W.
+    K̃ = S K S / (F0 W), f̃ = S f / F0·(1/W)·W, B̃ = B S / W, g̃ = g0 / W, ρ̃ = ρ D / L², R̃ = R / F0.
+    W is the larger of the deflection the total load would cause (F_tot L²/D) and the
+    largest gap, so both loads and gaps are of order one.
+    """
+
+    K: sp.csr_matrix
+    f: np.ndarray
+    B: sp.csr_matrix
+    g0: np.ndarray
+    rho: np.ndarray
+    dof_scale: np.ndarray  # S (per free dof)
+    L: float
+    W: float
+    F0: float
+    modes: np.ndarray  # rigid modes of K (n, k), scaled dofs
+
+    @classmethod
+    def from_model(cls, model: Model) -> Scaled:
+        c = model.contacts
+        if c is None:
+            raise ProblemError("the scene has no one-sided supports: nothing to formulate")
+        p = model.scene.plate
+        L = max(p.a, p.b)
+        D = p.D
+        nd = model.element.ndof_node
+        kind = model.free % nd
+        orders = np.array([dx + dy for dx, dy in model.element.node_dofs])
+        w_load = np.abs(model.f[kind == 0]).sum()
+        W = max(w_load * L**2 / D, np.abs(c.g0).max(initial=0.0), 1e-300)
+        if W <= 1e-300:
+            W = 1e-3 * L  # no load and no gaps: any scale will do
+        F0 = W * D / L**2
+        S = W / L ** orders[kind]
+        Sm = sp.diags(S)
+        K = (Sm @ model.K @ Sm / (F0 * W)).tocsr()
+        f = S * model.f / (F0 * W)
+        B = (c.B @ Sm / W).tocsr()
+        modes = model.rigid_modes() / S[:, None]
+        if modes.shape[1]:
+            modes = modes / np.linalg.norm(modes, axis=0)
+        return cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes)
+
+    @property
+    def n(self) -> int:
+        return self.K.shape[0]
+
+    @property
+    def m(self) -> int:
+        return self.g0.shape[0]
+
+    @property
+    def floating(self) -> bool:
+        """True if the two-sided supports leave rigid motions free (K singular)."""
+        return self.modes.shape[1] > 0
+
+
+@dataclass
+class Contact:
+    """The common output of the formulations' ``recover``: scaled fields, in the plate's terms."""
+
+    u: np.ndarray  # scaled free dofs
+    R: np.ndarray  # scaled reactions
+    s: np.ndarray  # scaled spring compressions
+
+
+@dataclass
+class Formulation:
+    """Base: a problem in standard form plus the recovery of plate quantities from its solution."""
+
+    name: str
+    data: Scaled
+    qp: QP | None = None
+    lcp: LCP | None = None
+    extras: dict = field(default_factory=dict)
+
+    def problem(self, accepts: frozenset[str]) -> QP | LCP:
+        """The form a backend takes: its QP if it takes QPs, else the LCP."""
+        if "qp" in accepts and self.qp is not None:
+            return self.qp
+        if "lcp" in accepts and self.lcp is not None:
+            return self.lcp
+        raise ProblemError(f"the {self.name} formulation has no form this backend takes ({sorted(accepts)})")
+
+    def recover(self, raw: RawSolution) -> Contact:
+        raise NotImplementedError
+
+
+class Primal(Formulation):
+    def __init__(self, data: Scaled) -> None:
+        n, m = data.n, data.m
+        el = np.flatnonzero(data.rho > 0)
+        ne = el.size
+        P = sp.block_diag([data.K, sp.identity(ne)], format="csc")
+        q = np.concatenate([-data.f, np.zeros(ne)])
+        T = sp.csr_matrix((-np.sqrt(data.rho[el]), (el, np.arange(ne))), shape=(m, ne))
+        G = sp.hstack([data.B, T], format="csc")
+        super().__init__("primal", data, qp=QP(P=P, q=q, G=G, h=data.g0.copy()))
+        self._el = el
+
+    def recover(self, raw: RawSolution) -> Contact:
+        d = self.data
+        u = raw.x[: d.n]
+        R = raw.z if raw.z is not None else np.full(d.m, np.nan)
+        s = np.zeros(d.m)
+        s[self._el] = np.sqrt(d.rho[self._el]) * raw.x[d.n:]
+        return Contact(u, R, s)
+
+
+class Condensed(Formulation):
+    def __init__(self, data: Scaled) -> None:
+        super().__init__("condensed", data)
+        B = data.B.tocsr()
+        m, n = B.shape
+        master = _masters(B)
+        others = np.setdiff1d(np.arange(n), master)
+        Bm = B[:, master].tocsc()
+        Bo = B[:, others].tocsc()
+        # Bm is diagonal when every support sits on a node; near-diagonal otherwise
+        try:
+            Binv = np.linalg.inv(Bm.toarray())
+        except np.linalg.LinAlgError as exn:
+            raise ProblemError("the contact points are too close together to condense onto "
+                               "(their interpolation rows are dependent); use the primal formulation") from exn
+        Binv[np.abs(Binv) < 1e-14 * np.abs(Binv).max()] = 0.0
+        Binv = sp.csr_matrix(Binv)
+        X = (Binv @ Bo).tocsr()
+        Tm = sp.hstack([Binv, -X])
+        To = sp.hstack([sp.csr_matrix((others.size, m)), sp.identity(others.size)])
+        P = sp.csr_matrix((np.ones(n), (np.concatenate([master, others]), np.arange(n))), shape=(n, n))
+        T = (P @ sp.vstack([Tm, To])).tocsr()
+        Kt = (T.T @ data.K @ T).tocsr()
+        ft = T.T @ data.f
+        Kcc = Kt[:m][:, :m].toarray()
+        Koc = Kt[m:][:, :m].tocsc()
+        Koo = Kt[m:][:, m:]
+        try:
+            fac = Factor(Koo)
+        except MechanismError as exn:
+            raise MechanismError("with every contact point held, the plate can still move: the "
+                                 "supports do not prevent rigid motion (fewer than three non-collinear "
+                                 "contact points and no two-sided supports); use the primal formulation, "
+                                 "which reports this as no equilibrium") from exn
+        fo = ft[m:]
+        S = Kcc.copy()
+        for j0 in range(0, m, _BLOCK):
+            cols = slice(j0, min(m, j0 + _BLOCK))
+            Y = fac.solve(Koc[:, cols].toarray())
+            S[:, cols] -= Koc.T @ Y
+        S = 0.5 * (S + S.T)
+        y0 = fac.solve(fo)
+        r = ft[:m] - Koc.T @ y0
+        rho = data.rho
+        A = np.eye(m) + S * rho[None, :]
+        M = np.linalg.solve(A, S)
+        q = np.linalg.solve(A, r - S @ data.g0)
+        M = 0.5 * (M + M.T)
+        self.lcp = LCP(M, q)
+        self.qp = self.lcp.as_qp()
+        self._T, self._fac, self._Koc, self._fo, self._m = T, fac, Koc, fo, m
+
+    def recover(self, raw: RawSolution) -> Contact:
+        d = self.data
+        z = raw.x
+        R = self.lcp.M @ z + self.lcp.q
+        w_c = d.g0 + d.rho * R - z
+        u_o = self._fac.solve(self._fo - self._Koc @ w_c)
+        u = self._T @ np.concatenate([w_c, u_o])
+        return Contact(u, R, d.rho * R)
+
+
+class Dual(Formulation):
+    def __init__(self, data: Scaled) -> None:
+        super().__init__("dual", data)
+        if data.floating:
+            raise ProblemError("the dual formulation needs K⁻¹, but this plate floats: its two-sided "
+                               "supports leave rigid motions free; use the primal or condensed formulation")
+        fac = Factor(data.K)
+        B = data.B.tocsr()
+        m = B.shape[0]
+        BT = B.T.tocsc()
+        G = np.empty((m, m))
+        for j0 in range(0, m, _BLOCK):
+            cols = slice(j0, min(m, j0 + _BLOCK))
+            G[:, cols] = B @ fac.solve(BT[:, cols].toarray())
+        G = 0.5 * (G + G.T)
+        u0 = fac.solve(data.f)
+        F = G + np.diag(data.rho)
+        dvec = data.g0 - B @ u0
+        self.lcp = LCP(F, dvec)
+        self.qp = self.lcp.as_qp()
+        self._fac, self._u0 = fac, u0
+
+    def recover(self, raw: RawSolution) -> Contact:
+        d = self.data
+        R = raw.x
+        u = self._u0 - self._fac.solve(d.B.T @ R)
+        return Contact(u, R, d.rho * R)
+
+
+def _masters(B: sp.csr_matrix) -> np.ndarray:
+    """One distinct dof per contact row, the one with the largest weight (greedy)."""
+    m = B.shape[0]
+    taken: set[int] = set()
+    out = np.empty(m, dtype=int)
+    order = np.argsort(-abs(B).max(axis=1).toarray().ravel())  # strongest rows choose first
+    for i in order:
+        lo, hi = B.indptr[i], B.indptr[i + 1]
+        cols, vals = B.indices[lo:hi], np.abs(B.data[lo:hi])
+        for k in np.argsort(-vals):
+            if cols[k] not in taken:
+                out[i] = cols[k]
+                taken.add(int(cols[k]))
+                break
+        else:
+            raise ProblemError(f"contact point {i} shares all its dofs with other contact points; "
+                               "use the primal formulation")
+    return out
+
+
+def formulate(data: Scaled, name: str) -> Formulation:
+    """Build the named formulation from scaled data."""
+    table = {"primal": Primal, "condensed": Condensed, "dual": Dual}
+    if name not in table:
+        raise ProblemError(f"unknown formulation {name!r}; choose one of {FORMULATIONS}")
+    return table[name](data)

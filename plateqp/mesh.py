@@ -1,0 +1,106 @@
+"""Structured rectangular meshes with cell masks (openings and cut-outs).
+
+Nodes are numbered row by row: node (i, j) at (i·hx, j·hy) has index j·(nx + 1) + i.
+Cells likewise: cell (i, j) spans [i·hx, (i+1)·hx] × [j·hy, (j+1)·hy], index j·nx + i, with
+corner nodes in the element order (0,0), (1,0), (1,1), (0,1).
+A node belongs to the plate if at least one of its cells is kept.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class Grid:
+    a: float
+    b: float
+    nx: int
+    ny: int
+    cell_mask: np.ndarray  # (nx*ny,) bool: cell kept
+
+    @classmethod
+    def from_scene(cls, scene) -> Grid:
+        p, m = scene.plate, scene.mesh
+        nx, ny = m.nx, m.ny
+        hx, hy = p.a / nx, p.b / ny
+        cx = (np.arange(nx) + 0.5) * hx
+        cy = (np.arange(ny) + 0.5) * hy
+        X, Y = np.meshgrid(cx, cy)  # (ny, nx): row j, column i -> index j*nx + i
+        keep = np.ones(X.shape, dtype=bool)
+        for o in scene.openings:
+            keep &= ~((X >= o.x0) & (X <= o.x1) & (Y >= o.y0) & (Y <= o.y1))
+        return cls(p.a, p.b, nx, ny, keep.ravel())
+
+    @property
+    def hx(self) -> float:
+        return self.a / self.nx
+
+    @property
+    def hy(self) -> float:
+        return self.b / self.ny
+
+    @property
+    def n_nodes(self) -> int:
+        return (self.nx + 1) * (self.ny + 1)
+
+    def node_xy(self) -> np.ndarray:
+        """(n_nodes, 2) coordinates of all grid nodes."""
+        i, j = np.meshgrid(np.arange(self.nx + 1), np.arange(self.ny + 1))
+        return np.column_stack([i.ravel() * self.hx, j.ravel() * self.hy])
+
+    def cell_nodes(self) -> np.ndarray:
+        """(n_cells, 4) node indices of every cell (kept or not), element corner order."""
+        i, j = np.meshgrid(np.arange(self.nx), np.arange(self.ny))
+        n0 = (j * (self.nx + 1) + i).ravel()
+        return np.column_stack([n0, n0 + 1, n0 + self.nx + 2, n0 + self.nx + 1])
+
+    def node_mask(self) -> np.ndarray:
+        """(n_nodes,) bool: node belongs to a kept cell."""
+        mask = np.zeros(self.n_nodes, dtype=bool)
+        mask[self.cell_nodes()[self.cell_mask].ravel()] = True
+        return mask
+
+    def node_at(self, x: float, y: float, rtol: float = 1e-9) -> int | None:
+        """Index of the plate node at (x, y), or None if no kept node is there."""
+        fi, fj = x / self.hx, y / self.hy
+        i, j = round(fi), round(fj)
+        if abs(fi - i) > rtol * max(1, self.nx) or abs(fj - j) > rtol * max(1, self.ny):
+            return None
+        if not (0 <= i <= self.nx and 0 <= j <= self.ny):
+            return None
+        n = j * (self.nx + 1) + i
+        return n if self.node_mask()[n] else None
+
+    def locate(self, x, y):
+        """Kept cell index and local coordinates (ξ, η) of points; cell −1 where off the plate.
+
+        A point on a cell boundary is given to a kept neighbour when there is one.
+        """
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        y = np.atleast_1d(np.asarray(y, dtype=float))
+        fx, fy = x / self.hx, y / self.hy
+        cell = np.full(x.shape, -1, dtype=int)
+        xi = np.zeros(x.shape)
+        eta = np.zeros(x.shape)
+        eps = 1e-9
+        # try the cell below-left of the point and its neighbours across a shared boundary
+        for dx in (0, -1):
+            for dy in (0, -1):
+                i = np.floor(fx + eps).astype(int) + dx
+                j = np.floor(fy + eps).astype(int) + dy
+                ok = (cell < 0) & (i >= 0) & (i < self.nx) & (j >= 0) & (j < self.ny)
+                lx, ly = fx - i, fy - j
+                ok &= (lx >= -eps) & (lx <= 1 + eps) & (ly >= -eps) & (ly <= 1 + eps)
+                c = np.where(ok, j * self.nx + i, 0)
+                ok &= self.cell_mask[c]
+                cell = np.where(ok, c, cell)
+                xi = np.where(ok, np.clip(lx, 0, 1), xi)
+                eta = np.where(ok, np.clip(ly, 0, 1), eta)
+        return cell, xi, eta
+
+    def covers(self, x: float, y: float) -> bool:
+        """True if (x, y) lies on a kept cell (boundaries included)."""
+        return bool(self.locate(x, y)[0][0] >= 0)

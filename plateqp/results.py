@@ -1,0 +1,197 @@
+"""Result of a solve, and the recovery of fields from the nodal dofs.
+
+Moments follow the convention of :mod:`plateqp.elements.base` (M = −D_b κ, Mx > 0 sags).
+Surface stresses are those of the bottom face (z = +h/2, the face on the side of positive w):
+σx = 6 Mx / h², σy = 6 My / h², τxy = 6 Mxy / h²; the top face has the opposite signs.
+Principal stresses σ1 ≥ σ2 of the bottom face, with the angle of σ1 from the x axis.
+
+For the ACM element moments are discontinuous between cells (non-conforming); values at a
+point on a cell boundary come from one neighbour, and :meth:`Result.nodal` averages the
+cells around each node for smooth plots.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .backends.base import Status
+from .elements import bending_matrix
+
+
+@dataclass
+class KKTReport:
+    """Residuals of the contact KKT conditions, in the plate's own terms (see :mod:`plateqp.kkt`)."""
+
+    stationarity: float = 0.0
+    spring: float = 0.0
+    primal: float = 0.0
+    dual: float = 0.0
+    complementarity: float = 0.0
+    tol: float = 0.0
+    scale: float = 1.0  # deflection scale for gaps
+
+    @property
+    def worst(self) -> float:
+        return max(self.stationarity, self.spring, self.primal, self.dual, self.complementarity)
+
+    @property
+    def ok(self) -> bool:
+        return bool(self.worst <= self.tol)
+
+    def as_dict(self) -> dict:
+        return {"stationarity": self.stationarity, "spring": self.spring, "primal": self.primal,
+                "dual": self.dual, "complementarity": self.complementarity, "tol": self.tol,
+                "scale": self.scale, "ok": self.ok}
+
+
+@dataclass
+class Result:
+    """The outcome of :func:`plateqp.solve`.
+
+    Attributes
+    ----------
+    u : full dof vector (prescribed values included)
+    reactions, gaps, compressions, active : one entry per contact point (discrete supports in
+        scene order, then bed nodes); empty for a two-sided scene
+    residual : ‖K u − f + Bᵀ R‖ / ‖f‖ of the final field
+    kkt : :class:`KKTReport` (contact scenes)
+    status : :class:`~plateqp.backends.base.Status`
+    times : seconds for "build", "formulate", "solve", "recover", "total"
+    """
+
+    scene: Any
+    model: Any
+    u: np.ndarray
+    status: Status = Status.OPTIMAL
+    backend: str = "direct"
+    formulation: str = "two-sided"
+    accuracy: str = "default"
+    reactions: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    gaps: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    compressions: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    active: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    residual: float = 0.0
+    kkt: KKTReport | None = None
+    iterations: int | None = None
+    times: dict = field(default_factory=dict)
+    extras: dict = field(default_factory=dict)
+
+    # -- fields at points ---------------------------------------------------------------------
+    def _eval(self, x, y, dx, dy):
+        x = np.asarray(x, dtype=float)
+        shape = np.broadcast(x, np.asarray(y)).shape
+        xb, yb = np.broadcast_arrays(x, np.asarray(y, dtype=float))
+        vals = self.model.interpolation(xb.ravel(), yb.ravel(), dx, dy) @ self.u
+        return vals.reshape(shape) if shape else float(vals[0])
+
+    def deflection(self, x, y):
+        """w at points (positive downward); arrays broadcast."""
+        return self._eval(x, y, 0, 0)
+
+    def slopes(self, x, y):
+        """(∂w/∂x, ∂w/∂y) at points."""
+        return self._eval(x, y, 1, 0), self._eval(x, y, 0, 1)
+
+    def curvatures(self, x, y):
+        """(w,xx, w,yy, w,xy) at points."""
+        return self._eval(x, y, 2, 0), self._eval(x, y, 0, 2), self._eval(x, y, 1, 1)
+
+    def moments(self, x, y):
+        """(Mx, My, Mxy) per unit length at points: M = −D_b κ."""
+        p = self.scene.plate
+        kxx, kyy, kxy = (np.asarray(v) for v in self.curvatures(x, y))
+        Db = bending_matrix(p.D, p.nu)
+        Mx = -(Db[0, 0] * kxx + Db[0, 1] * kyy)
+        My = -(Db[1, 0] * kxx + Db[1, 1] * kyy)
+        Mxy = -Db[2, 2] * 2.0 * kxy
+        return _unwrap(Mx), _unwrap(My), _unwrap(Mxy)
+
+    def stresses(self, x, y):
+        """(σx, σy, τxy) on the bottom face: 6 M / h²."""
+        c = 6.0 / self.scene.plate.h**2
+        return tuple(_unwrap(c * np.asarray(m)) for m in self.moments(x, y))
+
+    def principal_stresses(self, x, y):
+        """(σ1, σ2, θ1) on the bottom face: σ1 ≥ σ2 and the angle of σ1 from x (radians)."""
+        sx, sy, txy = (np.asarray(v) for v in self.stresses(x, y))
+        c = 0.5 * (sx + sy)
+        r = np.hypot(0.5 * (sx - sy), txy)
+        theta = 0.5 * np.arctan2(2.0 * txy, sx - sy)
+        return _unwrap(c + r), _unwrap(c - r), _unwrap(theta)
+
+    def section(self, p0, p1, n: int = 101, quantity: str = "w"):
+        """Values along the segment p0 → p1: returns (s, values) with s the distance from p0.
+
+        ``quantity``: "w", "Mx", "My", "Mxy", "sx", "sy", "txy", "s1", "s2".
+        """
+        t = np.linspace(0.0, 1.0, n)
+        x = p0[0] + t * (p1[0] - p0[0])
+        y = p0[1] + t * (p1[1] - p0[1])
+        s = t * np.hypot(p1[0] - p0[0], p1[1] - p0[1])
+        return s, self.at(x, y, quantity)
+
+    def at(self, x, y, quantity: str = "w"):
+        """Any named quantity at points (see :meth:`section`)."""
+        table = {
+            "w": lambda: self.deflection(x, y),
+            "Mx": lambda: self.moments(x, y)[0],
+            "My": lambda: self.moments(x, y)[1],
+            "Mxy": lambda: self.moments(x, y)[2],
+            "sx": lambda: self.stresses(x, y)[0],
+            "sy": lambda: self.stresses(x, y)[1],
+            "txy": lambda: self.stresses(x, y)[2],
+            "s1": lambda: self.principal_stresses(x, y)[0],
+            "s2": lambda: self.principal_stresses(x, y)[1],
+        }
+        if quantity not in table:
+            raise ValueError(f"unknown quantity {quantity!r}; choose one of {sorted(table)}")
+        return table[quantity]()
+
+    def nodal(self, quantity: str = "w") -> np.ndarray:
+        """(ny+1, nx+1) smoothed nodal values (average over the kept cells at each node; NaN off the plate)."""
+        g = self.model.grid
+        cells = self.model.cells
+        corners = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+        acc = np.zeros(g.n_nodes)
+        cnt = np.zeros(g.n_nodes)
+        cn = g.cell_nodes()[cells]
+        x0 = (cells % g.nx) * g.hx
+        y0 = (cells // g.nx) * g.hy
+        for k, (cx, cy) in enumerate(corners):
+            # evaluate just inside the cell so each cell contributes its own value
+            xi = 1e-9 + (1 - 2e-9) * cx
+            eta = 1e-9 + (1 - 2e-9) * cy
+            v = np.asarray(self.at(x0 + xi * g.hx, y0 + eta * g.hy, quantity)).ravel()
+            np.add.at(acc, cn[:, k], v)
+            np.add.at(cnt, cn[:, k], 1.0)
+        out = np.where(cnt > 0, acc / np.where(cnt > 0, cnt, 1), np.nan)
+        return out.reshape(g.ny + 1, g.nx + 1)
+
+    # -- summaries --------------------------------------------------------------------------
+    def w_nodes(self) -> np.ndarray:
+        """w at every plate node (NaN off the plate), shape (ny+1, nx+1)."""
+        g = self.model.grid
+        nd = self.model.element.ndof_node
+        w = self.u[0::nd][: g.n_nodes].astype(float).copy()
+        w[~g.node_mask()] = np.nan
+        return w.reshape(g.ny + 1, g.nx + 1)
+
+    def w_max(self) -> tuple[float, float, float]:
+        """(w, x, y) of the node with the largest |w|."""
+        g = self.model.grid
+        w = self.w_nodes().ravel()
+        k = int(np.nanargmax(np.abs(w)))
+        x, y = g.node_xy()[k]
+        return float(w[k]), float(x), float(y)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == Status.OPTIMAL
+
+
+def _unwrap(v):
+    a = np.asarray(v)
+    return float(a) if a.ndim == 0 else a

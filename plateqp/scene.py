@@ -1,0 +1,440 @@
+"""The scene: what the user describes. Dataclasses, validation and TOML load/save.
+
+A scene is pure data; :func:`plateqp.assembly.build_model` turns it into matrices.
+Every check raises :class:`~plateqp.errors.SceneError` naming the field (``supports.3.gap``)
+and, for a scene read from a file, the file.
+
+Units are any consistent set (plateqp never assumes SI). Conventions: the plate occupies
+[0, a] × [0, b]; w and loads are positive downward; a one-sided support's gap ``g0 > 0`` is
+settlement (support below the plate), ``g0 < 0`` heave (support pushed into the plate).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+from typing import Any, Callable
+
+from .errors import SceneError
+
+EDGE_KINDS = ("free", "simple", "clamped")
+EDGE_NAMES = ("left", "right", "bottom", "top")  # x = 0, x = a, y = 0, y = b
+ELEMENT_KINDS = ("acm", "bfs")
+GAP_PROFILES = ("uniform", "linear", "trough", "bump")
+
+
+@dataclass
+class Plate:
+    """Rectangle [0, a] × [0, b], thickness h, Young's modulus E, Poisson's ratio ν."""
+
+    a: float = 1.0
+    b: float = 1.0
+    h: float = 0.01
+    E: float = 1.0e7
+    nu: float = 0.3
+
+    @property
+    def D(self) -> float:
+        """Bending stiffness D = E h³ / (12 (1 − ν²))."""
+        return self.E * self.h**3 / (12.0 * (1.0 - self.nu**2))
+
+
+@dataclass
+class MeshSpec:
+    """A structured nx × ny grid of equal rectangles, with the element kind."""
+
+    nx: int = 16
+    ny: int = 16
+    element: str = "acm"
+
+
+@dataclass
+class Edge:
+    """Two-sided support along one edge.
+
+    ``kind``: "free", "simple" (w = w_value) or "clamped" (w = w_value and ∂w/∂n = slope,
+    n the outward normal). Non-zero ``w`` and ``slope`` are the source paper's w = f1,
+    ∂w/∂n = f2 (constant along the edge).
+    """
+
+    kind: str = "free"
+    w: float = 0.0
+    slope: float = 0.0
+
+
+@dataclass
+class Opening:
+    """A cut-out: every cell whose centre lies in [x0, x1] × [y0, y1] is removed."""
+
+    x0: float
+    x1: float
+    y0: float
+    y1: float
+
+
+@dataclass
+class Pin:
+    """Two-sided point support at a mesh node: w = ``w`` there."""
+
+    x: float
+    y: float
+    w: float = 0.0
+
+
+@dataclass
+class UniformLoad:
+    """Pressure q over the whole plate (force/length²)."""
+
+    q: float
+    type: str = field(default="uniform", init=False)
+
+
+@dataclass
+class PatchLoad:
+    """Pressure q over the rectangle [x0, x1] × [y0, y1]."""
+
+    q: float
+    x0: float
+    x1: float
+    y0: float
+    y1: float
+    type: str = field(default="patch", init=False)
+
+
+@dataclass
+class PointLoad:
+    """Point force P at (x, y), anywhere on the plate (consistent nodal loads)."""
+
+    P: float
+    x: float
+    y: float
+    type: str = field(default="point", init=False)
+
+
+Load = UniformLoad | PatchLoad | PointLoad
+_LOADS: dict[str, type] = {"uniform": UniformLoad, "patch": PatchLoad, "point": PointLoad}
+
+
+@dataclass
+class Support:
+    """One-sided discrete support at (x, y) with initial gap g0 (``gap``).
+
+    ``stiffness``: ``"rigid"`` or a positive number c (force/length): an elastic support with
+    R = c s, s its compression. A support off the mesh nodes acts through the element's
+    interpolation of w at that point.
+    """
+
+    x: float
+    y: float
+    gap: float = 0.0
+    stiffness: float | str = "rigid"
+
+    @property
+    def rigid(self) -> bool:
+        return isinstance(self.stiffness, str)
+
+
+@dataclass
+class Foundation:
+    """Tensionless elastic bed of modulus k (force/length³) over ``region`` (whole plate if None).
+
+    ``gap``: a number, a dict profile (``{profile = "linear", g0, gx, gy}``,
+    ``{profile = "trough" | "bump", x, y, radius, depth}``) or, in Python, any callable
+    g0(x, y) taking and returning arrays.
+    """
+
+    k: float
+    region: list[float] | None = None
+    gap: float | dict | Callable = 0.0
+
+    def gap_at(self, x, y):
+        """The initial gap field g0 at points (arrays)."""
+        import numpy as np
+
+        x = np.asarray(x, dtype=float)
+        y = np.asarray(y, dtype=float)
+        g = self.gap
+        if callable(g):
+            return np.broadcast_to(np.asarray(g(x, y), dtype=float), x.shape).copy()
+        if isinstance(g, dict):
+            prof = g.get("profile", "uniform")
+            if prof == "uniform":
+                return np.full(x.shape, float(g.get("g0", 0.0)))
+            if prof == "linear":
+                return g.get("g0", 0.0) + g.get("gx", 0.0) * x + g.get("gy", 0.0) * y
+            # trough (settlement, g0 > 0) or bump (heave, g0 < 0): smooth (1 − r²/R²)² bell
+            r2 = ((x - g["x"]) ** 2 + (y - g["y"]) ** 2) / g["radius"] ** 2
+            bell = np.where(r2 < 1.0, (1.0 - r2) ** 2, 0.0)
+            sign = 1.0 if prof == "trough" else -1.0
+            return sign * abs(g["depth"]) * bell
+        return np.full(x.shape, float(g))
+
+
+@dataclass
+class Scene:
+    """Everything a plate problem needs; validated on construction."""
+
+    name: str = "scene"
+    plate: Plate = field(default_factory=Plate)
+    mesh: MeshSpec = field(default_factory=MeshSpec)
+    edges: dict[str, Edge] = field(default_factory=dict)
+    openings: list[Opening] = field(default_factory=list)
+    pins: list[Pin] = field(default_factory=list)
+    loads: list[Load] = field(default_factory=list)
+    supports: list[Support] = field(default_factory=list)
+    foundation: Foundation | None = None
+    source: str | None = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        self.edges = {k: (v if isinstance(v, Edge) else _edge_from(v, f"edges.{k}", self.source))
+                      for k, v in self.edges.items()}
+        self.validate()
+
+    # -- validation -----------------------------------------------------------------------
+    def _fail(self, where: str, what: str):
+        prefix = f"{self.source}: " if self.source else ""
+        raise SceneError(f"{prefix}{where}: {what}")
+
+    def _num(self, where: str, v, *, positive=False, nonneg=False) -> float:
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            self._fail(where, f"must be a number (got {v!r})")
+        if not math.isfinite(v):
+            self._fail(where, f"must be finite (got {v!r})")
+        if positive and v <= 0:
+            self._fail(where, f"must be > 0 (got {v!r})")
+        if nonneg and v < 0:
+            self._fail(where, f"must be >= 0 (got {v!r})")
+        return float(v)
+
+    def _inside(self, where: str, x, y) -> None:
+        a, b = self.plate.a, self.plate.b
+        tol = 1e-12 * max(a, b)
+        if not (-tol <= x <= a + tol and -tol <= y <= b + tol):
+            self._fail(where, f"point ({x}, {y}) lies outside the plate [0, {a}] x [0, {b}]")
+        if self.in_opening(x, y):
+            self._fail(where, f"point ({x}, {y}) lies in an opening (no plate there)")
+
+    def in_opening(self, x: float, y: float) -> bool:
+        """True if (x, y) lies strictly inside the removed cells of an opening."""
+        from .mesh import Grid
+
+        return not Grid.from_scene(self).covers(x, y)
+
+    def validate(self) -> None:
+        """Check every field; raises SceneError naming the first bad one."""
+        p = self.plate
+        for k in ("a", "b", "h", "E"):
+            self._num(f"plate.{k}", getattr(p, k), positive=True)
+        self._num("plate.nu", p.nu)
+        if not (-1.0 < p.nu < 0.5):
+            self._fail("plate.nu", f"must lie in (-1, 0.5) (got {p.nu})")
+        m = self.mesh
+        for k in ("nx", "ny"):
+            v = getattr(m, k)
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                self._fail(f"mesh.{k}", f"must be an integer >= 1 (got {v!r})")
+        if m.element not in ELEMENT_KINDS:
+            self._fail("mesh.element", f"unknown element {m.element!r}; choose one of {ELEMENT_KINDS}")
+        for name, e in self.edges.items():
+            if name not in EDGE_NAMES:
+                self._fail(f"edges.{name}", f"unknown edge; edges are {EDGE_NAMES}")
+            if e.kind not in EDGE_KINDS:
+                self._fail(f"edges.{name}", f"unknown kind {e.kind!r}; choose one of {EDGE_KINDS}")
+            self._num(f"edges.{name}.w", e.w)
+            self._num(f"edges.{name}.slope", e.slope)
+            if e.kind == "simple" and e.slope != 0.0:
+                self._fail(f"edges.{name}.slope", "a slope can only be prescribed on a clamped edge")
+        for i, o in enumerate(self.openings):
+            for k in ("x0", "x1", "y0", "y1"):
+                self._num(f"openings.{i}.{k}", getattr(o, k))
+            if not (o.x0 < o.x1 and o.y0 < o.y1):
+                self._fail(f"openings.{i}", "needs x0 < x1 and y0 < y1")
+        from .mesh import Grid
+
+        grid = Grid.from_scene(self)
+        if not grid.cell_mask.any():
+            self._fail("openings", "the openings remove every cell of the plate")
+        for i, pin in enumerate(self.pins):
+            self._num(f"pins.{i}.x", pin.x)
+            self._num(f"pins.{i}.y", pin.y)
+            self._num(f"pins.{i}.w", pin.w)
+            self._inside(f"pins.{i}", pin.x, pin.y)
+            if grid.node_at(pin.x, pin.y) is None:
+                hx, hy = grid.hx, grid.hy
+                self._fail(f"pins.{i}", f"({pin.x}, {pin.y}) is not a mesh node (node spacing {hx:g} x {hy:g});"
+                           " move the pin or change mesh.nx / mesh.ny")
+        for i, ld in enumerate(self.loads):
+            where = f"loads.{i}"
+            if not isinstance(ld, (UniformLoad, PatchLoad, PointLoad)):
+                self._fail(where, f"not a load: {ld!r}")
+            if isinstance(ld, PointLoad):
+                self._num(f"{where}.P", ld.P)
+                self._num(f"{where}.x", ld.x)
+                self._num(f"{where}.y", ld.y)
+                self._inside(where, ld.x, ld.y)
+            else:
+                self._num(f"{where}.q", ld.q)
+            if isinstance(ld, PatchLoad):
+                for k in ("x0", "x1", "y0", "y1"):
+                    self._num(f"{where}.{k}", getattr(ld, k))
+                if not (ld.x0 < ld.x1 and ld.y0 < ld.y1):
+                    self._fail(where, "needs x0 < x1 and y0 < y1")
+                if ld.x1 <= 0 or ld.x0 >= p.a or ld.y1 <= 0 or ld.y0 >= p.b:
+                    self._fail(where, "the patch does not overlap the plate")
+        seen: dict[tuple[float, float], int] = {}
+        tol = 1e-9 * max(p.a, p.b)
+        for i, s in enumerate(self.supports):
+            where = f"supports.{i}"
+            self._num(f"{where}.x", s.x)
+            self._num(f"{where}.y", s.y)
+            self._num(f"{where}.gap", s.gap)
+            self._inside(where, s.x, s.y)
+            if isinstance(s.stiffness, str):
+                if s.stiffness != "rigid":
+                    self._fail(f"{where}.stiffness", f"must be \"rigid\" or a positive number (got {s.stiffness!r})")
+            else:
+                self._num(f"{where}.stiffness", s.stiffness, positive=True)
+            key = (round(s.x / tol), round(s.y / tol))
+            if key in seen:
+                self._fail(where, f"lies on the same point as supports.{seen[key]}; merge them into one support")
+            seen[key] = i
+        if self.foundation is not None:
+            f = self.foundation
+            self._num("foundation.k", f.k, positive=True)
+            if f.region is not None:
+                if len(f.region) != 4:
+                    self._fail("foundation.region", "must be [x0, x1, y0, y1]")
+                for j, v in enumerate(f.region):
+                    self._num(f"foundation.region.{j}", v)
+                if not (f.region[0] < f.region[1] and f.region[2] < f.region[3]):
+                    self._fail("foundation.region", "needs x0 < x1 and y0 < y1")
+            g = f.gap
+            if isinstance(g, dict):
+                prof = g.get("profile")
+                if prof not in GAP_PROFILES:
+                    self._fail("foundation.gap.profile", f"unknown profile {prof!r}; choose one of {GAP_PROFILES}")
+                need = {"uniform": ("g0",), "linear": (), "trough": ("x", "y", "radius", "depth"),
+                        "bump": ("x", "y", "radius", "depth")}[prof]
+                allowed = {"profile", *need, *(("gx", "gy", "g0") if prof == "linear" else ())}
+                for k in need:
+                    if k not in g:
+                        self._fail(f"foundation.gap.{k}", f"missing (profile {prof!r} needs {need})")
+                for k, v in g.items():
+                    if k not in allowed:
+                        self._fail(f"foundation.gap.{k}", f"unknown key for profile {prof!r}; allowed {sorted(allowed)}")
+                    if k != "profile":
+                        self._num(f"foundation.gap.{k}", v, positive=(k == "radius"))
+            elif not callable(g):
+                self._num("foundation.gap", g)
+
+    # -- convenience ----------------------------------------------------------------------
+    @property
+    def one_sided(self) -> bool:
+        """True if the scene has one-sided supports (discrete or a tensionless bed)."""
+        return bool(self.supports) or self.foundation is not None
+
+    # -- TOML -----------------------------------------------------------------------------
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Scene:
+        """Load a scene from a TOML file (unknown keys are errors)."""
+        path = Path(path)
+        try:
+            data = tomllib.loads(path.read_text())
+        except FileNotFoundError:
+            raise SceneError(f"{path}: no such file") from None
+        except tomllib.TOMLDecodeError as exn:
+            raise SceneError(f"{path}: not valid TOML: {exn}") from exn
+        return cls.from_dict(data, source=str(path))
+
+    @classmethod
+    def from_dict(cls, data: dict, source: str | None = None) -> Scene:
+        """Build a scene from the nested dict shape of the TOML file."""
+        prefix = f"{source}: " if source else ""
+
+        def fail(where, what):
+            raise SceneError(f"{prefix}{where}: {what}")
+
+        def build(klass, d, where):
+            if not isinstance(d, dict):
+                fail(where, f"must be a table (got {d!r})")
+            names = {f.name for f in fields(klass) if f.init}
+            extra = set(d) - names - ({"type"} if klass in _LOADS.values() else set())
+            if extra:
+                fail(f"{where}.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(names)}")
+            try:
+                return klass(**{k: v for k, v in d.items() if k != "type"})
+            except TypeError as exn:
+                fail(where, f"missing or bad keys ({exn})")
+
+        top = {"name", "plate", "mesh", "edges", "openings", "pins", "loads", "supports", "foundation"}
+        extra = set(data) - top
+        if extra:
+            fail(sorted(extra)[0], f"unknown key; allowed top-level keys: {sorted(top)}")
+        kw: dict[str, Any] = {"name": str(data.get("name", "scene"))}
+        if "plate" in data:
+            kw["plate"] = build(Plate, data["plate"], "plate")
+        if "mesh" in data:
+            kw["mesh"] = build(MeshSpec, data["mesh"], "mesh")
+        if "edges" in data:
+            if not isinstance(data["edges"], dict):
+                fail("edges", "must be a table")
+            kw["edges"] = {k: _edge_from(v, f"edges.{k}", source) for k, v in data["edges"].items()}
+        for key, klass in (("openings", Opening), ("pins", Pin), ("supports", Support)):
+            items = data.get(key, [])
+            if not isinstance(items, list):
+                fail(key, "must be an array of tables ([[" + key + "]])")
+            kw[key] = [build(klass, d, f"{key}.{i}") for i, d in enumerate(items)]
+        loads = []
+        for i, d in enumerate(data.get("loads", [])):
+            t = d.get("type") if isinstance(d, dict) else None
+            if t not in _LOADS:
+                fail(f"loads.{i}.type", f"must be one of {sorted(_LOADS)} (got {t!r})")
+            loads.append(build(_LOADS[t], d, f"loads.{i}"))
+        kw["loads"] = loads
+        if "foundation" in data:
+            kw["foundation"] = build(Foundation, data["foundation"], "foundation")
+        return cls(**kw, source=source)
+
+    def to_dict(self) -> dict:
+        """The nested dict shape of the TOML file (exact inverse of :meth:`from_dict`)."""
+        d: dict[str, Any] = {"name": self.name, "plate": asdict(self.plate), "mesh": asdict(self.mesh)}
+        if self.edges:
+            d["edges"] = {k: (e.kind if (e.w == 0.0 and e.slope == 0.0) else asdict(e)) for k, e in self.edges.items()}
+        for key in ("openings", "pins", "supports"):
+            if getattr(self, key):
+                d[key] = [asdict(o) for o in getattr(self, key)]
+        if self.loads:
+            d["loads"] = [{"type": ld.type, **{k: v for k, v in asdict(ld).items() if k != "type"}} for ld in self.loads]
+        if self.foundation is not None:
+            f = self.foundation
+            if callable(f.gap):
+                raise SceneError("foundation.gap: a Python callable cannot be saved to TOML; use a profile")
+            fd: dict[str, Any] = {"k": f.k, "gap": f.gap}
+            if f.region is not None:
+                fd["region"] = list(f.region)
+            d["foundation"] = fd
+        return d
+
+    def to_toml(self, path: str | Path | None = None) -> str:
+        """The scene as TOML text; written to ``path`` if given."""
+        import tomli_w
+
+        text = tomli_w.dumps(self.to_dict())
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
+
+def _edge_from(v, where: str, source: str | None) -> Edge:
+    prefix = f"{source}: " if source else ""
+    if isinstance(v, str):
+        return Edge(kind=v)
+    if isinstance(v, dict):
+        extra = set(v) - {"type", "kind", "w", "slope"}
+        if extra:
+            raise SceneError(f"{prefix}{where}.{sorted(extra)[0]}: unknown key; allowed: kind, w, slope")
+        kind = v.get("kind", v.get("type", "free"))
+        return Edge(kind=kind, w=v.get("w", 0.0), slope=v.get("slope", 0.0))
+    raise SceneError(f"{prefix}{where}: must be a kind (\"free\", \"simple\", \"clamped\") or a table")
