@@ -19,7 +19,7 @@ from .backends.base import Status
 from .errors import NoEquilibriumError, ProblemError, SolverError
 from .errors import PlateQPWarning
 from .formulations import FORMULATIONS, Contact, Scaled, formulate
-from .kkt import kkt_report
+from .kkt import equilibrium_possible, kkt_report
 from .results import Result
 
 NO_EQUILIBRIUM = ("the one-sided supports cannot carry this load: net uplift, or the load "
@@ -61,12 +61,21 @@ def formulations_for(accepts: frozenset[str]) -> list[str]:
 
 
 def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto",
-                  accuracy: str = "default", options: dict | None = None) -> Result:
-    """Solve the contact problem of a built model; see :func:`plateqp.solve`."""
+                  accuracy: str = "default", options: dict | None = None, check_statics: bool = True) -> Result:
+    """Solve the contact problem of a built model; see :func:`plateqp.solve`.
+
+    ``check_statics``: before solving, check by statics that the supports can carry the load
+    at all (:func:`plateqp.kkt.equilibrium_possible`) and raise NoEquilibriumError at once
+    if not. Whatever it is set to, a backend's claim of "no equilibrium" is checked against
+    the same statics, and a false claim is a SolverError, never a NoEquilibriumError.
+    """
     if accuracy not in ACCURACIES:
         raise ProblemError(f"unknown accuracy {accuracy!r}; choose one of {ACCURACIES}")
     t0 = time.perf_counter()
     data = Scaled.from_model(model)
+    possible, why = equilibrium_possible(data)
+    if check_statics and not possible:
+        raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({why}; found by statics, before any solve)")
     backend, formulation = _choose(data, backend, formulation)
     b = get_backend(backend)
     if formulation not in formulations_for(b.accepts):
@@ -78,8 +87,15 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     try:
         raw = b.solve(problem, accuracy=accuracy, options=options or {})
     except NoEquilibriumError as exn:
-        raise NoEquilibriumError(f"{backend} on the {formulation} problem: {NO_EQUILIBRIUM} ({exn})") from exn
+        if possible:
+            raise SolverError(f"{backend} on the {formulation} problem claimed no equilibrium ({exn}), "
+                              "but statics says the supports can carry the load: the solver failed") from exn
+        raise NoEquilibriumError(f"{backend} on the {formulation} problem: {NO_EQUILIBRIUM} ({why})") from exn
     t2 = time.perf_counter()
+    if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED) and possible:
+        raise SolverError(f"{backend} on the {formulation} problem ended {raw.status.value} "
+                          f"({raw.solver_status}), but statics says the supports can carry the load: "
+                          "the solver failed")
     if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED):
         raise NoEquilibriumError(f"{backend} on the {formulation} problem ended {raw.status.value} "
                                  f"({raw.solver_status}): {NO_EQUILIBRIUM}")

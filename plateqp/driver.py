@@ -37,7 +37,7 @@ def solve_two_sided(model: Model, factor: Factor | None = None) -> tuple[np.ndar
 
 
 def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accuracy: str = "default",
-          options: dict | None = None, model: Model | None = None) -> Result:
+          options: dict | None = None, model: Model | None = None, check_statics: bool = True) -> Result:
     """Solve a scene.
 
     Parameters
@@ -49,6 +49,8 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     accuracy : "low", "default" or "high" (each backend maps it to its own tolerances)
     options : passed to the backend untouched
     model : a model built before from the same scene (skips the assembly)
+    check_statics : check first, by statics alone, that the one-sided supports can carry the
+        load (else NoEquilibriumError before any solve); set False to let the backend find out
 
     Returns
     -------
@@ -66,7 +68,7 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     from .contact import solve_contact
 
     result = solve_contact(model, backend=backend, formulation=formulation, accuracy=accuracy,
-                           options=options)
+                           options=options, check_statics=check_statics)
     result.times["build"] = t_build
     result.times["total"] = time.perf_counter() - t0
     return result

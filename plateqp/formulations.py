@@ -75,6 +75,7 @@ class Scaled:
     W: float
     F0: float
     modes: np.ndarray  # rigid modes of K (n, k), scaled dofs
+    is_w: np.ndarray  # (n,) bool: the dof is a deflection (not a slope or twist)
 
     @classmethod
     def from_model(cls, model: Model) -> Scaled:
@@ -100,7 +101,7 @@ class Scaled:
         modes = model.rigid_modes() / S[:, None]
         if modes.shape[1]:
             modes = modes / np.linalg.norm(modes, axis=0)
-        return cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes)
+        return cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, kind == 0)
 
     @property
     def n(self) -> int:
