@@ -104,3 +104,12 @@ class Grid:
     def covers(self, x: float, y: float) -> bool:
         """True if (x, y) lies on a kept cell (boundaries included)."""
         return bool(self.locate(x, y)[0][0] >= 0)
+
+    def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
+        """True if the box [x0, x1] × [y0, y1] overlaps a kept cell with positive area."""
+        i = np.arange(self.nx)
+        j = np.arange(self.ny)
+        ox = np.minimum(x1, (i + 1) * self.hx) - np.maximum(x0, i * self.hx) > 0
+        oy = np.minimum(y1, (j + 1) * self.hy) - np.maximum(y0, j * self.hy) > 0
+        hit = np.outer(oy, ox).ravel()  # index j*nx + i, like cell_mask
+        return bool(np.any(hit & self.cell_mask))

@@ -188,6 +188,12 @@ class Scene:
     source: str | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        # tuples given in Python become lists, as they come back from TOML (exact round trips)
+        for key in ("openings", "pins", "loads", "supports"):
+            if isinstance(getattr(self, key), tuple):
+                setattr(self, key, list(getattr(self, key)))
+        if self.foundation is not None and isinstance(self.foundation.region, tuple):
+            self.foundation.region = list(self.foundation.region)
         self.edges = {k: (v if isinstance(v, Edge) else _edge_from(v, f"edges.{k}", self.source))
                       for k, v in self.edges.items()}
         self.validate()
@@ -244,6 +250,8 @@ class Scene:
                 self._fail(f"edges.{name}", f"unknown kind {e.kind!r}; choose one of {EDGE_KINDS}")
             self._num(f"edges.{name}.w", e.w)
             self._num(f"edges.{name}.slope", e.slope)
+            if e.kind == "free" and (e.w != 0.0 or e.slope != 0.0):
+                self._fail(f"edges.{name}", "a free edge cannot carry a prescribed w or slope; make it simple or clamped")
             if e.kind == "simple" and e.slope != 0.0:
                 self._fail(f"edges.{name}.slope", "a slope can only be prescribed on a clamped edge")
         for i, o in enumerate(self.openings):
@@ -283,6 +291,8 @@ class Scene:
                     self._fail(where, "needs x0 < x1 and y0 < y1")
                 if ld.x1 <= 0 or ld.x0 >= p.a or ld.y1 <= 0 or ld.y0 >= p.b:
                     self._fail(where, "the patch does not overlap the plate")
+                if not grid.covers_area(ld.x0, ld.x1, ld.y0, ld.y1):
+                    self._fail(where, "the patch lies entirely in an opening (no plate there to load)")
         seen: dict[tuple[float, float], int] = {}
         tol = 1e-9 * max(p.a, p.b)
         for i, s in enumerate(self.supports):
@@ -387,6 +397,8 @@ class Scene:
                 fail(key, "must be an array of tables ([[" + key + "]])")
             kw[key] = [build(klass, d, f"{key}.{i}") for i, d in enumerate(items)]
         loads = []
+        if not isinstance(data.get("loads", []), list):
+            fail("loads", "must be an array of tables ([[loads]])")
         for i, d in enumerate(data.get("loads", [])):
             t = d.get("type") if isinstance(d, dict) else None
             if t not in _LOADS:
