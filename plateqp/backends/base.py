@@ -26,7 +26,7 @@ from typing import Any, Protocol
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import ProblemError
+from ..errors import ProblemError, SolverError
 
 ACCURACIES = ("low", "default", "high")
 
@@ -161,3 +161,20 @@ class Backend(Protocol):
     def version(self) -> str | None: ...
 
     def solve(self, problem: QP | LCP, accuracy: str = "default", options: dict | None = None) -> RawSolution: ...
+
+
+def via_qp(problem: QP | LCP, solve_qp) -> RawSolution:
+    """Solve a QP with ``solve_qp``, or an LCP with symmetric M as its QP (x = z, w = M z + q).
+
+    Shared by the QP backends: an LCP with non-symmetric M is not the KKT system of a QP,
+    so a QP backend refuses it with a SolverError.
+    """
+    if not isinstance(problem, LCP):
+        return solve_qp(problem)
+    M = problem.M
+    if not np.allclose(M, M.T, rtol=1e-10, atol=1e-12 * max(1.0, np.abs(M).max())):
+        raise SolverError("a QP backend solves an LCP only for symmetric M")
+    out = solve_qp(problem.as_qp())
+    if out.x is not None:
+        out.w = M @ out.x + problem.q
+    return out
