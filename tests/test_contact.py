@@ -215,8 +215,9 @@ def test_rigid_limit_of_elastic_supports(lemke_symmetric):
     sc = symmetric_scene()
     for s in sc.supports:
         s.stiffness = 1e12 * sc.plate.D
-    for formulation in ("condensed", "dual"):
-        res = run(sc, "lemke", formulation)
+    for backend, formulation in (("lemke", "condensed"), ("lemke", "dual"), (_qp_backend(), "primal")):
+        res = run(sc, backend, formulation)
+        assert res.status == pq.Status.OPTIMAL  # stiffness enters the primal as 1/√c: no ill-conditioning
         np.testing.assert_allclose(res.reactions, lemke_symmetric.reactions, rtol=0,
                                    atol=1e-7 * np.abs(lemke_symmetric.reactions).max())
 
