@@ -74,6 +74,11 @@ def _finite_or_none(v) -> np.ndarray | None:
     return a.copy() if np.all(np.isfinite(a)) else None
 
 
+
+def presets_for_wrappers() -> dict[str, dict]:
+    """Our OSQP presets as cvxpy or qpsolvers pass them on (they set ``verbose`` themselves)."""
+    return {a: {**{k: v for k, v in OVERRIDES.items() if k != "verbose"}, **ACCURACY[a]} for a in ACCURACIES}
+
 def solve_qp(qp: QP, accuracy: str = "default", options: dict | None = None) -> RawSolution:
     """Solve a :class:`QP` with OSQP; see the module docstring for the multiplier mapping."""
     if osqp is None:

@@ -32,10 +32,7 @@ PREFIX = "qpsolvers"
 
 # OSQP and Clarabel take the presets of osqp_.py / clarabel_.py (reasons there), without
 # ``verbose``, which qpsolvers sets itself.
-_OSQP = {
-    a: {**{k: v for k, v in osqp_.OVERRIDES.items() if k != "verbose"}, **osqp_.ACCURACY[a]}
-    for a in ACCURACIES
-}
+_OSQP = osqp_.presets_for_wrappers()
 _CLARABEL = {a: dict(clarabel_.ACCURACY[a]) for a in ACCURACIES}
 
 #: Our presets in each solver's own option names (qpsolvers passes them through).
