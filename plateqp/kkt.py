@@ -10,7 +10,15 @@ spring             max |s − ρ R| / δ           (elastic supports: R = c s)
 primal             max(0, −gap) / δ
 dual               max(0, −R) / ρ_R
 complementarity    max |R_i gap_i| / (ρ_R δ)
+natural            max |min(R_i, k_i gap_i)| / ρ_R
 =================  ==============================================================
+
+The last is the natural residual of the complementarity conditions in force units: a gap
+error counts as the force it would take to close it, with k_i the local stiffness at support
+i (Σ_j B_ij² K_jj, an upper bound of the condensed stiffness, in series with the support's
+own spring). Gap-unit residuals alone cannot see reaction errors where supports are close
+together: measured on a 64² plate on a 30×30 support grid, Clarabel ended with gap-unit
+residuals of 3e-12 and reactions 1e-7 off; the natural residual sees that.
 
 with the deflection scale δ = max(‖B u‖∞, ‖g0‖∞) and the force scale
 ρ_R = max(‖R‖∞, 10⁻¹² ‖f‖₁). A result is ``ok`` when the worst residual is at most the
@@ -33,7 +41,7 @@ def kkt_report(data: Scaled, c: Contact, accuracy: str) -> KKTReport:
     u, R, s = c.u, c.R, c.s
     if not (np.all(np.isfinite(u)) and np.all(np.isfinite(R))):
         inf = float("inf")
-        return KKTReport(inf, inf, inf, inf, inf, KKT_TOL[accuracy], 1.0)
+        return KKTReport(inf, inf, inf, inf, inf, inf, KKT_TOL[accuracy], 1.0)
     BtR = data.B.T @ R
     r = data.K @ u - data.f + BtR
     st = np.linalg.norm(r) / max(np.linalg.norm(data.f), np.linalg.norm(BtR), 1e-300)
@@ -41,15 +49,24 @@ def kkt_report(data: Scaled, c: Contact, accuracy: str) -> KKTReport:
     delta = max(np.abs(w).max(initial=0.0), np.abs(data.g0).max(initial=0.0), 1e-300)
     gap = data.g0 + s - w
     rscale = max(np.abs(R).max(initial=0.0), 1e-12 * np.abs(data.f).sum(), 1e-300)
+    k = local_stiffness(data)
+    natural = np.abs(np.minimum(R, k * gap)).max(initial=0.0) / rscale
     return KKTReport(
         stationarity=float(st),
         spring=float(np.abs(s - data.rho * R).max(initial=0.0) / delta),
         primal=float(max(0.0, -gap.min(initial=0.0)) / delta),
         dual=float(max(0.0, -R.min(initial=0.0)) / rscale),
         complementarity=float(np.abs(R * gap).max(initial=0.0) / (rscale * delta)),
+        natural=float(natural),
         tol=KKT_TOL[accuracy],
         scale=delta * data.W,
     )
+
+
+def local_stiffness(data: Scaled) -> np.ndarray:
+    """Force per unit gap at each support: Σ_j B_ij² K_jj in series with the spring (1/ρ)."""
+    kb = data.B.multiply(data.B) @ data.K.diagonal()
+    return kb / (1.0 + data.rho * kb)
 
 
 def equilibrium_possible(data: Scaled) -> tuple[bool, str]:

@@ -30,12 +30,13 @@ class KKTReport:
     primal: float = 0.0
     dual: float = 0.0
     complementarity: float = 0.0
+    natural: float = 0.0
     tol: float = 0.0
     scale: float = 1.0  # deflection scale for gaps
 
     @property
     def worst(self) -> float:
-        return max(self.stationarity, self.spring, self.primal, self.dual, self.complementarity)
+        return max(self.stationarity, self.spring, self.primal, self.dual, self.complementarity, self.natural)
 
     @property
     def ok(self) -> bool:
@@ -43,7 +44,8 @@ class KKTReport:
 
     def as_dict(self) -> dict:
         return {"stationarity": self.stationarity, "spring": self.spring, "primal": self.primal,
-                "dual": self.dual, "complementarity": self.complementarity, "tol": self.tol,
+                "dual": self.dual, "complementarity": self.complementarity, "natural": self.natural,
+                "tol": self.tol,
                 "scale": self.scale, "ok": self.ok}
 
 
