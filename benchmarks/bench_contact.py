@@ -86,8 +86,11 @@ def main():
     ap.add_argument("--accuracy", default="high")
     ap.add_argument("--timeout", type=float, default=120.0)
     ap.add_argument("--out", default=str(HERE / "results" / "contact.csv"))
+    ap.add_argument("--skip-cvxpy", action="store_true", help="leave out cvxpy:* (the same solvers as the direct and qpsolvers routes)")
     args = ap.parse_args()
     names = pq.available_backends() if args.backends == "all" else args.backends.split(",")
+    if args.skip_cvxpy:
+        names = [n for n in names if not n.startswith("cvxpy")]
     rows = []
     for g in (int(v) for v in args.grids.split(",")):
         ref = run_case((args.mesh, g, "lemke", "condensed", "high"), 10 * args.timeout)
@@ -103,8 +106,9 @@ def main():
                        "status": r["status"], "build_s": r.get("build"), "solve_s": r.get("solve")}
                 if "kkt" in r:
                     k = r["kkt"]
-                    row.update({key: k[key] for key in ("stationarity", "spring", "primal", "dual", "complementarity")})
-                    row["kkt_worst"] = max(k[key] for key in ("stationarity", "spring", "primal", "dual", "complementarity"))
+                    keys = ("stationarity", "spring", "primal", "dual", "complementarity", "natural")
+                    row.update({key: k[key] for key in keys})
+                    row["kkt_worst"] = max(k[key] for key in keys)
                     row["reaction_error"] = float(np.abs(np.array(r["reactions"]) - R0).max() / np.abs(R0).max())
                 rows.append(row)
                 fmt = lambda v, f="{:.3g}": "–" if v is None else f.format(v)  # noqa: E731
