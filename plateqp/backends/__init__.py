@@ -12,7 +12,7 @@ from ..errors import SolverError
 from .base import ACCURACIES, LCP, QP, Backend, RawSolution, Status
 
 # module name -> the backends it provides (a family such as qpsolvers provides many)
-_MODULES = ("lemke", "osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
+_MODULES = ("lemke", "bpp", "pgs", "pdas", "osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
 
 _registry: dict[str, Backend] | None = None
 
