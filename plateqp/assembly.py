@@ -118,14 +118,6 @@ def build_model(scene: Scene) -> Model:
     nodes = grid.cell_nodes()[cells]
     cell_dofs = (nodes[:, :, None] * nd + np.arange(nd)).reshape(len(cells), -1)
 
-    # stiffness: every cell has the same element matrix; COO → CSR sums duplicates
-    Ke = el.stiffness(hx, hy, p.D, p.nu)
-    ne = el.ndof
-    rows = np.repeat(cell_dofs, ne, axis=1).ravel()
-    cols = np.tile(cell_dofs, (1, ne)).ravel()
-    vals = np.tile(Ke.ravel(), len(cells))
-    K_full = sp.csr_matrix((vals, (rows, cols)), shape=(n_full, n_full))
-
     f_full = _loads(scene, grid, el, cells, cell_dofs, n_full)
 
     fixed, values = _prescribed(scene, grid, el)
@@ -135,11 +127,77 @@ def build_model(scene: Scene) -> Model:
     is_fixed[fixed] = True
     free = np.flatnonzero(on_plate & ~is_fixed)
 
-    K = K_full[free][:, free].tocsr()
-    f = f_full[free] - K_full[free][:, fixed] @ values
+    # stiffness: every cell has the same element matrix; CSR built directly from node blocks
+    V, cnode = _node_blocks(grid, el.stiffness(hx, hy, p.D, p.nu), nd)
+    K_full = _csr_from_blocks(V, cnode, np.arange(n_full), n_full)  # off-plate rows empty
+    pos = np.full(n_full, -1)
+    pos[free] = np.arange(free.size)
+    K = _csr_from_blocks(V, cnode, pos, free.size)
+    u_c = np.zeros(n_full)
+    u_c[fixed] = values
+    f = f_full[free] - (K_full @ u_c)[free]
     model = Model(scene, grid, el, K, f, free, fixed, values, n_full, cell_dofs, cells, f_full, K_full)
     model.contacts = _contacts(scene, model)
     return model
+
+
+CORNER_IJ = ((0, 0), (1, 0), (1, 1), (0, 1))  # element corner order (di, dj)
+
+
+def _node_blocks(grid, Ke, nd):
+    """Node-level stencil of the assembled stiffness.
+
+    Every kept cell has the same Ke, so the nd×nd block coupling node p to its neighbour
+    p + (di, dj) (o = 3(dj+1) + di+1, ascending in node number) is the sum of Ke's corner blocks
+    over the kept cells that hold both nodes; which of those exist is one of 16 patterns per node.
+    Returns V (n_nodes, nd, 9, nd), cnode (n_nodes, 9) neighbour node or -1 where no block.
+    """
+    nn = grid.n_nodes
+    kept = np.zeros((nn, 4))
+    cn = grid.cell_nodes()[grid.cell_mask]
+    for a in range(4):
+        kept[cn[:, a], a] = 1.0  # the cell having node p as its corner a is kept
+    T = np.zeros((4, nd, 9, nd))
+    S = np.zeros((4, 9))
+    for a, (ia, ja) in enumerate(CORNER_IJ):
+        for b, (ib, jb) in enumerate(CORNER_IJ):
+            o = 3 * (jb - ja + 1) + (ib - ia + 1)
+            T[a, :, o, :] = Ke[a * nd:(a + 1) * nd, b * nd:(b + 1) * nd]
+            S[a, o] = 1.0
+    # a node's blocks depend only on which of its <= 4 cells are kept: 16 patterns. Sum each
+    # pattern's corner blocks in ascending cell order (corners 2, 3, 1, 0 of the node), so the
+    # (p, q) and (q, p) entries add the same numbers in the same order: K exactly symmetric.
+    bits = (kept * np.array([1, 2, 4, 8])).sum(axis=1).astype(np.intp)
+    table = np.zeros((16, nd * 9 * nd))
+    Tf = T.reshape(4, -1)
+    for pat in range(16):
+        for a in (2, 3, 1, 0):
+            if pat >> a & 1:
+                table[pat] += Tf[a]
+    V = table[bits].reshape(nn, nd, 9, nd)
+    off = np.array([dj * (grid.nx + 1) + di for dj in (-1, 0, 1) for di in (-1, 0, 1)])
+    cnode = np.where(kept @ S > 0, np.arange(nn)[:, None] + off, -1)
+    return V, cnode
+
+
+def _csr_from_blocks(V, cnode, pos, ncol):
+    """Rows/cols: dofs with pos >= 0 (pos: new index per full dof, increasing). Canonical CSR."""
+    nn, nd = V.shape[:2]
+    posn = pos.reshape(nn, nd)
+    G = np.where(cnode[:, :, None] >= 0, posn[np.maximum(cnode, 0)], -1).reshape(nn, 9 * nd)
+    G = G.astype(np.int32)
+    colok = G >= 0
+    rowok = posn >= 0
+    m = rowok[:, :, None] & colok[:, None, :]
+    data = V.reshape(nn, nd, 9 * nd)[m]
+    indices = np.broadcast_to(G[:, None, :], m.shape)[m]
+    counts = np.broadcast_to(colok.sum(axis=1)[:, None], rowok.shape)[rowok]
+    indptr = np.zeros(counts.size + 1, dtype=np.int32)
+    np.cumsum(counts, out=indptr[1:])
+    A = sp.csr_matrix((data, indices, indptr), shape=(counts.size, ncol))
+    A.has_sorted_indices = True
+    A.has_canonical_format = True
+    return A
 
 
 def _loads(scene, grid, el, cells, cell_dofs, n_full) -> np.ndarray:
@@ -148,7 +206,7 @@ def _loads(scene, grid, el, cells, cell_dofs, n_full) -> np.ndarray:
     for ld in scene.loads:
         if isinstance(ld, UniformLoad):
             fe = el.load(hx, hy)
-            np.add.at(f, cell_dofs, ld.q * fe[None, :])
+            f += np.bincount(cell_dofs.ravel(), weights=np.tile(ld.q * fe, len(cells)), minlength=n_full)
         elif isinstance(ld, PatchLoad):
             ci = cells % grid.nx
             cj = cells // grid.nx

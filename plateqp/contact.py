@@ -33,7 +33,7 @@ AUTO_QP_BACKENDS = ("clarabel", "qpsolvers:clarabel", "osqp", "cvxpy")
 
 def _choose(data: Scaled, backend: str, formulation: str) -> tuple[str, str]:
     if formulation == "auto":
-        if data.m <= AUTO_CONDENSED_MAX and (backend == "auto" or "lcp" in _accepts(backend)):
+        if data.m <= AUTO_CONDENSED_MAX and (backend == "auto" or "condensed" in formulations_for(backend)):
             formulation = "condensed"
         else:
             formulation = "primal"
@@ -51,13 +51,17 @@ def _choose(data: Scaled, backend: str, formulation: str) -> tuple[str, str]:
     return backend, formulation
 
 
-def _accepts(backend: str) -> frozenset[str]:
-    return get_backend(backend).accepts
-
-
-def formulations_for(accepts: frozenset[str]) -> list[str]:
-    """The formulations a backend that takes ``accepts`` can solve."""
-    return [f for f in FORMULATIONS if "qp" in accepts or (f != "primal" and "lcp" in accepts)]
+def formulations_for(backend) -> list[str]:
+    """The formulations a backend can solve: every one for a QP backend, condensed and dual for
+    an LCP backend, restricted further by the backend's optional ``formulations`` attribute
+    (e.g. a solver built for the sparse primal). ``backend``: a Backend or its name."""
+    if isinstance(backend, (set, frozenset)):  # a bare ``accepts`` set
+        accepts, only = backend, None
+    else:
+        b = get_backend(backend) if isinstance(backend, str) else backend
+        accepts, only = b.accepts, getattr(b, "formulations", None)
+    return [f for f in FORMULATIONS if ("qp" in accepts or (f != "primal" and "lcp" in accepts))
+            and (only is None or f in only)]
 
 
 def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto",
@@ -78,9 +82,9 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({why}; found by statics, before any solve)")
     backend, formulation = _choose(data, backend, formulation)
     b = get_backend(backend)
-    if formulation not in formulations_for(b.accepts):
+    if formulation not in formulations_for(b):
         raise ProblemError(f"backend {backend!r} does not take the {formulation} formulation; "
-                           f"it takes: {', '.join(formulations_for(b.accepts))}")
+                           f"it takes: {', '.join(formulations_for(b))}")
     form = formulate(data, formulation)
     problem = form.problem(b.accepts)
     t1 = time.perf_counter()

@@ -38,7 +38,7 @@ KNOWN_FAILURES: dict[tuple[str, str], str] = {
     ("cvxpy:CVXOPT", "dual"): "CVXOPT through cvxpy ends in solver_error at the 'high' preset",
 }
 
-PAIRS = [(b, f) for b in ALL for f in formulations_for(pq.get_backend(b).accepts)]
+PAIRS = [(b, f) for b in ALL for f in formulations_for(b)]
 
 
 def plate(**kw):
