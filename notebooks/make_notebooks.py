@@ -1,0 +1,213 @@
+# Regenerates the teaching notebooks (python notebooks/make_notebooks.py); edit here, not in the .ipynb.
+import nbformat as nbf
+from nbformat.v4 import new_notebook, new_markdown_cell as md, new_code_cell as code
+
+def save(name, cells):
+    nb = new_notebook(cells=cells, metadata={"kernelspec": {"name": "python3", "display_name": "Python 3", "language": "python"}})
+    nbf.write(nb, f"/work/main/notebooks/{name}")
+
+save("01_contact_as_a_qp.ipynb", [
+md("""# 1. Contact as a convex QP: three formulations side by side
+
+A plate on one-sided supports minimises its potential energy subject to *gap ≥ 0*. We write the
+three standard forms of plateqp (primal, condensed, dual) **by hand in cvxpy** from the same
+nondimensional data, solve each, and check the KKT conditions ourselves with NumPy:
+
+* stationarity  K u − f + Bᵀ R = 0
+* primal feasibility  gap = g0 + s − B u ≥ 0
+* dual feasibility  R ≥ 0
+* complementarity  R_i · gap_i = 0 for every support"""),
+code("""import numpy as np
+import cvxpy as cp
+import plateqp as pq
+from plateqp.assembly import build_model
+from plateqp.formulations import Scaled, formulate
+
+# a free plate on a 3 x 3 grid of rigid supports; one corner support settled, a point load
+supports = [pq.Support(x, y, gap=(0.002 if (x, y) == (1.0, 1.0) else 0.0))
+            for x in (0.0, 0.5, 1.0) for y in (0.0, 0.5, 1.0)]
+scene = pq.Scene(name="nb1", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(8, 8),
+                 loads=[pq.PointLoad(50.0, 0.6, 0.4), pq.UniformLoad(5.0)], supports=supports)
+d = Scaled.from_model(build_model(scene))   # K, f, B, g0, rho: nondimensional
+print(f"{d.n} free dofs, {d.m} supports, floating plate: {d.floating}")"""),
+md("""## Primal: all dofs
+minimise ½ uᵀKu − fᵀu subject to B u ≤ g0 (rigid supports, so no spring variables).
+The plate floats (no two-sided support), so K is only positive *semi*definite; the QP is
+still bounded because the supports can carry the load."""),
+code("""u = cp.Variable(d.n)
+cons = [d.B @ u <= d.g0]
+primal = cp.Problem(cp.Minimize(0.5 * cp.quad_form(u, cp.psd_wrap(d.K)) - d.f @ u), cons)
+primal.solve(solver="CLARABEL")
+u_p, R_p = u.value, cons[0].dual_value
+print(primal.status, "reactions (scaled):", np.round(R_p, 4))"""),
+md("""## Condensed: the gaps at the supports (the source paper's route)
+Static condensation of every non-contact dof gives the LCP R = M z + q with z the gaps:
+the KKT system of  minimise ½ zᵀMz + qᵀz, z ≥ 0."""),
+code("""cond = formulate(d, "condensed")
+M, q = cond.lcp.M, cond.lcp.q
+z = cp.Variable(d.m)
+c2 = [z >= 0]
+cp.Problem(cp.Minimize(0.5 * cp.quad_form(z, cp.psd_wrap(M)) + q @ z), c2).solve(solver="CLARABEL")
+R_c = M @ z.value + q       # the reactions are the multipliers of z >= 0
+print("reactions (scaled):", np.round(R_c, 4))"""),
+md("""## Dual: the reactions
+With the flexibility G = B K⁻¹ Bᵀ the gaps are gap = G R + d. K⁻¹ needs two-sided supports
+that hold the plate: ours floats, so plateqp refuses the dual clearly. We hold the plate with
+three pins (its supports then act on top of a held plate) to show the dual."""),
+code("""try:
+    formulate(d, "dual")
+except pq.ProblemError as exn:
+    print("refused:", exn)
+
+held = pq.Scene(name="nb1-held", plate=scene.plate, mesh=scene.mesh, loads=scene.loads,
+                supports=[s for s in supports if (s.x, s.y) not in ((0, 0), (1, 0), (0, 1))],
+                pins=[pq.Pin(0.0, 0.0), pq.Pin(1.0, 0.0), pq.Pin(0.0, 1.0)])
+dh = Scaled.from_model(build_model(held))
+dual = formulate(dh, "dual")
+R = cp.Variable(dh.m)
+cp.Problem(cp.Minimize(0.5 * cp.quad_form(R, cp.psd_wrap(dual.lcp.M)) + dual.lcp.q @ R), [R >= 0]).solve(solver="CLARABEL")
+cond_h = formulate(dh, "condensed")
+zh = cp.Variable(dh.m)
+cp.Problem(cp.Minimize(0.5 * cp.quad_form(zh, cp.psd_wrap(cond_h.lcp.M)) + cond_h.lcp.q @ zh), [zh >= 0]).solve(solver="CLARABEL")
+print("dual      R:", np.round(R.value, 5))
+print("condensed R:", np.round(cond_h.lcp.M @ zh.value + cond_h.lcp.q, 5))"""),
+md("## The KKT conditions, checked by hand (primal solution of the floating plate)"),
+code("""gap = d.g0 - d.B @ u_p
+stationarity = np.linalg.norm(d.K @ u_p - d.f + d.B.T @ R_p) / np.linalg.norm(d.f)
+print(f"stationarity      {stationarity:.1e}")
+print(f"min gap           {gap.min():.1e}   (>= 0 up to the solver tolerance)")
+print(f"min reaction      {R_p.min():.1e}   (>= 0)")
+print(f"max |R_i gap_i|   {np.abs(R_p * gap).max():.1e}")
+assert stationarity < 1e-6 and gap.min() > -1e-6 and R_p.min() > -1e-6
+np.testing.assert_allclose(R_p, R_c, atol=1e-5 * np.abs(R_c).max())   # primal and condensed agree"""),
+md("## The same through plateqp, in the user's units, with its own KKT report"),
+code("""res = pq.solve(scene, backend="lemke", formulation="condensed", accuracy="high")
+print(res.status, res.kkt.as_dict())
+print("reactions:", np.round(res.reactions, 3), " sum:", res.reactions.sum(), "= load", 50 + 5)
+np.testing.assert_allclose(res.reactions / d.F0, R_c, atol=1e-5 * np.abs(R_c).max())"""),
+])
+
+save("02_lemke_step_by_step.ipynb", [
+md("""# 2. Lemke's method step by step
+
+Lemke's complementary pivoting solves the condensed LCP  R = M z + q, z ≥ 0, R ≥ 0, zᵀR = 0
+(z the gaps, R the reactions). It adds an artificial variable z0 with a *covering vector* d:
+R = M z + q + d z0. Starting from z0 large enough every "reaction" is non-negative: the
+source paper reads d z0 as a **uniform pre-compression** of all supports. Each pivot then
+exchanges one support between the two states (its gap enters the basis: it opens; its
+reaction enters: it presses) until the pre-compression z0 reaches zero."""),
+code("""import numpy as np
+import plateqp as pq
+from plateqp.backends import lemke
+from plateqp.assembly import build_model
+from plateqp.formulations import Scaled, formulate
+
+supports = [pq.Support(x, y, gap=(-0.05 if (x, y) in ((0.5, 0.0), (1.0, 0.0)) else 0.0))
+            for x in (0.5, 0.75, 1.0) for y in (0.0, 0.5, 1.0)]
+scene = pq.Scene(name="nb2", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(8, 8),
+                 edges={"left": "simple"}, loads=[pq.PointLoad(40.0, 0.7, 0.7)], supports=supports)
+data = Scaled.from_model(build_model(scene))   # nondimensional: gaps in units of data.W
+lcp = formulate(data, "condensed").lcp
+raw = lemke.lemke(lcp.M, lcp.q, trace=True)
+names = {"z": "gap of support", "w": "reaction at support"}
+for step in raw.extras["trace"]:
+    e, l = step["entering"], step["leaving"]
+    ent = "z0 (pre-compression)" if e[0] == "z0" else f"{names[e[0]]} {e[1]}"
+    lea = "z0 (pre-compression)" if l[0] == "z0" else f"{names[l[0]]} {l[1]}"
+    print(f"pivot {step['step']:2d}: enters {ent:28s} leaves {lea:28s} z0 = {step['z0']:.4g}")"""),
+md("Every pivot is a support entering or leaving contact; when z0 leaves, the working scheme is found:"),
+code("""z = raw.x
+R = lcp.M @ z + lcp.q
+for i, s in enumerate(scene.supports):
+    state = "contact" if R[i] > 1e-12 else "lifted off"
+    print(f"support {i} at ({s.x}, {s.y}) gap0 {s.gap:+.3f}: {state:10s} R = {R[i] * data.F0:8.4f}, gap = {z[i] * data.W:.2e}")
+assert np.all(z >= 0) and np.all(R >= -1e-12) and abs(z @ R) < 1e-12"""),
+md("""## Any positive covering vector gives the same answer
+The pre-compression may be non-uniform: the path of pivots changes, the solution does not
+(M is positive definite here because the simple edge holds the plate)."""),
+code("""for d in (np.ones(lcp.n), np.linspace(1, 5, lcp.n), np.random.default_rng(0).uniform(0.1, 10, lcp.n)):
+    r = lemke.lemke(lcp.M, lcp.q, covering=d)
+    print(f"{r.iterations:2d} pivots, max |z - z_uniform| = {np.abs(r.x - z).max():.1e}")
+    np.testing.assert_allclose(r.x, z, atol=1e-12)"""),
+])
+
+save("03_heave_and_settlement.ipynb", [
+md("""# 3. Heave and settlement: one-sided against two-sided support
+
+The source paper's first two studies: a plate on discrete supports under a point load, the
+soil heaving under some supports (negative gaps) or settling (positive gaps). We compare the
+one-sided solution with the two-sided one (every support holds the plate both ways), as the
+paper does: in the lift-off zones the two differ a lot, in the contact zone little."""),
+code("""import numpy as np
+import plateqp as pq
+
+def grid_scene(name, gaps):
+    xs = (0.0, 100.0, 200.0, 300.0, 400.0)
+    sups = [pq.Support(x, y, gap=gaps.get((x, y), 0.0)) for x in xs for y in xs]
+    return pq.Scene(name=name, plate=pq.Plate(400.0, 400.0, 20.0, 2e5, 0.2), mesh=pq.MeshSpec(16, 16),
+                    loads=[pq.PointLoad(20000.0, 150.0, 250.0), pq.UniformLoad(0.05)], supports=sups)
+
+heave = grid_scene("heave", {(0.0, 0.0): -0.02, (100.0, 0.0): -0.02, (0.0, 100.0): -0.02})
+settle = grid_scene("settlement", {(300.0, 300.0): 0.02, (400.0, 400.0): 0.02, (300.0, 400.0): 0.02})
+for sc in (heave, settle):
+    one = pq.solve(sc, backend="lemke", formulation="condensed", accuracy="high")
+    two = pq.solve_bilateral(sc)
+    w1, w2 = one.w_nodes(), two.w_nodes()
+    print(f"{sc.name}: {one.active.sum()} of {one.active.size} supports in contact, "
+          f"max w one-sided {np.nanmax(w1):.4f} cm, two-sided {np.nanmax(w2):.4f} cm, "
+          f"max |difference| {np.nanmax(np.abs(w1 - w2)):.4f} cm")
+    print("   two-sided reactions below zero (tension the soil cannot give):", int((two.reactions < 0).sum()))
+    total = 20000.0 + 0.05 * 400.0**2
+    assert abs(one.reactions.sum() - total) < 1e-8 * total     # statics: a floating plate"""),
+md("## Deflection along a section through the load (solid one-sided, dashed two-sided)"),
+code("""import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+fig, ax = plt.subplots(figsize=(6, 3))
+for sc, colour in ((heave, "C0"), (settle, "C1")):
+    one = pq.solve(sc, backend="lemke", formulation="condensed")
+    two = pq.solve_bilateral(sc)
+    s, w1 = one.section((0.0, 250.0), (400.0, 250.0))
+    _, w2 = two.section((0.0, 250.0), (400.0, 250.0))
+    ax.plot(s, w1, colour, label=f"{sc.name}, one-sided")
+    ax.plot(s, w2, colour, ls="--", label=f"{sc.name}, two-sided")
+ax.invert_yaxis(); ax.set_xlabel("x along y = 250 cm [cm]"); ax.set_ylabel("w [cm] (down)")
+ax.legend(fontsize=7); fig.tight_layout()"""),
+])
+
+save("04_backends_compared.ipynb", [
+md("""# 4. Backends compared on speed and accuracy
+
+Every installed backend on every formulation it takes, on one small scene: solve time, the
+worst KKT residual, and the reaction error against Lemke on the condensed LCP (exact up to
+rounding). A status `inaccurate` is the backend's answer with residuals above the preset's
+tolerance: plateqp says so instead of passing it as optimal. (The full study is in
+benchmarks/.)"""),
+code("""import time, warnings
+import numpy as np
+import plateqp as pq
+from plateqp.contact import formulations_for
+
+supports = [pq.Support(x, y, gap=2e-4 * (x + y - 1.0)) for x in (0.2, 0.4, 0.6, 0.8) for y in (0.2, 0.4, 0.6, 0.8)]
+scene = pq.Scene(name="nb4", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(12, 12),
+                 edges={k: "simple" for k in ("left", "right", "bottom", "top")},
+                 loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.7, 0.6)], supports=supports)
+ref = pq.solve(scene, backend="lemke", formulation="condensed", accuracy="high").reactions
+rows = []
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    for b in pq.available_backends():
+        for f in formulations_for(b):
+            try:
+                r = pq.solve(scene, backend=b, formulation=f, accuracy="default")
+                err = np.abs(r.reactions - ref).max() / np.abs(ref).max()
+                rows.append((b, f, r.status.value, r.times["solve"], r.kkt.worst, err))
+            except pq.PlateQPError as exn:
+                rows.append((b, f, type(exn).__name__, np.nan, np.nan, np.nan))
+print(f"{'backend':22s} {'formulation':10s} {'status':12s} {'solve s':>8s} {'KKT':>8s} {'R error':>8s}")
+for b, f, st, t, k, e in sorted(rows, key=lambda r: (np.nan_to_num(r[3], nan=1e9))):
+    print(f"{b:22s} {f:10s} {st:12s} {t:8.4f} {k:8.1e} {e:8.1e}")
+# the promise: whatever claims optimal at 'default' is right to about the tolerance
+assert all(e < 1e-4 for _, _, st, _, _, e in rows if st == "optimal")"""),
+])
+print("written")
