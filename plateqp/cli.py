@@ -99,36 +99,15 @@ def cmd_solve(args) -> int:
 
 
 def cmd_demo(args) -> int:
-    names = [args.name] if args.name else scenes.names()
-    out = Path(args.out) if args.out else None
-    for name in names:
-        scene = scenes.load(name)
-        result = solve(scene, accuracy="high")
-        print(_summary(result))
-        report = {"one_sided": result_dict(result)}
-        if scene.one_sided:
-            from .assembly import build_model
-            from .contact import solve_bilateral
+    from .demo import run
 
-            two = solve_bilateral(build_model(scene))
-            w1, w2 = result.w_nodes(), two.w_nodes()
-            dw = np.nanmax(np.abs(w1 - w2))
-            print(f"  two-sided comparison: max |w_one-sided - w_two-sided| = {dw:.4g}"
-                  f" (two-sided max w {np.nanmax(np.abs(w2)):.4g});"
-                  f" two-sided reactions range [{two.reactions.min():.4g}, {two.reactions.max():.4g}]")
-            report["two_sided"] = result_dict(two)
-        if out is not None:
-            out.mkdir(parents=True, exist_ok=True)
-            (out / f"{name}.json").write_text(json.dumps(report, indent=1))
-            print(f"  report written to {out / (name + '.json')}")
-        print()
-    return 0
+    return run([args.name] if args.name else None, Path(args.out) if args.out else None)
 
 
 def cmd_backends(args) -> int:
     rows = []
     for name, b in sorted(registry().items()):
-        rows.append({"name": name, "formulations": formulations_for(b.accepts), "installed": bool(b.available()),
+        rows.append({"name": name, "formulations": formulations_for(b), "installed": bool(b.available()),
                      "version": b.version() if b.available() else None})
     if args.json:
         print(json.dumps({"backends": rows}, indent=1))
@@ -137,6 +116,58 @@ def cmd_backends(args) -> int:
         for r in rows:
             print(f"{r['name']:24s} {'yes' if r['installed'] else 'no':9s} {str(r['version'] or '-'):12s} "
                   f"{', '.join(r['formulations'])}")
+    return 0
+
+
+def _sweep_values(args) -> list:
+    """--values V1,V2,... ("rigid" allowed) or --range A:B:N[:log]."""
+    if args.values is not None:
+        out = []
+        for v in args.values.split(","):
+            v = v.strip()
+            if v.lower() in ("rigid", "inf"):
+                out.append("rigid")
+                continue
+            try:
+                out.append(int(v) if v.lstrip("+-").isdigit() else float(v))
+            except ValueError:
+                raise PlateQPError(f"--values: not a number or 'rigid': {v!r}") from None
+        return out
+    parts = args.range.split(":")
+    try:
+        if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
+            raise ValueError
+        a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+    except ValueError:
+        raise PlateQPError(f"--range wants A:B:N or A:B:N:log (got {args.range!r})") from None
+    if n < 1:
+        raise PlateQPError(f"--range: N must be >= 1 (got {n})")
+    if len(parts) == 4 and parts[3] == "log":
+        if a <= 0 or b <= 0:
+            raise PlateQPError(f"--range {args.range}: a log range needs A, B > 0")
+        return [float(v) for v in np.geomspace(a, b, n)]
+    return [float(v) for v in np.linspace(a, b, n)]
+
+
+def cmd_sweep(args) -> int:
+    from .studies import sweep
+
+    scene = Scene.from_toml(args.scene)
+    values = _sweep_values(args)
+    opts = json.loads(args.options) if args.options else None
+    res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
+                accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
+                max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                refine_breakpoints=not args.no_refine, rtol=args.rtol)
+    if args.json:
+        print(json.dumps(res.to_dict(), indent=1))
+    else:
+        print(res)
+    bad = [r for r in res.rows if r["status"] != Status.OPTIMAL.value]
+    if bad:
+        print(f"plateqp: sweep: {len(bad)} of {len(res.rows)} values failed or missed the asked accuracy "
+              f"(first: {args.param} = {bad[0]['value']}: {bad[0]['error'] or bad[0]['status']})", file=sys.stderr)
+        return 5
     return 0
 
 
@@ -155,11 +186,25 @@ def main(argv=None) -> int:
     s.add_argument("--options", help="backend options as a JSON object, passed through untouched")
     s.add_argument("--json", action="store_true")
     s.add_argument("--out")
+    w = sub.add_parser("sweep", help="solve a scene for a range of one parameter; find where the contact set changes")
+    w.add_argument("scene")
+    w.add_argument("--param", required=True, metavar="PATH", help="e.g. supports.*.stiffness, supports.3.gap, loads.0.P")
+    wv = w.add_mutually_exclusive_group(required=True)
+    wv.add_argument("--values", metavar="V1,V2,...", help="values in sweep order ('rigid' allowed for a stiffness)")
+    wv.add_argument("--range", metavar="A:B:N[:log]", help="N values from A to B, evenly or log spaced")
+    w.add_argument("--backend", default="auto")
+    w.add_argument("--formulation", default="auto", choices=["auto", "primal", "condensed", "dual"])
+    w.add_argument("--accuracy", default="default", choices=["low", "default", "high"])
+    w.add_argument("--options", help="backend options as a JSON object, passed through untouched")
+    w.add_argument("--rtol", type=float, default=1e-3, help="relative width of each breakpoint's bracket")
+    w.add_argument("--no-refine", action="store_true", help="report changes between values without bisection")
+    w.add_argument("--workers", type=int, default=2, help="local worker processes (1: serial)")
+    w.add_argument("--json", action="store_true")
     b = sub.add_parser("backends", help="list the backends and the formulations each takes")
     b.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
     try:
-        return {"demo": cmd_demo, "solve": cmd_solve, "backends": cmd_backends}[args.cmd](args)
+        return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends}[args.cmd](args)
     except NoEquilibriumError as exn:
         print(f"plateqp: no equilibrium: {exn}", file=sys.stderr)
         return 3
