@@ -19,7 +19,7 @@ from .backends.base import Status
 from .errors import NoEquilibriumError, ProblemError, SolverError
 from .errors import PlateQPWarning
 from .formulations import FORMULATIONS, Contact, Scaled, formulate
-from .kkt import equilibrium_possible, kkt_report
+from .kkt import KKT_TOL, equilibrium_possible, kkt_report
 from .results import Result
 
 NO_EQUILIBRIUM = ("the one-sided supports cannot carry this load: net uplift, or the load "
@@ -132,8 +132,10 @@ def _result(model: Model, data: Scaled, c: Contact, status, backend, formulation
     gaps = model.contacts.g0 + s - w
     stat = model.K @ u - model.f + model.contacts.B.T @ R
     res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))
-    # in contact: the reaction carries load, or the support touches (gap ≈ 0)
-    active = (R > 1e-9 * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= 1e-9 * max(data.W, 1e-300))
+    # in contact: the reaction carries load, or the support touches (gap ≈ 0), both judged at
+    # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports)
+    tol = max(KKT_TOL[accuracy], 1e-9)
+    active = (R > tol * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= tol * max(data.W, 1e-300))
     return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
                   accuracy=accuracy, reactions=R, gaps=gaps, compressions=s, active=active, residual=res)
 

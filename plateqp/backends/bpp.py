@@ -1,0 +1,699 @@
+r"""Block principal pivoting (Júdice & Pires 1994) for LCP(M, q), in NumPy/SciPy.
+
+The problem
+-----------
+Find ``z ≥ 0`` such that ``w = M z + q ≥ 0`` and ``zᵀ w = 0``; here ``M`` is
+symmetric positive (semi)definite, the condensed stiffness of a plate on
+one-sided supports (or its flexibility, for the dual formulation), or any
+P-matrix.
+
+The method
+----------
+J. J. Júdice and F. M. Pires, *A block principal pivoting algorithm for
+large-scale strictly monotone linear complementarity problems*, Computers &
+Operations Research 21(5) (1994). The unknowns are split into a
+complementary pair of sets: ``F`` (``z_F`` free, ``w_F = 0``) and its
+complement ``T`` (``z_T = 0``, ``w_T`` free). For a given split, the
+complementary basic solution is one linear solve::
+
+    M_FF z_F = −q_F,    z_T = 0,    w_T = q_T + M_TF z_F.
+
+The split is optimal when it is feasible, ``z_F ≥ 0`` and ``w_T ≥ 0``. Otherwise
+the infeasible indices ``H1 = {i ∈ F : z_i < 0}`` and
+``H2 = {i ∈ T : w_i < 0}`` are all exchanged at once (a *block* principal
+pivot): ``F ← (F − H1) ∪ H2``. Block pivoting alone can cycle, so the number
+of infeasibilities ``|H1 ∪ H2|`` is watched: when it has not decreased for
+``p`` consecutive steps (``p = 3`` by default, as in the paper) the method
+falls back on Murty's single principal pivoting rule — exchange only the
+*least* index of ``H1 ∪ H2`` — until the count drops below its best value, and
+then block pivoting resumes. Murty's rule alone terminates for every
+P-matrix (K. G. Murty, *Note on a Bard-type scheme for solving the
+complementarity problem*, Opsearch 11, 1974), hence so does the whole method.
+(Kim & Park's statement of the same safeguard for NNLS, SIAM J. Sci. Comput.
+33, 2011, takes the *largest* index: any fixed order of the indices is
+Murty's rule.)
+
+Default start: ``F = {i : q_i < 0}``, i.e. every support with ``q_i ≥ 0`` (in
+compression when all gaps are closed) starts in contact. Option ``active``
+gives another start: a boolean array, ``True`` where ``z_i = 0`` is held (the
+set ``T``). The final split is returned in ``extras["active"]`` in the same
+form, so that a sweep of neighbouring problems can warm start each solve from
+the previous one. **What ``active`` means is the LCP's**: ``z_i = 0``. On the
+condensed formulation (z = gaps) that is "support in contact"; on the dual
+formulation (z = reactions) it is "support *not* in contact".
+
+Each step factorises the principal block afresh (Cholesky, ``O(|F|³/3)``
+flops; LU when ``M`` is not symmetric); there are no updates, so rounding
+errors do not accumulate from step to step. ``w`` is then one product
+``M z + q`` (``O(n²)``).
+
+Singular blocks (positive semidefinite M)
+-----------------------------------------
+For symmetric PSD ``M`` (a floating plate: the rigid motions span the null
+space of the condensed stiffness) a principal block ``M_FF`` is singular
+exactly when the supports in ``T`` cannot hold the plate. Such a block is
+detected by a Cholesky pivot below ``1000 · sing_tol · max diag`` (or a failed
+Cholesky) and then decomposed ``M_FF = V Λ Vᵀ``; eigenvalues at most
+``sing_tol · λ_max`` count as zero, ``N`` spans their eigenvectors and
+``P = N Nᵀ``. With ``b = −q_F``:
+
+* ``P b ≈ 0`` (at the feasibility tolerance, in reaction units): the system is
+  consistent and every ``z_F + N c`` solves it (with the same ``w``: ``M`` is
+  PSD, so ``M [N c; 0] = 0``). ``z_F`` is the minimum-norm solution
+  ``V Λ⁺ Vᵀ b``; if it has negative entries, a small LP looks for a ``c``
+  that makes ``z_F + N c ≥ 0`` (or, failing that, least negative), and the
+  step goes on as usual with that ``z_F``;
+* otherwise the plate is a mechanism under this split: the energy
+  ``½ zᵀMz + qᵀz`` falls without bound along the null space of ``M_FF``. An LP
+  on that null space (``k`` unknowns, ``k ≤ 3`` on a plate) looks for
+  ``y = N c ≥ 0`` with ``qᵀy < 0``: a Farkas certificate that the LCP has no
+  solution (``w = Mz + q ≥ 0`` would give ``0 ≤ yᵀw = qᵀy < 0``); it is
+  checked on the full ``M`` and :class:`~plateqp.errors.NoEquilibriumError`
+  is raised. Without one, along the steepest descent ``y = P b`` the gaps with
+  ``y_i < 0`` would close first as the plate falls: they are the infeasible
+  indices of ``F`` (they go to ``T``), with ``z_F`` the least-squares solution.
+
+For PSD ``M`` the finite-termination theorem does not apply, and Murty's rule
+can cycle (measured: a quarter of random rank-deficient ``M = AᵀA``; never on
+the rigid-motion null spaces of floating plates). A split seen twice in the
+single-pivot phase, which cannot happen for a P-matrix in exact arithmetic,
+ends the pivoting. Then (also after ``max_iter`` splits if a singular block
+was met):
+
+1. the whole LCP is tested for solvability: for symmetric PSD ``M`` it has no
+   solution iff some ``y ≥ 0`` has ``M y = 0`` and ``qᵀy < 0``; an eigen-
+   decomposition of ``M`` and the LP above on its null space decide it
+   (→ NoEquilibriumError);
+2. if it has a solution, proximal-point steps (Rockafellar 1976)
+   ``z ← solution of LCP(M + ε D, q − ε D z)`` with ``D = diag(M)`` and
+   ``ε = PROX_EPS``, each a positive definite problem that the pivoting
+   solves finitely, warm started one from the other; after each, its split is
+   tried once on the original problem. In the measurements 1–3 steps sufficed.
+
+Otherwise the status is ``ERROR`` (no ``x``; ``extras`` holds the best split's
+``z`` and ``w``), or ``MAX_ITER`` (with ``x`` the best split seen) when the
+iteration limit ended it. A failed Cholesky whose eigenvalues show ``M`` is
+not PSD, or a singular block of a non-symmetric ``M``, is an ``ERROR`` at once.
+
+The answer
+----------
+After termination, one clean solve on the final split (the factor of the last
+step, one step of iterative refinement) gives ``z``; negatives down to
+``feas_tol`` of its scale are set to zero and ``w = M z + q`` is computed from
+the full ``M``. The status comes from an independent check of that answer, the
+relative natural residual (:func:`natural_residual`)
+
+.. math::
+
+    r = \frac{\max_i |\min(M_{ii} z_i,\ w_i)|}{\max(\|w\|_\infty, \|q\|_\infty)},
+
+which covers the signs of ``z`` and ``w`` and complementarity at once (gaps
+counted as the force ``M_ii z_i`` it would take to close them, like the
+natural residual of :mod:`plateqp.kkt`): ``OPTIMAL`` if ``r ≤ accept_tol``,
+else ``INACCURATE``. A wrong ``OPTIMAL`` is therefore impossible whatever
+happened inside the pivoting.
+
+Accuracy
+--------
+A direct (finite) method: at every preset the answer is exact up to rounding,
+about ``cond(M_FF) · ε`` relative. The presets in :data:`ACCURACY` only set the
+tolerance under which a negative ``z_i`` or ``w_i`` counts as zero
+(``feas_tol``) and the residual above which the answer is flagged
+``INACCURATE`` (``accept_tol``).
+
+Examples
+--------
+>>> import numpy as np
+>>> from plateqp.backends.bpp import bpp
+>>> sol = bpp(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]))
+>>> np.round(sol.x * 3, 12), sol.iterations       # z = (4/3, 7/3)
+(array([4., 7.]), 1)
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import NoEquilibriumError, ProblemError
+from .base import ACCURACIES, LCP, QP, RawSolution, Status
+
+__all__ = ["name", "accepts", "ACCURACY", "OPTIONS", "available", "version", "solve", "bpp",
+           "natural_residual", "backends"]
+
+name = "bpp"
+accepts = frozenset({"lcp"})
+
+#: Tolerances of each accuracy preset (a direct method: exact up to rounding at every preset).
+#:
+#: ``feas_tol``
+#:     ``z_i`` (``w_i``) counts as infeasible only below ``−feas_tol`` times the
+#:     scale of ``z`` (of ``w``: ``max(‖q‖∞, max|M| ‖z‖∞)``); smaller negatives are
+#:     rounding, and are clipped to zero in the final ``z``.
+#: ``accept_tol``
+#:     relative natural residual of the final answer above which the status is
+#:     ``INACCURATE`` instead of ``OPTIMAL`` (100 × ``feas_tol``: clipping a
+#:     ``z_i`` of size ``feas_tol`` moves ``w`` by about that much).
+ACCURACY: dict[str, dict[str, float]] = {
+    "low": {"feas_tol": 1e-8, "accept_tol": 1e-6},
+    "default": {"feas_tol": 1e-10, "accept_tol": 1e-8},
+    "high": {"feas_tol": 1e-12, "accept_tol": 1e-10},
+}
+
+#: Keys accepted in the ``options`` dict of :func:`solve`.
+OPTIONS = ("active", "max_iter", "p", "sing_tol", "trace") + tuple(ACCURACY["default"])
+
+#: A Cholesky pivot below ``SING_TRIGGER · sing_tol · max diag(M_FF)`` sends the block to the
+#: eigen-decomposition, which decides whether it is singular.
+SING_TRIGGER = 1e3
+
+#: Proximal-point fallback (used only when the pivoting fails, i.e. for singular M): at most
+#: ``PROX_STEPS`` steps z ← solution of LCP(M + ε D, q − ε D z), ε = ``PROX_EPS``, D = diag(M).
+PROX_EPS = 1e-2
+PROX_STEPS = 50
+
+_NO_SOLUTION = (
+    "the one-sided supports cannot carry this load (net uplift, or the load resultant lies "
+    "outside the supports' reach): block principal pivoting found y ≥ 0 with M y = 0 and "
+    "qᵀy < 0, a certificate that LCP(M, q) has no solution"
+)
+
+
+def available() -> bool:
+    """Block principal pivoting needs NumPy and SciPy only: always available."""
+    return True
+
+
+def version() -> str:
+    """The plateqp package version (the backend is part of plateqp)."""
+    try:
+        from importlib.metadata import version as _version
+
+        return f"plateqp {_version('plateqp')}"
+    except Exception:  # not installed as a distribution
+        return "plateqp"
+
+
+def backends() -> list:
+    """The backends this module provides: ``[module]`` (it satisfies the ``Backend`` protocol)."""
+    return [sys.modules[__name__]]
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def natural_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray, w: np.ndarray) -> float:
+    r"""Relative natural residual of a candidate solution of LCP(M, q), with ``w = M z + q``.
+
+    .. math::
+
+        r = \frac{\max_i |\min(d_i z_i,\ w_i)|}{\max(\|w\|_\infty, \|q\|_\infty)},
+        \qquad d = \mathrm{diag}(M).
+
+    Zero exactly at a solution; it sees a negative ``z_i`` or ``w_i`` and a
+    violated complementarity alike. ``z`` is weighted by the diagonal so that
+    both terms are in the units of ``w`` (for the condensed plate problem:
+    force, like the natural residual of :mod:`plateqp.kkt`) and the measure
+    does not change when a row and its column are scaled. The scale is that of
+    ``w`` and ``q`` (forces), never that of ``z``: an iterate that runs away
+    (no solution) must not make its own residual look small. Shared by
+    :mod:`~plateqp.backends.pgs` as its stopping test.
+    """
+    if z.size == 0:
+        return 0.0
+    dz = np.abs(np.diagonal(M)) * z
+    num = np.abs(np.minimum(dz, w)).max()
+    scale = max(np.abs(w).max(), np.abs(q).max())
+    if scale == 0.0:
+        return 0.0 if num == 0.0 else float("inf")
+    return float(num / scale)
+
+
+def _check_accuracy(accuracy: str) -> dict:
+    if accuracy not in ACCURACIES:
+        raise ProblemError(f"unknown accuracy {accuracy!r}; expected one of {ACCURACIES}")
+    return dict(ACCURACY[accuracy])
+
+
+class _Block:
+    """A factorised principal block ``M_FF``: Cholesky, LU, or (singular) eigen-decomposition."""
+
+    def __init__(self, A: np.ndarray, symmetric: bool, sing_tol: float) -> None:
+        self.kind = "empty"
+        self.A = A
+        self.null = None  # (|F|, k) orthonormal basis of the null space, eigen path only
+        self.negative = 0.0  # most negative eigenvalue / λ_max, eigen path only
+        if A.shape[0] == 0:
+            return
+        dmax = max(np.abs(np.diagonal(A)).max(), np.finfo(float).tiny)
+        if symmetric:
+            try:
+                c = sla.cho_factor(A, lower=True, check_finite=False)
+                if np.diagonal(c[0]).min() ** 2 > SING_TRIGGER * sing_tol * dmax:
+                    self.kind, self._fac = "cholesky", c
+                    return
+            except np.linalg.LinAlgError:
+                pass
+            lam, V = sla.eigh(A, check_finite=False)
+            lmax = max(np.abs(lam).max(), 0.0)
+            keep = lam > sing_tol * lmax
+            self.kind = "eigh"
+            self._V, self._lam = V[:, keep], lam[keep]
+            self.null = V[:, ~keep]
+            self.negative = float(lam.min() / lmax) if lmax > 0 else 0.0
+        else:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # LinAlgWarning on an exactly singular block
+                lu = sla.lu_factor(A, check_finite=False)
+            u = np.abs(np.diagonal(lu[0]))
+            if u.min() <= sing_tol * max(u.max(), np.finfo(float).tiny):
+                self.kind = "singular"
+                return
+            self.kind, self._fac = "lu", lu
+
+    @property
+    def singular(self) -> bool:
+        return self.kind in ("eigh", "singular") and (self.kind == "singular" or self.null.shape[1] > 0)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """Solution of ``M_FF x = b`` (minimum-norm least squares on the eigen path)."""
+        if self.kind == "empty":
+            return np.zeros(0)
+        if self.kind == "cholesky":
+            return sla.cho_solve(self._fac, b, check_finite=False)
+        if self.kind == "lu":
+            return sla.lu_solve(self._fac, b, check_finite=False)
+        return self._V @ ((self._V.T @ b) / self._lam)
+
+    def null_part(self, b: np.ndarray) -> np.ndarray:
+        """``P b``, the component of ``b`` in the null space of ``M_FF`` (zero if nonsingular)."""
+        if self.null is None or self.null.shape[1] == 0:
+            return np.zeros_like(b)
+        return self.null @ (self.null.T @ b)
+
+
+class _Step:
+    """One complementary split: its factor, basic solution and infeasibilities."""
+
+    def __init__(self, M, q, F, symmetric, sing_tol, feas_tol, Mmax) -> None:
+        self.F = F.copy()
+        idx = np.flatnonzero(F)
+        self.idx = idx
+        self.block = _Block(M[np.ix_(idx, idx)], symmetric, sing_tol)
+        self.drift = None  # descent direction of a mechanism (inconsistent singular block)
+        self.certificate = None  # y ≥ 0, M y = 0, qᵀy < 0, if this split exposed one
+        n = q.shape[0]
+        z = np.zeros(n)
+        self.z = self.w = z
+        self.infeasible = np.zeros(n, bool)
+        self.violation = np.inf
+        if self.block.kind == "singular":  # non-symmetric M: nothing sensible to do
+            return
+        b = -q[idx]
+        z[idx] = self.block.solve(b)
+        zscale = max(np.abs(z).max(initial=0.0), np.finfo(float).tiny)
+        wscale = max(np.abs(q).max(initial=0.0), Mmax * zscale, np.finfo(float).tiny)
+        H = np.zeros(n, bool)
+        Pb = self.block.null_part(b)
+        if np.abs(Pb).max(initial=0.0) > feas_tol * wscale:
+            # inconsistent: the plate is a mechanism under this split; it falls along the null
+            # space of M_FF, and the gaps that close first are the infeasible ones of F
+            y = _null_certificate(self.block.null, q[idx], feas_tol)
+            if y is not None:
+                self.certificate = np.zeros(n)
+                self.certificate[idx] = y
+            self.drift = Pb  # steepest descent of ½zᵀMz + qᵀz in the null space
+            H[idx] = Pb < -feas_tol * np.abs(Pb).max()
+        elif self.block.singular and z[idx].min() < -feas_tol * zscale:
+            # consistent: z_F + N c solves the block for every c; look for one that is ≥ 0
+            z[idx] = _nonnegative_completion(z[idx], self.block.null, feas_tol * zscale)
+            zscale = max(np.abs(z).max(initial=0.0), np.finfo(float).tiny)
+            wscale = max(np.abs(q).max(initial=0.0), Mmax * zscale, np.finfo(float).tiny)
+        w = M @ z + q
+        H[idx] |= z[idx] < -feas_tol * zscale
+        H |= ~F & (w < -feas_tol * wscale)
+        viol = max(max(0.0, -z[idx].min(initial=0.0)) / zscale,
+                   max(0.0, -w[~F].min(initial=0.0)) / wscale)
+        self.z, self.w, self.infeasible = z, w, H
+        self.violation = np.inf if self.drift is not None else viol
+
+
+def _nonnegative_completion(z0: np.ndarray, N: np.ndarray, tol: float) -> np.ndarray:
+    """``z0 + N c`` with the least total negativity (zero if some ``c`` makes it ≥ 0); an LP."""
+    from scipy.optimize import linprog
+
+    m, k = N.shape
+    scale = max(np.abs(z0).max(), np.finfo(float).tiny)
+    # variables (c, s): minimise Σ s  subject to  z0 + N c + s ≥ 0,  s ≥ 0
+    cost = np.concatenate([np.zeros(k), np.ones(m)])
+    A = np.hstack([-N, -np.eye(m)])
+    res = linprog(cost, A_ub=A, b_ub=z0 / scale, bounds=[(None, None)] * k + [(0, None)] * m,
+                  method="highs")
+    if res.status != 0:
+        return z0
+    z = z0 + N @ (res.x[:k] * scale)
+    z[(z < 0) & (z >= -tol)] = 0.0
+    return z
+
+
+def _null_certificate(N: np.ndarray, q: np.ndarray, tol: float) -> np.ndarray | None:
+    """``y = N c ≥ 0`` with ``qᵀy < 0`` (``Σ y = 1``), if one exists; an LP in ``c``."""
+    from scipy.optimize import linprog
+
+    if N is None or N.shape[1] == 0:
+        return None
+    k = N.shape[1]
+    qs = q / max(np.abs(q).max(), np.finfo(float).tiny)
+    res = linprog(N.T @ qs, A_ub=-N, b_ub=np.zeros(N.shape[0]), A_eq=N.sum(axis=0)[None, :],
+                  b_eq=[1.0], bounds=[(None, None)] * k, method="highs")
+    if res.status != 0 or res.fun >= -max(tol, 1e-12):
+        return None
+    return np.maximum(N @ res.x, 0.0)
+
+
+def _full_null_space(M: np.ndarray, sing_tol: float) -> np.ndarray:
+    """Orthonormal basis of the (numerical) null space of symmetric ``M``."""
+    lam, V = sla.eigh(M, check_finite=False)
+    lmax = max(np.abs(lam).max(initial=0.0), 0.0)
+    return V[:, lam <= sing_tol * lmax]
+
+
+def _verified(M: np.ndarray, q: np.ndarray, y: np.ndarray | None, sing_tol: float) -> bool:
+    """``y ≥ 0``, ``M y ≈ 0`` and ``qᵀy < 0``, checked on the full ``M``: a proof of no solution."""
+    if y is None:
+        return False
+    ny = np.abs(y).max()
+    if ny == 0 or y.min() < 0:
+        return False
+    My = M @ y
+    return bool(np.abs(My).max() <= SING_TRIGGER * sing_tol * np.abs(M).max() * ny * np.sqrt(q.shape[0])
+                and q @ y < 0)
+
+
+# --------------------------------------------------------------------------- the method
+
+
+class _Failure(Exception):
+    """A split the method cannot go on from (M neither PSD nor a P-matrix)."""
+
+
+@dataclass
+class _Run:
+    """What one pivoting run ends with."""
+
+    ending: str  # "solved" | "cycle" | "max_iter"
+    best: _Step
+    splits: int = 0
+    block: int = 0
+    single: int = 0
+    singular: int = 0
+
+
+def _pivoting(M, q, F, max_iter, p, symmetric, sing_tol, feas_tol, steps=None) -> _Run:
+    """The block principal pivoting loop from split ``F`` (Júdice & Pires, with Murty's backup).
+
+    Raises NoEquilibriumError on a verified certificate, _Failure on a block it cannot handle.
+    """
+    n = q.shape[0]
+    Mmax = np.abs(M).max(initial=0.0)
+    ninf, pbar = n + 1, p
+    visited: set[bytes] = set()
+    run = _Run("max_iter", None)
+    while run.splits < max_iter:
+        run.splits += 1
+        step = _Step(M, q, F, symmetric, sing_tol, feas_tol, Mmax)
+        run.singular += step.block.singular
+        if step.block.kind == "singular":
+            raise _Failure(f"singular principal block (|F| = {step.idx.size}) of a non-symmetric M")
+        if step.block.negative < -SING_TRIGGER * sing_tol:
+            raise _Failure(f"M is not positive semidefinite (a principal block has eigenvalue "
+                           f"{step.block.negative:.1e} λ_max)")
+        if step.certificate is not None and _verified(M, q, step.certificate, sing_tol):
+            raise NoEquilibriumError(f"{_NO_SOLUTION} (after {run.splits} splits)")
+        if run.best is None or step.violation < run.best.violation:
+            run.best = step
+        H = step.infeasible
+        nV = int(H.sum())
+        if nV == 0:
+            if step.drift is not None:  # the plate falls and nothing stops it: y = P b ≥ 0
+                y = np.zeros(n)
+                y[step.idx] = np.maximum(step.drift, 0.0)
+                if _verified(M, q, y, sing_tol):
+                    raise NoEquilibriumError(f"{_NO_SOLUTION} (after {run.splits} splits)")
+                raise _Failure("singular principal block with no certificate of infeasibility")
+            run.best, run.ending = step, "solved"
+            _record(steps, run.splits, step, nV, None)
+            return run
+        if nV < ninf:
+            ninf, pbar, rule = nV, p, "block"
+            visited.clear()
+        elif pbar >= 1:
+            pbar, rule = pbar - 1, "block"
+        else:
+            rule = "single"
+            key = F.tobytes()
+            if key in visited:  # Murty's rule never revisits a split in exact arithmetic
+                run.ending = "cycle"
+                _record(steps, run.splits, step, nV, None)
+                return run
+            visited.add(key)
+            r = int(np.flatnonzero(H)[0])  # least index
+            H = np.zeros(n, bool)
+            H[r] = True
+        _record(steps, run.splits, step, nV, rule, H)
+        run.block += rule == "block"
+        run.single += rule == "single"
+        F = F ^ H
+    return run
+
+
+def _finish(M, q, step: _Step, feas_tol: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """One clean solve on a split (its factor, one refinement step): z, w = M z + q, residual."""
+    idx = step.idx
+    z = np.zeros(q.shape[0])
+    if idx.size:
+        zF = step.z[idx]
+        zF = zF - step.block.solve(step.block.A @ zF + q[idx])  # (Λ⁺ ignores a null part)
+        zscale = max(np.abs(zF).max(), np.finfo(float).tiny)
+        zF[(zF < 0) & (zF >= -feas_tol * zscale)] = 0.0
+        z[idx] = zF
+    w = M @ z + q
+    return z, w, natural_residual(M, q, z, w)
+
+
+def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default",
+        feas_tol=None, accept_tol=None, sing_tol=None) -> RawSolution:
+    """Solve LCP(M, q) by block principal pivoting (Júdice & Pires 1994).
+
+    Find ``z ≥ 0`` with ``w = M z + q ≥ 0`` and ``zᵀ w = 0``.
+
+    Parameters
+    ----------
+    M : array_like or sparse matrix, shape (n, n)
+        Symmetric positive (semi)definite, or any P-matrix (densified).
+    q : array_like, shape (n,)
+    active : array_like of bool, shape (n,), optional
+        Warm start: ``True`` where ``z_i = 0`` is held at the start (the set
+        ``T``). Default ``q ≥ 0``. Pass ``extras["active"]`` of an earlier
+        solve of a neighbouring problem.
+    max_iter : int, optional
+        Maximum number of splits tried by the pivoting (default ``2 n + 50``;
+        each costs one factorisation); the proximal fallback, if it runs, has a
+        budget of its own of as many. Reaching it gives ``Status.MAX_ITER`` with
+        the best split's ``x``.
+    p : int, optional
+        Number of block pivots allowed without a decrease of the number of
+        infeasibilities before Murty's single-pivot rule takes over (default 3,
+        Júdice & Pires). ``p = 0``: Murty's rule whenever the count does not
+        decrease.
+    trace : bool, optional
+        Record every split of the main run in ``extras["trace"]`` as
+        ``{"step": k, "free": |F|, "infeasible": |H1 ∪ H2|, "pivot": "block" |
+        "single" | None, "exchanged": [indices], "singular": bool}``
+        (``pivot`` and ``exchanged``: the exchange made *after* the step).
+    accuracy : {"low", "default", "high"}, optional
+        Preset of :data:`ACCURACY`; the keywords below override it.
+    feas_tol, accept_tol : float, optional
+        See :data:`ACCURACY`.
+    sing_tol : float, optional
+        Relative eigenvalue under which a principal block counts as singular
+        (default ``max(1e-12, 10 n ε)``).
+
+    Returns
+    -------
+    RawSolution
+        ``status``: ``OPTIMAL`` when the natural residual of the cleaned-up
+        answer is at most ``accept_tol``, whatever route led to it; else
+        ``INACCURATE`` (a feasible split was found but rounding spoiled it),
+        ``MAX_ITER`` (``x`` is the best split seen) or ``ERROR`` (no ``x``: the
+        pivoting cycled or met a block it cannot handle; ``M`` is then neither
+        a P-matrix nor symmetric PSD, or the problem is degenerate beyond the
+        fallback; ``extras`` holds the best ``z`` and ``w``). ``x = z``,
+        ``w = M z + q``, ``obj = ½ zᵀMz + qᵀz``, ``iterations`` (number of
+        splits tried, every run included: a warm start from the solution's
+        split takes 1), ``solve_time``. ``extras``: ``active`` (final ``T``, a
+        bool array), ``block_pivots``, ``single_pivots``, ``singular_blocks``,
+        ``proximal_steps``, ``natural_residual``, ``factor``, ``trace`` if asked.
+
+    Raises
+    ------
+    NoEquilibriumError
+        A certificate ``y ≥ 0, M y = 0, qᵀy < 0`` was found: no solution exists.
+    ProblemError
+        Malformed data or a bad option value.
+    """
+    t0 = time.perf_counter()
+    prob = LCP(M, q)
+    M, q, n = prob.M, prob.q, prob.n
+
+    tol = _check_accuracy(accuracy)
+    for key, val in (("feas_tol", feas_tol), ("accept_tol", accept_tol)):
+        if val is not None:
+            tol[key] = val
+    if sing_tol is None:
+        sing_tol = max(1e-12, 10 * n * np.finfo(float).eps)
+    tol["sing_tol"] = sing_tol
+    for key in ("feas_tol", "accept_tol", "sing_tol"):
+        v = tol[key]
+        if isinstance(v, bool) or not (np.isscalar(v) and np.isfinite(v) and 0 <= v < 1):
+            raise ProblemError(f"option {key} must be a number in [0, 1), got {v!r}")
+    feas_tol, accept_tol, sing_tol = float(tol["feas_tol"]), float(tol["accept_tol"]), float(sing_tol)
+    if max_iter is None:
+        max_iter = 2 * n + 50
+    for key, val, low in (("max_iter", max_iter, 1), ("p", p, 0)):
+        if isinstance(val, bool) or not isinstance(val, (int, np.integer)) or val < low:
+            raise ProblemError(f"option {key} must be an integer ≥ {low}, got {val!r}")
+    if not isinstance(trace, (bool, np.bool_)):
+        raise ProblemError(f"option trace must be True or False, got {trace!r}")
+    if active is None:
+        F = q < 0
+    else:
+        a = np.asarray(active)
+        if a.dtype != bool or a.shape != (n,):
+            raise ProblemError(f"option active must be a boolean array of length {n}, "
+                               f"got {a.dtype} array of shape {a.shape}")
+        F = ~a
+
+    Mmax = np.abs(M).max(initial=0.0)
+    symmetric = bool(np.abs(M - M.T).max(initial=0.0) <= 1e-10 * max(Mmax, np.finfo(float).tiny))
+    steps: list[dict] | None = [] if trace else None
+    extras: dict = {"trace": steps} if trace else {}
+    args = (p, symmetric, sing_tol, feas_tol)
+    try:
+        run = _pivoting(M, q, F, max_iter, *args, steps=steps)
+    except _Failure as exn:
+        return RawSolution(status=Status.ERROR, solve_time=time.perf_counter() - t0, extras=extras,
+                           solver_status=f"{exn}: block principal pivoting needs a P-matrix or a "
+                                         "symmetric positive semidefinite M")
+    runs = [run]
+    z, w, res = _finish(M, q, run.best, feas_tol)
+    final, how = run, run.ending
+    n_prox = 0
+    if res > accept_tol and symmetric and (run.ending == "cycle" or
+                                           (run.ending == "max_iter" and run.singular)):
+        # The pivoting failed (possible for a singular M: the theorem is for P-matrices).
+        # First, does the LCP have a solution at all? For symmetric PSD M it has none iff
+        # some y ≥ 0 has M y = 0 and qᵀy < 0: a small LP on the null space of M.
+        y = _null_certificate(_full_null_space(M, sing_tol), q, feas_tol)
+        if _verified(M, q, y, sing_tol):
+            raise NoEquilibriumError(f"{_NO_SOLUTION} (found after the pivoting had failed, "
+                                     f"{run.splits} splits)")
+        # It has one: proximal-point steps z ← LCP(M + εD, q − εD z), each with a positive
+        # definite matrix (finite pivoting), each split tried on the original problem.
+        d = np.diagonal(M).copy()
+        d[d <= 0] = max(d.max(initial=0.0), 1.0)
+        Mp = M + PROX_EPS * np.diag(d)
+        zk, act = np.maximum(z, 0.0), ~run.best.F
+        try:
+            for n_prox in range(1, PROX_STEPS + 1):
+                budget = max_iter - sum(r.splits for r in runs[1:])  # its own budget
+                if budget < 2:
+                    break
+                sub = _pivoting(Mp, q - PROX_EPS * d * zk, ~act, budget - 1, *args)
+                zk = _finish(Mp, q - PROX_EPS * d * zk, sub.best, feas_tol)[0]
+                act = zk <= 0
+                test = _pivoting(M, q, ~act, 1, *args)
+                runs += [sub, test]
+                zt, wt, rt = _finish(M, q, test.best, feas_tol)
+                if rt <= accept_tol:
+                    z, w, res, final, how = zt, wt, rt, test, "proximal"
+                    break
+        except _Failure:
+            pass
+    splits = sum(r.splits for r in runs)
+    x = z
+    if res <= accept_tol:
+        status = Status.OPTIMAL
+    elif run.ending == "solved":
+        status = Status.INACCURATE
+    else:
+        status = Status.ERROR if run.ending == "cycle" else Status.MAX_ITER
+    message = {
+        "solved": f"feasible split after {splits} splits",
+        "proximal": (f"pivoting {run.ending} after {run.splits} splits; solved after {n_prox} "
+                     f"proximal steps ({splits} splits in all)"),
+        "cycle": (f"a split repeated under Murty's rule after {run.splits} splits (M is not a "
+                  f"P-matrix) and {n_prox} proximal steps did not recover; best split: natural "
+                  f"residual {res:.1e}"),
+        "max_iter": (f"iteration limit {max_iter} reached, {n_prox} proximal steps; best split: "
+                     f"natural residual {res:.1e}"),
+    }[how]
+    if status is Status.ERROR:
+        x = None
+        extras.update(z=z, w=w)
+    extras.update(active=~final.best.F, block_pivots=sum(r.block for r in runs),
+                  single_pivots=sum(r.single for r in runs),
+                  singular_blocks=sum(r.singular for r in runs), proximal_steps=n_prox,
+                  natural_residual=res, factor=final.best.block.kind)
+    return RawSolution(status=status, x=x, w=None if x is None else w,
+                       obj=float(0.5 * z @ M @ z + q @ z), iterations=splits,
+                       solve_time=time.perf_counter() - t0, solver_status=message, extras=extras)
+
+
+def _record(steps: list | None, it: int, step: _Step, nV: int, rule: str | None,
+            exchanged: np.ndarray | None = None) -> None:
+    if steps is not None:
+        steps.append({"step": it, "free": int(step.idx.size), "infeasible": nV, "pivot": rule,
+                      "exchanged": [] if exchanged is None else np.flatnonzero(exchanged).tolist(),
+                      "singular": bool(step.block.singular)})
+
+
+def solve(problem, accuracy: str = "default", options: dict | None = None) -> RawSolution:
+    """Solve an :class:`~plateqp.backends.base.LCP` by block principal pivoting (Backend protocol).
+
+    Parameters
+    ----------
+    problem : LCP
+        The problem; a :class:`~plateqp.backends.base.QP` is rejected.
+    accuracy : {"low", "default", "high"}
+        Preset of :data:`ACCURACY`.
+    options : dict, optional
+        Overrides, keys among :data:`OPTIONS`: ``active`` (warm start),
+        ``max_iter``, ``p``, ``sing_tol``, ``trace``, ``feas_tol``,
+        ``accept_tol`` (see :func:`bpp`).
+
+    Returns
+    -------
+    RawSolution
+        See :func:`bpp`.
+
+    Raises
+    ------
+    ProblemError
+        Not an LCP, unknown accuracy or option.
+    NoEquilibriumError
+        A certificate that no solution exists (the supports cannot carry the load).
+    """
+    if isinstance(problem, QP) or not isinstance(problem, LCP):
+        raise ProblemError(f"the bpp backend solves LCPs only, got {type(problem).__name__}")
+    _check_accuracy(accuracy)
+    options = dict(options or {})
+    unknown = sorted(set(options) - set(OPTIONS))
+    if unknown:
+        raise ProblemError(f"unknown option(s) {unknown} for backend bpp; known: {list(OPTIONS)}")
+    return bpp(problem.M, problem.q, accuracy=accuracy, **options)

@@ -1,0 +1,301 @@
+r"""Projected Gauss–Seidel (PGS, with over-relaxation: PSOR) for LCP(M, q), in NumPy.
+
+The problem
+-----------
+Find ``z ≥ 0`` such that ``w = M z + q ≥ 0`` and ``zᵀ w = 0``; ``M`` symmetric
+positive semidefinite, with a positive diagonal (the condensed stiffness of a
+plate on one-sided supports, or its flexibility), so that the LCP is the
+optimality condition of  min ½ zᵀMz + qᵀz,  z ≥ 0.
+
+The method
+----------
+The baseline iterative method, for teaching and comparison (Cryer 1971, *The
+solution of a quadratic programming problem using systematic overrelaxation*,
+SIAM J. Control 9; Cottle, Pang & Stone, *The Linear Complementarity Problem*,
+§5.2). One *sweep* updates every component in turn, each from the latest values
+of the others::
+
+    for i = 1 … n:   z_i ← max(0, z_i − ω (q_i + M_i z) / M_ii)
+
+i.e. exact minimisation of the QP objective along coordinate ``i`` followed by
+projection onto ``z_i ≥ 0`` (``ω = 1``: projected Gauss–Seidel), or a step
+``ω ∈ (0, 2)`` times as long (projected SOR). For symmetric PSD ``M`` with a
+positive diagonal and ``0 < ω < 2`` the objective decreases monotonically and,
+when the LCP has a solution, ``w`` converges to its (unique) value; the rate
+is linear and governed by the conditioning of ``M``: slow on plates, whose
+condensed stiffness has condition numbers of 10⁴–10⁶.
+
+Cost and implementation
+-----------------------
+The sweep is inherently sequential (each update uses the one before), so it is a
+Python loop over ``i``; what can be precomputed is. ``w = M z + q`` is kept
+up to date instead of recomputing ``M_i z`` (``O(n)``) for every ``i``: a change
+``δ`` of ``z_i`` is one BLAS ``daxpy``, ``w ← w + δ M_{:,i}`` (row ``i`` of ``M``,
+as ``M`` is symmetric, so the access is contiguous). A component that does not
+change — a support in contact that stays in contact, ``z_i = 0`` with
+``w_i ≥ 0``, the majority on a plate — costs a few scalar operations and no
+``daxpy``. A sweep thus costs ``O(n)`` interpreter work plus ``O(n · k)`` flops,
+``k`` the number of components that moved (at most ``n``: ``O(n²)``). The
+stopping test after each sweep is ``O(n)`` on the running ``w``; every
+``RESYNC`` sweeps, and before the sweeps stop, ``w`` is recomputed as one
+product ``M z + q`` (``O(n²)``, BLAS), which clears the drift of the updates, so
+the returned ``w`` and residual are exact. Measured on one core: about 0.6 ms
+per sweep at ``n = 900`` with about 730 moving components (a pure-Python inner
+product per component would cost ~100 ms per sweep).
+
+Stopping test: the relative natural residual
+(:func:`plateqp.backends.bpp.natural_residual`)
+
+.. math::
+
+    r = \frac{\max_i |\min(M_{ii} z_i,\ w_i)|}{\max(\|w\|_\infty, \|q\|_\infty)}
+
+(the gap weighted by the diagonal so that both terms are forces, like the
+natural residual of :mod:`plateqp.kkt`; scaled by forces only, so that a
+runaway ``z`` cannot shrink it), checked after every sweep.
+
+Accuracy
+--------
+``tol`` of each preset in :data:`ACCURACY`: the sweeps stop as soon as
+``r ≤ tol`` (status ``OPTIMAL``). If ``max_iter`` sweeps or ``time_limit``
+seconds run out first, the status is ``MAX_ITER`` and the last iterate is
+returned in ``x``, ``w`` so that the KKT check of :mod:`plateqp.kkt` can show how
+far it is; ``solver_status`` says which limit ended it. An LCP without a
+solution (net uplift) makes ``z`` grow without bound: it ends on a limit, never
+``OPTIMAL``.
+
+Examples
+--------
+>>> import numpy as np
+>>> from plateqp.backends.pgs import pgs
+>>> sol = pgs(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), accuracy="high")
+>>> sol.status.value, np.round(sol.x * 3, 8)     # z = (4/3, 7/3)
+('optimal', array([4., 7.]))
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+from scipy.linalg.blas import daxpy
+
+from ..errors import ProblemError
+from .base import ACCURACIES, LCP, QP, RawSolution, Status
+from .bpp import natural_residual
+
+__all__ = ["name", "accepts", "ACCURACY", "OPTIONS", "available", "version", "solve", "pgs", "backends"]
+
+name = "pgs"
+accepts = frozenset({"lcp"})
+
+#: Stopping tolerance of each accuracy preset: the sweeps stop when the relative natural
+#: residual ``r`` (module docstring) is at most ``tol``.
+ACCURACY: dict[str, dict[str, float]] = {
+    "low": {"tol": 1e-5},
+    "default": {"tol": 1e-8},
+    "high": {"tol": 1e-11},
+}
+
+#: Keys accepted in the ``options`` dict of :func:`solve`.
+OPTIONS = ("omega", "max_iter", "time_limit", "z0") + tuple(ACCURACY["default"])
+
+#: Defaults of the limits: sweeps, and seconds of wall-clock time.
+MAX_ITER = 100_000
+TIME_LIMIT = 60.0
+
+#: ``w`` is recomputed as ``M z + q`` every ``RESYNC`` sweeps (and before stopping).
+RESYNC = 10
+
+
+def available() -> bool:
+    """PGS needs NumPy and SciPy only: always available."""
+    return True
+
+
+def version() -> str:
+    """The plateqp package version (the backend is part of plateqp)."""
+    try:
+        from importlib.metadata import version as _version
+
+        return f"plateqp {_version('plateqp')}"
+    except Exception:  # not installed as a distribution
+        return "plateqp"
+
+
+def backends() -> list:
+    """The backends this module provides: ``[module]`` (it satisfies the ``Backend`` protocol)."""
+    return [sys.modules[__name__]]
+
+
+def _check_accuracy(accuracy: str) -> dict:
+    if accuracy not in ACCURACIES:
+        raise ProblemError(f"unknown accuracy {accuracy!r}; expected one of {ACCURACIES}")
+    return dict(ACCURACY[accuracy])
+
+
+def _sweep(rows: list, step: list, z: list, w: np.ndarray) -> None:
+    """One projected Gauss–Seidel sweep, in place on ``z`` (a list) and ``w`` (kept = M z + q)."""
+    for i in range(len(z)):
+        zi = z[i]
+        new = zi - step[i] * w[i]
+        if new < 0.0:  # noqa: PLR1730 (a branch is cheaper than max() in this loop)
+            new = 0.0
+        if new != zi:
+            z[i] = new
+            daxpy(rows[i], w, a=new - zi)  # w += (new − zi) M[i], in place
+
+
+def pgs(M, q, omega=1.0, max_iter=None, time_limit=None, z0=None, *, accuracy="default",
+        tol=None) -> RawSolution:
+    """Solve LCP(M, q) by projected Gauss–Seidel / projected SOR sweeps.
+
+    Parameters
+    ----------
+    M : array_like or sparse matrix, shape (n, n)
+        Symmetric positive semidefinite with a positive diagonal (densified).
+        Only the rows of ``M`` are read: for a non-symmetric ``M`` the
+        iteration is projected Gauss–Seidel on the rows, without a
+        convergence guarantee.
+    q : array_like, shape (n,)
+    omega : float, optional
+        Relaxation factor ``ω ∈ (0, 2)`` (default 1: Gauss–Seidel; > 1:
+        over-relaxation).
+    max_iter : int, optional
+        Maximum number of sweeps (default :data:`MAX_ITER`).
+    time_limit : float, optional
+        Wall-clock seconds after which the sweeps stop (default
+        :data:`TIME_LIMIT`), checked after every sweep.
+    z0 : array_like, shape (n,), optional
+        Warm start (negative entries are set to zero). Default ``z = 0``.
+    accuracy : {"low", "default", "high"}, optional
+        Preset of :data:`ACCURACY`.
+    tol : float, optional
+        Overrides the preset's stopping tolerance.
+
+    Returns
+    -------
+    RawSolution
+        ``status`` ``OPTIMAL`` (the natural residual reached ``tol``) or
+        ``MAX_ITER`` (a limit was reached first; ``solver_status`` says which),
+        ``x = z`` and ``w = M z + q`` in both cases, ``obj``, ``iterations``
+        (sweeps), ``solve_time``. ``extras``: ``natural_residual``,
+        ``active`` (``z == 0``, the form :mod:`~plateqp.backends.bpp` takes as
+        a warm start), ``omega``.
+
+    Raises
+    ------
+    ProblemError
+        Malformed data or a bad option value.
+
+    Notes
+    -----
+    A component with ``M_ii ≤ 0`` cannot be updated (the step divides by
+    ``M_ii``); for a PSD ``M`` its row is zero (up to rounding: three
+    supports under a floating plate give ``M ≈ 0``), so ``z_i`` does not act
+    on ``w`` and is held at its start value (0 unless ``z0`` says otherwise).
+    If that prevents convergence the sweeps end on a limit, ``MAX_ITER``.
+    """
+    t0 = time.perf_counter()
+    prob = LCP(M, q)
+    M, q, n = prob.M, prob.q, prob.n
+    opts = _check_accuracy(accuracy)
+    if tol is not None:
+        opts["tol"] = tol
+    tol = opts["tol"]
+    if isinstance(tol, bool) or not (np.isscalar(tol) and np.isfinite(tol) and 0 <= tol < 1):
+        raise ProblemError(f"option tol must be a number in [0, 1), got {tol!r}")
+    if isinstance(omega, bool) or not (np.isscalar(omega) and np.isfinite(omega) and 0 < omega < 2):
+        raise ProblemError(f"option omega must be a number in (0, 2), got {omega!r}")
+    if max_iter is None:
+        max_iter = MAX_ITER
+    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
+        raise ProblemError(f"option max_iter must be a positive integer, got {max_iter!r}")
+    if time_limit is None:
+        time_limit = TIME_LIMIT
+    if isinstance(time_limit, bool) or not (np.isscalar(time_limit) and time_limit > 0):
+        raise ProblemError(f"option time_limit must be a positive number of seconds, got {time_limit!r}")
+    d = np.diagonal(M).copy()
+    held = ~(d > 0)  # a zero row of a PSD M (up to rounding): z_i cannot move w, hold it
+    d[held] = 1.0
+    if z0 is None:
+        z = np.zeros(n)
+    else:
+        z = np.asarray(z0, dtype=float).reshape(-1)
+        if z.shape != (n,) or not np.all(np.isfinite(z)):
+            raise ProblemError(f"option z0 must be a finite array of length {n}")
+        z = np.maximum(z, 0.0)
+
+    w = M @ z + q
+    res = natural_residual(M, q, z, w)
+    rows = list(np.ascontiguousarray(M))  # row views: M[i] without indexing in the loop
+    step = np.where(held, 0.0, omega / d).tolist()
+    zl = z.tolist()
+    sweeps = 0
+    ended = None
+    fresh = True  # w is M z + q computed afresh, not the running update
+    while True:
+        if res <= tol:
+            if fresh:
+                break
+            w, fresh = M @ z + q, True  # confirm on a fresh w before stopping
+            res = natural_residual(M, q, z, w)
+            continue
+        if sweeps >= max_iter:
+            ended = f"sweep limit {max_iter} reached"
+            break
+        if time.perf_counter() - t0 >= time_limit:
+            ended = f"time limit {time_limit:g} s reached after {sweeps} sweeps"
+            break
+        _sweep(rows, step, zl, w)
+        sweeps += 1
+        z = np.array(zl)
+        fresh = sweeps % RESYNC == 0
+        if fresh:  # clear the drift of the running updates
+            w = M @ z + q
+        res = natural_residual(M, q, z, w)
+    if not fresh:
+        w = M @ z + q
+        res = natural_residual(M, q, z, w)
+    status = Status.OPTIMAL if ended is None else Status.MAX_ITER
+    message = (f"natural residual {res:.1e} ≤ {tol:.0e} after {sweeps} sweeps" if ended is None
+               else f"{ended}; natural residual {res:.1e} > {tol:.0e}")
+    if held.any():
+        message += f" ({int(held.sum())} components with M_ii ≤ 0 held at their start value)"
+    return RawSolution(status=status, x=z, w=w, obj=float(0.5 * z @ (w + q)), iterations=sweeps,
+                       solve_time=time.perf_counter() - t0, solver_status=message,
+                       extras={"natural_residual": res, "active": z == 0, "omega": float(omega)})
+
+
+def solve(problem, accuracy: str = "default", options: dict | None = None) -> RawSolution:
+    """Solve an :class:`~plateqp.backends.base.LCP` by projected Gauss–Seidel (Backend protocol).
+
+    Parameters
+    ----------
+    problem : LCP
+        The problem; a :class:`~plateqp.backends.base.QP` is rejected.
+    accuracy : {"low", "default", "high"}
+        Preset of :data:`ACCURACY`.
+    options : dict, optional
+        Overrides, keys among :data:`OPTIONS`: ``omega``, ``max_iter``,
+        ``time_limit``, ``z0``, ``tol`` (see :func:`pgs`).
+
+    Returns
+    -------
+    RawSolution
+        See :func:`pgs`.
+
+    Raises
+    ------
+    ProblemError
+        Not an LCP, unknown accuracy or option.
+    """
+    if isinstance(problem, QP) or not isinstance(problem, LCP):
+        raise ProblemError(f"the pgs backend solves LCPs only, got {type(problem).__name__}")
+    _check_accuracy(accuracy)
+    options = dict(options or {})
+    unknown = sorted(set(options) - set(OPTIONS))
+    if unknown:
+        raise ProblemError(f"unknown option(s) {unknown} for backend pgs; known: {list(OPTIONS)}")
+    return pgs(problem.M, problem.q, accuracy=accuracy, **options)
