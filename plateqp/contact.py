@@ -16,7 +16,7 @@ import scipy.sparse.linalg as spla
 from .assembly import Model
 from .backends import ACCURACIES, get_backend, registry
 from .backends.base import Status
-from .errors import NoEquilibriumError, ProblemError, SolverError
+from .errors import MechanismError, NoEquilibriumError, ProblemError, SolverError
 from .errors import PlateQPWarning
 from .formulations import FORMULATIONS, Contact, Scaled, formulate
 from .kkt import KKT_TOL, equilibrium_possible, kkt_report
@@ -80,12 +80,23 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     possible, why = equilibrium_possible(data)
     if check_statics and not possible:
         raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({why}; found by statics, before any solve)")
+    asked_backend, asked_formulation = backend, formulation
     backend, formulation = _choose(data, backend, formulation)
     b = get_backend(backend)
     if formulation not in formulations_for(b):
         raise ProblemError(f"backend {backend!r} does not take the {formulation} formulation; "
                            f"it takes: {', '.join(formulations_for(b))}")
-    form = formulate(data, formulation)
+    try:
+        form = formulate(data, formulation)
+    except (ProblemError, MechanismError):
+        # "auto" chose to condense, but the contact points cannot be condensed onto (too close
+        # together, or they do not hold the plate): the primal form needs neither
+        if asked_formulation != "auto" or formulation == "primal" or (
+                asked_backend != "auto" and "primal" not in formulations_for(asked_backend)):
+            raise  # never swap a backend the user named for another one
+        backend, formulation = _choose(data, asked_backend, "primal")
+        b = get_backend(backend)
+        form = formulate(data, formulation)
     problem = form.problem(b.accepts)
     t1 = time.perf_counter()
     try:

@@ -80,6 +80,9 @@ class Scaled:
     F0: float
     modes: np.ndarray  # rigid modes of K (n, k), scaled dofs
     is_w: np.ndarray  # (n,) bool: the dof is a deflection (not a slope or twist)
+    # the model's own K and B: the key of the condensation cache (see _cached)
+    K_src: sp.csr_matrix | None = field(default=None, repr=False, compare=False)
+    B_src: sp.csr_matrix | None = field(default=None, repr=False, compare=False)
 
     @classmethod
     def from_model(cls, model: Model) -> Scaled:
@@ -105,7 +108,7 @@ class Scaled:
         modes = model.rigid_modes() / S[:, None]
         if modes.shape[1]:
             modes = modes / np.linalg.norm(modes, axis=0)
-        return cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, kind == 0)
+        return cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, kind == 0, model.K, c.B)
 
     @property
     def n(self) -> int:
@@ -176,44 +179,10 @@ class Primal(Formulation):
 class Condensed(Formulation):
     def __init__(self, data: Scaled) -> None:
         super().__init__("condensed", data)
-        B = data.B.tocsr()
-        m, n = B.shape
-        master = _masters(B)
-        others = np.setdiff1d(np.arange(n), master)
-        Bm = B[:, master].tocsc()
-        Bo = B[:, others].tocsc()
-        # Bm is diagonal when every support sits on a node; near-diagonal otherwise
-        try:
-            Binv = np.linalg.inv(Bm.toarray())
-        except np.linalg.LinAlgError as exn:
-            raise ProblemError("the contact points are too close together to condense onto "
-                               "(their interpolation rows are dependent); use the primal formulation") from exn
-        Binv[np.abs(Binv) < 1e-14 * np.abs(Binv).max()] = 0.0
-        Binv = sp.csr_matrix(Binv)
-        X = (Binv @ Bo).tocsr()
-        Tm = sp.hstack([Binv, -X])
-        To = sp.hstack([sp.csr_matrix((others.size, m)), sp.identity(others.size)])
-        P = sp.csr_matrix((np.ones(n), (np.concatenate([master, others]), np.arange(n))), shape=(n, n))
-        T = (P @ sp.vstack([Tm, To])).tocsr()
-        Kt = (T.T @ data.K @ T).tocsr()
+        T, fac, Koc, S = _cached(data, "condensed", lambda: _condense(data))
+        m = data.m
         ft = T.T @ data.f
-        Kcc = Kt[:m][:, :m].toarray()
-        Koc = Kt[m:][:, :m].tocsc()
-        Koo = Kt[m:][:, m:]
-        try:
-            fac = Factor(Koo)
-        except MechanismError as exn:
-            raise MechanismError("with every contact point held, the plate can still move: the "
-                                 "supports do not prevent rigid motion (fewer than three non-collinear "
-                                 "contact points and no two-sided supports); use the primal formulation, "
-                                 "which reports this as no equilibrium") from exn
         fo = ft[m:]
-        S = Kcc.copy()
-        for j0 in range(0, m, _BLOCK):
-            cols = slice(j0, min(m, j0 + _BLOCK))
-            Y = fac.solve(Koc[:, cols].toarray())
-            S[:, cols] -= Koc.T @ Y
-        S = 0.5 * (S + S.T)
         y0 = fac.solve(fo)
         r = ft[:m] - Koc.T @ y0
         rho = data.rho
@@ -241,15 +210,8 @@ class Dual(Formulation):
         if data.floating:
             raise ProblemError("the dual formulation needs K⁻¹, but this plate floats: its two-sided "
                                "supports leave rigid motions free; use the primal or condensed formulation")
-        fac = Factor(data.K)
+        fac, G = _cached(data, "dual", lambda: _flexibility(data))
         B = data.B.tocsr()
-        m = B.shape[0]
-        BT = B.T.tocsc()
-        G = np.empty((m, m))
-        for j0 in range(0, m, _BLOCK):
-            cols = slice(j0, min(m, j0 + _BLOCK))
-            G[:, cols] = B @ fac.solve(BT[:, cols].toarray())
-        G = 0.5 * (G + G.T)
         u0 = fac.solve(data.f)
         F = G + np.diag(data.rho)
         dvec = data.g0 - B @ u0
@@ -262,6 +224,78 @@ class Dual(Formulation):
         R = raw.x
         u = self._u0 - self._fac.solve(d.B.T @ R)
         return Contact(u, R, d.rho * R)
+
+
+# The condensed stiffness and the flexibility depend only on the model's K and B (not on the
+# gaps, springs, loads or the deflection scale: K̃ and B̃ are independent of W), so a sweep over
+# gaps, stiffnesses or loads that shares K and B (plateqp.studies.adapt_model) condenses once.
+_CACHE: list[tuple] = []  # (K_src, B_src, kind, value), most recent last
+_CACHE_SIZE = 2
+
+
+def _cached(data: Scaled, kind: str, build):
+    if data.K_src is not None:
+        for K, B, k, value in _CACHE:
+            if K is data.K_src and B is data.B_src and k == kind:
+                return value
+    value = build()
+    if data.K_src is not None:
+        _CACHE.append((data.K_src, data.B_src, kind, value))
+        del _CACHE[:-_CACHE_SIZE]
+    return value
+
+
+def _condense(data: Scaled):
+    """Static condensation onto the contact deflections: (T, factor of K_oo, K_oc, S)."""
+    B = data.B.tocsr()
+    m, n = B.shape
+    master = _masters(B)
+    others = np.setdiff1d(np.arange(n), master)
+    Bm = B[:, master].tocsc()
+    Bo = B[:, others].tocsc()
+    # Bm is diagonal when every support sits on a node; near-diagonal otherwise
+    try:
+        Binv = np.linalg.inv(Bm.toarray())
+    except np.linalg.LinAlgError as exn:
+        raise ProblemError("the contact points are too close together to condense onto "
+                           "(their interpolation rows are dependent); use the primal formulation") from exn
+    Binv[np.abs(Binv) < 1e-14 * np.abs(Binv).max()] = 0.0
+    Binv = sp.csr_matrix(Binv)
+    X = (Binv @ Bo).tocsr()
+    Tm = sp.hstack([Binv, -X])
+    To = sp.hstack([sp.csr_matrix((others.size, m)), sp.identity(others.size)])
+    P = sp.csr_matrix((np.ones(n), (np.concatenate([master, others]), np.arange(n))), shape=(n, n))
+    T = (P @ sp.vstack([Tm, To])).tocsr()
+    Kt = (T.T @ data.K @ T).tocsr()
+    Kcc = Kt[:m][:, :m].toarray()
+    Koc = Kt[m:][:, :m].tocsc()
+    Koo = Kt[m:][:, m:]
+    try:
+        fac = Factor(Koo)
+    except MechanismError as exn:
+        raise MechanismError("with every contact point held, the plate can still move: the "
+                             "supports do not prevent rigid motion (fewer than three non-collinear "
+                             "contact points and no two-sided supports); use the primal formulation, "
+                             "which reports this as no equilibrium") from exn
+    S = Kcc.copy()
+    for j0 in range(0, m, _BLOCK):
+        cols = slice(j0, min(m, j0 + _BLOCK))
+        Y = fac.solve(Koc[:, cols].toarray())
+        S[:, cols] -= Koc.T @ Y
+    return T, fac, Koc, 0.5 * (S + S.T)
+
+
+def _flexibility(data: Scaled):
+    """The factor of K and the flexibility G = B K⁻¹ Bᵀ (right-hand sides in blocks)."""
+    fac = Factor(data.K)
+    B = data.B.tocsr()
+    m = B.shape[0]
+    BT = B.T.tocsc()
+    G = np.empty((m, m))
+    for j0 in range(0, m, _BLOCK):
+        cols = slice(j0, min(m, j0 + _BLOCK))
+        G[:, cols] = B @ fac.solve(BT[:, cols].toarray())
+    return fac, 0.5 * (G + G.T)
 
 
 def _masters(B: sp.csr_matrix) -> np.ndarray:

@@ -311,3 +311,29 @@ def test_bad_supports_are_scene_errors():
         pq.Scene(openings=[pq.Opening(0.5, 1.0, 0.5, 1.0)], supports=[pq.Support(0.8, 0.8)])
     with pytest.raises(pq.SceneError, match="two-sided"):
         build_model(pq.Scene(edges={"left": "simple"}, supports=[pq.Support(0.0, 0.5)]))
+
+
+def test_auto_falls_back_to_primal_when_condensation_is_impossible():
+    """25 supports on a 2 × 2 mesh share all their dofs: "auto" solves the primal instead."""
+    xs = (0.0, 0.25, 0.5, 0.75, 1.0)
+    sc = pq.Scene(plate=plate(), mesh=pq.MeshSpec(2, 2), loads=[pq.UniformLoad(4.0)],
+                  supports=[pq.Support(x, y) for x in xs for y in xs])
+    res = run(sc, "auto", "auto", accuracy="default")
+    assert res.formulation == "primal"
+    np.testing.assert_allclose(res.reactions.sum(), 4.0, rtol=1e-6)  # statics: a floating plate
+    with pytest.raises(pq.ProblemError):
+        run(sc, "lemke", "auto")  # a named LCP backend is not swapped for another
+
+
+def test_condensation_is_reused_across_gap_changes():
+    """Same K and B, other gaps: the cached condensation gives the answer of a fresh build."""
+    from plateqp.studies import adapt_model, set_param
+
+    sc = symmetric_scene()
+    base = build_model(sc)
+    first = pq.solve(sc, backend="lemke", formulation="condensed", model=base)
+    sc2 = set_param(sc, "supports.4.gap", -2e-3)
+    reused = pq.solve(sc2, backend="lemke", formulation="condensed", model=adapt_model(base, sc2))
+    fresh = pq.solve(sc2, backend="lemke", formulation="condensed")
+    assert not np.allclose(first.reactions, fresh.reactions)
+    np.testing.assert_allclose(reused.reactions, fresh.reactions, rtol=1e-10, atol=1e-12)
