@@ -1,0 +1,353 @@
+"""Tests of the primal–dual active set backend (plateqp.backends.pdas).
+
+References are external to the code under test, never its own earlier output:
+
+* statics: a floating plate on three supports is statically determinate (reactions from
+  force and moment balance, worked out in the comments); on a tensionless bed the reactions
+  balance the total load and its moments;
+* symmetry: a scene symmetric about both mid-lines and the diagonal has symmetric reactions;
+* an independent algorithm: Lemke's method on the condensed LCP (plateqp.backends.lemke);
+* small QPs solved by hand;
+* no equilibrium: net uplift and a load outside the supports, where statics says no
+  reactions R ≥ 0 can balance the load (plateqp.kkt.equilibrium_possible is the driver's
+  check, turned off here so that the backend must find out by itself).
+
+Each plate test runs both linear-algebra routes where they apply: ``method="condensed"``
+(CHOLMOD, the rows' dofs ordered last) and ``method="sparse"`` (a factor of K + Bᵀ W_A B kept
+current), with each CHOLMOD binding plateqp.linalg can use (scikit-sparse, cvxopt's wheels)
+and with SuperLU.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import plateqp as pq
+from plateqp import linalg
+from plateqp.backends import pdas as PD
+from plateqp.backends.base import LCP, QP, Status
+from plateqp.errors import NoEquilibriumError, ProblemError, SolverError
+
+PLATE = pq.Plate(a=1.0, b=1.0, h=0.02, E=1.0e7, nu=0.3)
+ALL_SIMPLE = {k: "simple" for k in ("left", "right", "bottom", "top")}
+
+#: (name, options, CHOLMOD binding used): the condensed method needs CHOLMOD and a definite K
+#: (a floating plate goes to the sparse one); the sparse method refactorises with CHOLMOD's
+#: analysis (scikit-sparse: also rank-k updates; cvxopt's wheels) or with plateqp.linalg.Factor.
+ROUTES = [
+    ("auto-sksparse", {}, "sksparse"),
+    ("sparse-sksparse", {"method": "sparse"}, "sksparse"),
+    ("auto-cvxopt", {}, "cvxopt"),
+    ("sparse-cvxopt", {"method": "sparse"}, "cvxopt"),
+    ("sparse-superlu", {"method": "sparse", "factor": "superlu"}, None),
+]
+
+
+@pytest.fixture(params=ROUTES, ids=lambda r: r[0])
+def route(request, monkeypatch):
+    _, options, binding = request.param
+    have = {"sksparse": linalg.HAVE_CHOLMOD, "cvxopt": getattr(linalg, "HAVE_CVXOPT", False)}
+    if binding is not None and not have[binding]:
+        pytest.skip(f"CHOLMOD through {binding} is not installed")
+    if binding == "cvxopt":  # scikit-sparse off: pdas takes the next binding plateqp.linalg found
+        monkeypatch.setattr(linalg, "HAVE_CHOLMOD", False)
+    return dict(options)
+
+
+def solve(scene, options=None, **kw):
+    return pq.solve(scene, backend="pdas", formulation="primal", accuracy="high", options=options, **kw)
+
+
+def assert_kkt_ok(res):
+    assert res.status is Status.OPTIMAL, (res.status, res.kkt.as_dict())
+    assert res.kkt.ok and res.kkt.worst <= 1e-10, res.kkt.as_dict()
+
+
+# ----------------------------------------------------------------------------- statics
+
+
+def triangle(P, x, y, gaps=(0.0, 0.0, 0.0), n=8):
+    """A free plate on one-sided supports at (0,0), (1,0), (0,1) and a point load P at (x, y)."""
+    sups = [pq.Support(0.0, 0.0, gap=gaps[0]), pq.Support(1.0, 0.0, gap=gaps[1]),
+            pq.Support(0.0, 1.0, gap=gaps[2])]
+    return pq.Scene(name="triangle", plate=PLATE, mesh=pq.MeshSpec(n, n, "acm"), edges={},
+                    loads=[pq.PointLoad(P, x, y)], supports=sups)
+
+
+@pytest.mark.parametrize("x, y", [(0.4, 0.3), (0.1, 0.7), (0.25, 0.25)])
+def test_floating_triangle_statics(route, x, y):
+    # Vertical balance R1 + R2 + R3 = P; moments about the line x = 0 (through supports 1
+    # and 3): R2·1 = P·x; about the line y = 0 (supports 1 and 2): R3·1 = P·y. Hence
+    # R = P (1 − x − y, x, y), whatever the (small) settlements: the plate tilts rigidly.
+    P = 100.0
+    res = solve(triangle(P, x, y, gaps=(1e-4, 0.0, 2e-4)), route)
+    np.testing.assert_allclose(res.reactions, P * np.array([1 - x - y, x, y]), rtol=1e-10, atol=1e-10 * P)
+    assert res.active.all()
+    assert_kkt_ok(res)
+
+
+def test_floating_triangle_touching_supports(route):
+    # g0 = 0 at all three: the same statics. (The KKT report's deflection scale is degenerate
+    # here, since every support deflection is zero; the reactions are what is checked.)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        res = solve(triangle(60.0, 0.5, 0.2), route)
+    np.testing.assert_allclose(res.reactions, 60.0 * np.array([0.3, 0.5, 0.2]), rtol=1e-10)
+    assert res.kkt.natural <= 1e-12 and res.kkt.stationarity <= 1e-10
+
+
+def bed_scene(n=16):
+    """A free plate on a tensionless bed whose surface falls away towards (1, 1): about half
+    of the plate lifts off under a uniform load and an off-centre point load."""
+    return pq.Scene(name="bed", plate=PLATE, mesh=pq.MeshSpec(n, n, "acm"), edges={},
+                    loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
+                    foundation=pq.Foundation(2.0e4, gap={"profile": "linear", "g0": 0.0, "gx": 0.004, "gy": 0.002}))
+
+
+def test_bed_carries_the_load(route):
+    # A floating plate: the bed's reactions alone balance the load. Total: q·1·1 + P; moments
+    # about x = 0 and y = 0: Σ R x_i = q·½ + P·0.6 and Σ R y_i = q·½ + P·0.55 (the bed's
+    # springs sit at the nodes, so the moments are exact sums over nodes).
+    res = solve(bed_scene(), route)
+    assert_kkt_ok(res)
+    R = res.reactions
+    xy = res.model.contacts.xy
+    total = 20.0 + 200.0
+    assert R.sum() == pytest.approx(total, rel=1e-10)
+    assert R @ xy[:, 0] == pytest.approx(20.0 * 0.5 + 200.0 * 0.6, rel=1e-10)
+    assert R @ xy[:, 1] == pytest.approx(20.0 * 0.5 + 200.0 * 0.55, rel=1e-10)
+    frac = res.active.mean()
+    assert 0.2 < frac < 0.8  # partial contact: the test is not a two-sided bed in disguise
+    assert np.all(R[~res.active] == 0.0) and np.all(R >= 0)
+
+
+# ----------------------------------------------------------------------------- symmetry
+
+
+def symmetric_scene(floating=False):
+    """Supports on a 4 × 4 grid symmetric about x = ½, y = ½ and x = y; gaps depend on the
+    distance from the centre only; uniform load and a central point load."""
+    xs = [0.125, 0.375, 0.625, 0.875]
+    sups = [pq.Support(x, y, gap=2e-4 * ((x - 0.5) ** 2 + (y - 0.5) ** 2) - 2e-5) for x in xs for y in xs]
+    return pq.Scene(name="sym", plate=PLATE, mesh=pq.MeshSpec(16, 16, "acm"),
+                    edges={} if floating else ALL_SIMPLE, supports=sups,
+                    loads=[pq.UniformLoad(30.0), pq.PointLoad(150.0, 0.5, 0.5)])
+
+
+@pytest.mark.parametrize("floating", [False, True], ids=["simple", "floating"])
+def test_symmetric_reactions(route, floating):
+    res = solve(symmetric_scene(floating), route)
+    assert_kkt_ok(res)
+    R = res.reactions.reshape(4, 4)  # R[i, j] at (xs[i], xs[j])
+    scale = np.abs(R).max()
+    assert scale > 0
+    for image in (R[::-1, :], R[:, ::-1], R.T):
+        np.testing.assert_allclose(R, image, rtol=0, atol=1e-10 * scale)
+    assert 0 < res.active.sum() < 16
+
+
+# ----------------------------------------------------------------------------- Lemke
+
+
+def grid_scene(n_mesh=16, n_grid=5, elastic=True):
+    """benchmarks/bench_contact.py's scene family (simply supported plate, grid of supports with
+    heave in one corner and settlement in the other), every third support elastic."""
+    a = 1.0
+    xs = np.round(np.linspace(a / (n_grid + 1), a * n_grid / (n_grid + 1), n_grid) * n_mesh) / n_mesh
+    sups = []
+    for i, (x, y) in enumerate((x, y) for x in xs for y in xs):
+        stiff = 3.0e4 * (1 + i % 4) if (elastic and i % 3 == 0) else "rigid"
+        sups.append(pq.Support(float(x), float(y), gap=float(2e-4 * (x + y - a)), stiffness=stiff))
+    return pq.Scene(name=f"grid{n_grid}", plate=PLATE, mesh=pq.MeshSpec(n_mesh, n_mesh, "acm"), edges=ALL_SIMPLE,
+                    loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.7, 0.6)], supports=sups)
+
+
+OFF_NODE = pq.Scene(name="off-node", plate=PLATE, mesh=pq.MeshSpec(12, 12, "acm"),
+                    edges={"left": "simple", "right": "simple"},
+                    loads=[pq.UniformLoad(10.0), pq.PointLoad(100.0, 0.55, 0.45)],
+                    supports=[pq.Support(x, y, gap=-2e-4 * x, stiffness="rigid" if k % 2 else 5e4)
+                              for k, (x, y) in enumerate((x, y) for x in np.linspace(0.13, 0.87, 5)
+                                                         for y in np.linspace(0.11, 0.91, 5))])
+
+
+@pytest.mark.parametrize("scene", [grid_scene(16, 5), grid_scene(24, 8), OFF_NODE], ids=["16-5", "24-8", "off-node"])
+def test_agrees_with_lemke(route, scene):
+    ref = pq.solve(scene, backend="lemke", formulation="condensed", accuracy="high")
+    assert ref.status is Status.OPTIMAL
+    res = solve(scene, route)
+    assert_kkt_ok(res)
+    scale = np.abs(ref.reactions).max()
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_array_equal(res.active, ref.active)
+    rigid = np.array([s.rigid for s in scene.supports])
+    assert rigid.any() and (~rigid).any() and ref.active.any() and (~ref.active).any()  # a mixed scheme
+
+
+def test_murty_safeguard_reaches_the_same_answer():
+    # p = 0: no block exchange without progress, Murty's single exchanges take over at once
+    scene = grid_scene(24, 8, elastic=False)
+    ref = pq.solve(scene, backend="lemke", formulation="condensed", accuracy="high")
+    res = solve(scene, {"p": 0, "trace": True})
+    assert_kkt_ok(res)
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+    assert any(s.get("exchange") == "single" for s in res.extras["trace"])
+
+
+# ----------------------------------------------------------------------------- no equilibrium
+
+
+NO_EQUILIBRIUM = {
+    "net uplift": triangle(-100.0, 0.4, 0.3),
+    "load outside the supports": triangle(100.0, 0.8, 0.8),
+    "bed, net uplift": pq.Scene(name="bed-uplift", plate=PLATE, mesh=pq.MeshSpec(12, 12, "acm"), edges={},
+                                loads=[pq.UniformLoad(-5.0), pq.PointLoad(2.0, 0.5, 0.5)],
+                                foundation=pq.Foundation(2.0e4)),
+}
+
+
+@pytest.mark.parametrize("name", list(NO_EQUILIBRIUM))
+def test_no_equilibrium_is_detected_by_the_backend(route, name):
+    scene = NO_EQUILIBRIUM[name]
+    # statics first (the driver's check): no reactions R ≥ 0 balance this load
+    with pytest.raises(NoEquilibriumError, match="statics"):
+        solve(scene, route)
+    # the backend on its own: it must end UNBOUNDED (a certificate), never OPTIMAL
+    with pytest.raises(NoEquilibriumError, match="unbounded"):
+        solve(scene, route, check_statics=False)
+
+
+def test_unbounded_certificate_on_the_qp():
+    from plateqp.assembly import build_model
+    from plateqp.formulations import Primal, Scaled
+
+    qp = Primal(Scaled.from_model(build_model(triangle(-100.0, 0.4, 0.3)))).qp
+    raw = PD.solve(qp, "high")
+    assert raw.status is Status.UNBOUNDED and raw.x is None
+    d = raw.extras["ray"]  # P d = 0, G d ≤ 0, qᵀd < 0: the objective falls without bound along d
+    scale = np.abs(d).max() * abs(qp.P).max()
+    assert np.abs(qp.P @ d).max() <= 1e-8 * scale
+    assert np.all(qp.G @ d <= 1e-12 * np.abs(qp.G @ d).max())
+    assert qp.q @ d < 0
+
+
+# ----------------------------------------------------------------------------- warm start, output
+
+
+def test_warm_start_from_the_final_active_set():
+    scene = grid_scene(24, 8)
+    cold = solve(scene)
+    act = cold.extras["active"]
+    assert act.dtype == bool and act.shape == (len(scene.supports),)
+    np.testing.assert_array_equal(act, cold.active)
+    warm = solve(scene, {"active": act})
+    assert_kkt_ok(warm)
+    assert warm.iterations == 1 < cold.iterations
+    np.testing.assert_allclose(warm.reactions, cold.reactions, rtol=0, atol=1e-12 * np.abs(cold.reactions).max())
+
+
+def test_raw_solution_fields():
+    from plateqp.assembly import build_model
+    from plateqp.formulations import Primal, Scaled
+
+    qp = Primal(Scaled.from_model(build_model(grid_scene(12, 4)))).qp
+    raw = PD.solve(qp, "high")
+    assert raw.status is Status.OPTIMAL and raw.iterations >= 1 and raw.solve_time > 0
+    assert raw.z.shape == (qp.G.shape[0],) and np.all(raw.z >= 0)
+    # stationarity of the QP itself, t variables included: P x + q + Gᵀ z = 0
+    r = qp.P @ raw.x + qp.q + qp.G.T @ raw.z
+    assert np.abs(r).max() <= 1e-9 * np.abs(qp.q).max()
+    assert np.all(qp.G @ raw.x - qp.h <= 1e-12 * np.abs(qp.h).max())
+    assert raw.obj == pytest.approx(0.5 * raw.x @ (qp.P @ raw.x) + qp.q @ raw.x)
+
+
+def test_iteration_limit_is_max_iter():
+    from plateqp.assembly import build_model
+    from plateqp.formulations import Primal, Scaled
+
+    qp = Primal(Scaled.from_model(build_model(grid_scene(24, 8)))).qp
+    raw = PD.solve(qp, "high", options={"max_iter": 2})
+    assert raw.status is Status.MAX_ITER and raw.iterations == 2
+    assert raw.x is not None and raw.extras["active"].shape == (qp.G.shape[0],)  # the last iterate
+
+
+# ----------------------------------------------------------------------------- small QPs by hand
+
+
+def test_small_qp_by_hand():
+    # min ½(x1² + x2²) − x1 − x2  s.t.  x1 + x2 ≤ 1: by symmetry x1 = x2 = ½, and
+    # stationarity x − 1 + z = 0 gives z = ½.
+    qp = QP(P=sp.identity(2, format="csc"), q=[-1.0, -1.0], G=sp.csr_matrix([[1.0, 1.0]]), h=[1.0])
+    raw = PD.solve(qp, "high")
+    np.testing.assert_allclose(raw.x, [0.5, 0.5], atol=1e-14)
+    np.testing.assert_allclose(raw.z, [0.5], atol=1e-14)
+    # h = 3: the constraint is slack, x = (1, 1), z = 0
+    raw = PD.solve(QP(P=qp.P, q=qp.q, G=qp.G, h=[3.0]), "high")
+    np.testing.assert_allclose(raw.x, [1.0, 1.0], atol=1e-14)
+    assert raw.z[0] == 0.0
+
+
+def test_separable_variable_is_a_spring():
+    # min ½ u² − 2u + ½ t²  s.t.  u − t ≤ 0.5 (t: a spring of flexibility ρ = 1): active,
+    # u − 2 + z = 0, t − z = 0, u − t = 0.5  ⇒  z = 0.75, u = 1.25, t = 0.75.
+    qp = QP(P=sp.identity(2, format="csc"), q=[-2.0, 0.0], G=sp.csr_matrix([[1.0, -1.0]]), h=[0.5])
+    raw = PD.solve(qp, "high")
+    np.testing.assert_allclose(raw.x, [1.25, 0.75], atol=1e-14)
+    np.testing.assert_allclose(raw.z, [0.75], atol=1e-14)
+
+
+# ----------------------------------------------------------------------------- refusals
+
+
+def test_refuses_other_shapes():
+    P = sp.identity(3, format="csc")
+    G = sp.csr_matrix(np.ones((1, 3)))
+    with pytest.raises(SolverError, match="QP"):
+        PD.solve(LCP(np.eye(2), np.ones(2)))
+    with pytest.raises(SolverError, match="primal"):
+        PD.solve(QP(P=P, q=np.ones(3), lb=np.zeros(3)))
+    with pytest.raises(SolverError, match="equality"):
+        PD.solve(QP(P=P, q=np.ones(3), G=G, h=[1.0], A=G, b=[0.0]))
+    with pytest.raises(SolverError, match="sparse"):
+        PD.solve(QP(P=np.eye(3), q=np.ones(3), G=np.ones((1, 3)), h=[1.0]))
+    with pytest.raises(SolverError, match="few constraint rows"):
+        PD.solve(QP(P=P, q=np.ones(3), G=sp.csr_matrix(np.ones((4, 3))), h=np.ones(4)))
+    with pytest.raises(SolverError, match="no inequality|needs inequality"):
+        PD.solve(QP(P=P, q=np.ones(3)))
+    with pytest.raises(ProblemError, match="unknown option"):
+        PD.solve(QP(P=P, q=np.ones(3), G=G, h=[1.0]), options={"rho": 1.0})
+    with pytest.raises(ProblemError, match="active"):
+        PD.solve(QP(P=P, q=np.ones(3), G=G, h=[1.0]), options={"active": [1, 0]})
+
+
+def test_takes_the_primal_formulation_only():
+    from plateqp.assembly import build_model
+    from plateqp.contact import formulations_for
+    from plateqp.formulations import Condensed, Scaled
+
+    assert formulations_for("pdas") == ["primal"]
+    scene = grid_scene(8, 3)
+    for form in ("condensed", "dual"):
+        with pytest.raises(ProblemError, match="does not take"):
+            pq.solve(scene, backend="pdas", formulation=form)
+    # handed the condensed form's QP (bounds) directly, the backend says what it takes
+    qp = Condensed(Scaled.from_model(build_model(scene))).qp
+    with pytest.raises(SolverError, match="formulation='primal'"):
+        PD.solve(qp)
+
+
+@pytest.mark.skipif(not (linalg.HAVE_CHOLMOD or getattr(linalg, "HAVE_CVXOPT", False)),
+                    reason="the condensed method needs CHOLMOD")
+def test_condensed_method_refuses_a_floating_plate():
+    with pytest.raises(SolverError, match="floating"):
+        solve(triangle(100.0, 0.4, 0.3), {"method": "condensed"})
+    assert solve(triangle(100.0, 0.4, 0.3, gaps=(1e-4, 0, 0))).extras["method"] == "sparse"  # auto falls back
+
+
+def test_registered():
+    b = pq.get_backend("pdas")
+    assert b.accepts == frozenset({"qp"}) and b.available()
+    assert "pdas" in pq.available_backends()
