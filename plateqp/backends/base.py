@@ -144,6 +144,16 @@ class RawSolution:
     extras: dict = field(default_factory=dict)
 
 
+def plateqp_version() -> str:
+    """The version of an in-house backend: plateqp's own."""
+    try:
+        from importlib.metadata import version as _version
+
+        return f"plateqp {_version('plateqp')}"
+    except Exception:  # not installed as a distribution
+        return "plateqp"
+
+
 class Backend(Protocol):
     """What every backend module provides (one file per backend, one line in the registry).
 

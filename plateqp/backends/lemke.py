@@ -103,7 +103,7 @@ from itertools import chain
 import numpy as np
 
 from ..errors import NoEquilibriumError, ProblemError
-from .base import ACCURACIES, LCP, QP, RawSolution, Status
+from .base import ACCURACIES, LCP, QP, RawSolution, Status, plateqp_version
 
 __all__ = ["name", "accepts", "ACCURACY", "available", "version", "solve", "lemke", "backends"]
 
@@ -150,14 +150,7 @@ def available() -> bool:
     return True
 
 
-def version() -> str:
-    """The plateqp package version (the backend is part of plateqp)."""
-    try:
-        from importlib.metadata import version as _version
-
-        return f"plateqp {_version('plateqp')}"
-    except Exception:  # not installed as a distribution
-        return "plateqp"
+version = plateqp_version  # the backend is part of plateqp
 
 
 def backends() -> list:

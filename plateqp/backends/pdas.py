@@ -163,7 +163,7 @@ import scipy.sparse as sp
 from .. import linalg as _linalg
 from ..errors import ProblemError, SolverError
 from ..linalg import Factor
-from .base import ACCURACIES, QP, RawSolution, Status
+from .base import ACCURACIES, QP, RawSolution, Status, plateqp_version
 
 
 def _bindings() -> list[str]:
@@ -372,14 +372,7 @@ def available() -> bool:
     return True
 
 
-def version() -> str:
-    """The plateqp package version (the backend is part of plateqp)."""
-    try:
-        from importlib.metadata import version as _version
-
-        return f"plateqp {_version('plateqp')}"
-    except Exception:  # not installed as a distribution
-        return "plateqp"
+version = plateqp_version  # the backend is part of plateqp
 
 
 def backends() -> list:

@@ -82,7 +82,7 @@ import numpy as np
 from scipy.linalg.blas import daxpy
 
 from ..errors import ProblemError
-from .base import ACCURACIES, LCP, QP, RawSolution, Status
+from .base import ACCURACIES, LCP, QP, RawSolution, Status, plateqp_version
 from .bpp import natural_residual
 
 __all__ = ["name", "accepts", "ACCURACY", "OPTIONS", "available", "version", "solve", "pgs", "backends"]
@@ -114,14 +114,7 @@ def available() -> bool:
     return True
 
 
-def version() -> str:
-    """The plateqp package version (the backend is part of plateqp)."""
-    try:
-        from importlib.metadata import version as _version
-
-        return f"plateqp {_version('plateqp')}"
-    except Exception:  # not installed as a distribution
-        return "plateqp"
+version = plateqp_version  # the backend is part of plateqp
 
 
 def backends() -> list:
