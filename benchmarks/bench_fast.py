@@ -14,12 +14,15 @@ Parts (``--parts``, comma-separated):
 
 * ``goal``: pdas (``pq.solve(..., backend="pdas", formulation="primal", accuracy="high")``,
   the backend's own solve time) against the two-sided factorise-and-solve, medians of
-  ``--repeat`` interleaved runs, at ``--mesh`` (default 128);
+  ``--repeat`` interleaved runs, at ``--mesh`` (default 128), once per library (``--bindings``:
+  CHOLMOD through scikit-sparse, CHOLMOD from cvxopt's wheels, SuperLU), both sides through
+  the same one (plateqp.linalg's flags switched for the run);
 * ``backends``: the same scenes through osqp, clarabel, qpsolvers:proxqp and qpsolvers:scs at
   "high" on the primal formulation and Lemke on the condensed one (grid only), one run each
   in a subprocess with ``--timeout``; reactions compared with Lemke's (grid: exact to
   rounding) or with pdas's (bed: KKT at rounding; no other exact solver takes a 16 641-row bed);
-* ``mesh``: pdas iterations, factorisations, solves and time ratio for meshes 32² … 256².
+* ``mesh``: pdas iterations, factorisations, solves and time ratio for meshes 32² … 256²
+  (first library installed).
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_fast.py
     python benchmarks/bench_fast.py --parts goal --mesh 64 --repeat 5

@@ -20,7 +20,7 @@ own spring). Gap-unit residuals alone cannot see reaction errors where supports 
 together: measured on a 64² plate on a 30×30 support grid, Clarabel ended with gap-unit
 residuals of 3e-12 and reactions 1e-7 off; the natural residual sees that.
 
-with the deflection scale δ = max(‖B u‖∞, ‖g0‖∞) and the force scale
+with the deflection scale δ = max(‖B u‖∞, ‖g0‖∞, max |w| of the plate) and the force scale
 ρ_R = max(‖R‖∞, 10⁻¹² ‖f‖₁). A result is ``ok`` when the worst residual is at most the
 tolerance of its accuracy preset (``KKT_TOL``). Unlike qpsolvers' own check, this tests the
 sign of every reaction and complementarity support by support.
@@ -46,7 +46,9 @@ def kkt_report(data: Scaled, c: Contact, accuracy: str) -> KKTReport:
     r = data.K @ u - data.f + BtR
     st = np.linalg.norm(r) / max(np.linalg.norm(data.f), np.linalg.norm(BtR), 1e-300)
     w = data.B @ u
-    delta = max(np.abs(w).max(initial=0.0), np.abs(data.g0).max(initial=0.0), 1e-300)
+    # the plate's own deflection too: with every support touching at zero gap, w and g0 vanish
+    delta = max(np.abs(w).max(initial=0.0), np.abs(data.g0).max(initial=0.0),
+                np.abs(u[data.is_w]).max(initial=0.0), 1e-300)
     gap = data.g0 + s - w
     rscale = max(np.abs(R).max(initial=0.0), 1e-12 * np.abs(data.f).sum(), 1e-300)
     k = local_stiffness(data)

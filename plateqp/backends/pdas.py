@@ -47,30 +47,30 @@ an active set comes back, one row only is exchanged, the infeasible row of large
 the dual LCP's matrix ``B K⁻¹ Bᵀ + diag(ρ)`` is whenever ``K`` is definite and ``B`` has full
 row rank; ``max_iter`` bounds the work for the rest (``Status.MAX_ITER``).
 
-Two ways to solve a step, one sparse factorisation each
--------------------------------------------------------
+Two ways to solve a step
+------------------------
 ``method="condensed"`` (the default where CHOLMOD is at hand, through scikit-sparse or the copy
 in cvxopt's wheels, ``K`` is definite and the rows touch at most ``max_dense`` dofs: discrete
-supports on a held plate). The dofs the rows act on go
-*last* in the elimination order (fill-reducing AMD order on the rest); one sparse Cholesky
-``K = L Lᵀ`` then holds, in its trailing dense block ``L_cc``, the static condensation of every
-other dof: ``L_cc L_ccᵀ`` is the condensed stiffness. With ``Z = L_cc⁻¹ B_cᵀ`` (a dense
-triangular solve) the dual LCP
+supports on a held plate). The dofs the rows act on go *last* in the elimination order
+(AMD order on the rest); one sparse Cholesky ``K = L Lᵀ`` then holds, in its trailing dense
+block ``L_cc``, the static condensation of every other dof: ``L_cc L_ccᵀ`` is the condensed
+stiffness. With ``Z = L_cc⁻¹ B_cᵀ`` (a dense triangular solve) the dual LCP
 
 .. math::
 
     \mathrm{gap} = d + M\lambda,\qquad M = Z^T Z + \mathrm{diag}(\rho) = B K^{-1} B^T + \mathrm{diag}(\rho),
-    \qquad d = g - Z^T y_c,\quad y = L^{-1} f,
+    \qquad d = g - B K^{-1} f,
 
 costs no column solves at all (where each row is one dof, ``M`` is the inverse of
 ``L_cc L_ccᵀ``, LAPACK's POTRI, rows and columns scaled). Measured on a 128 × 128 plate with a
-30 × 30 grid of supports: the contacts-last factor costs about 1.7 plain factorisations
-plus 0.3 for extracting ``L_cc``, where the columns ``K⁻¹ B_iᵀ`` (each about 1/50 of a
-factorisation, even solved in blocks) would cost 18 for the 900 rows, or 3–5 for only the
-rows that ever enter the active set. Each active set is then a dense Cholesky of ``M_AA``
-(|A|³/3 flops). The final set is solved on the exact sparse equations by iterative
-refinement with ``L`` and ``M_AA`` (one forward and one backward sparse solve per step), so
-rounding in ``d`` (``g − B K⁻¹ f`` cancels) does not reach the answer.
+30 × 30 grid of supports: the contacts-last factor costs about 1.5–2 plain factorisations,
+plus a third of one to read ``L_cc``, where the columns ``K⁻¹ B_iᵀ`` (each about 1/50 of a
+factorisation, even solved in blocks) would cost 18 for the 900 rows. Each active set is
+then a dense Cholesky of ``M_AA`` (|A|³/3 flops). The final set is solved on the exact sparse
+equations by iterative refinement with ``K⁻¹`` and ``M_AA`` (two sparse solves per step), so
+rounding in ``d`` (``g − B K⁻¹ f`` cancels) does not reach the answer. (cvxopt's factor is
+spent once ``L_cc`` is read from it: there the solves use a second, plain factorisation,
+:class:`plateqp.linalg.Factor`.)
 
 ``method="sparse"`` (beds: every node a contact point; floating plates; no CHOLMOD). One
 sparse Cholesky of
