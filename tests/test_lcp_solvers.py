@@ -22,9 +22,8 @@ import warnings
 
 import numpy as np
 import pytest
-import scipy.linalg as sla
+from lcp_reference import brute_force, bvls_reference, random_spd
 import scipy.sparse as sp
-from scipy.optimize import lsq_linear
 
 import plateqp as pq
 from plateqp.backends import bpp as BPP
@@ -60,37 +59,10 @@ def check_lcp(M, q, z, w, rtol=1e-10):
     assert np.abs(z * w).max() <= rtol * zs * ws
 
 
-def brute_force(M, q, tol=1e-10):
-    """All solutions of LCP(M, q) on complementary splits (2ⁿ principal systems)."""
-    n = len(q)
-    sols = []
-    for mask in itertools.product([False, True], repeat=n):
-        S = np.array(mask)
-        z = np.zeros(n)
-        if S.any():
-            MSS = M[np.ix_(S, S)]
-            if abs(np.linalg.det(MSS)) < 1e-12:
-                continue
-            z[S] = np.linalg.solve(MSS, -q[S])
-        w = M @ z + q
-        if z.min() >= -tol and w.min() >= -tol:
-            sols.append(np.maximum(z, 0.0))
-    return sols
 
 
-def bvls_reference(M, q):
-    """min ½ zᵀMz + qᵀz, z ≥ 0 for SPD M, by scipy's BVLS on the Cholesky factor."""
-    Lc = np.linalg.cholesky(M)  # M = Lc Lcᵀ
-    b = -sla.solve_triangular(Lc, q, lower=True)
-    res = lsq_linear(Lc.T, b, bounds=(0.0, np.inf), method="bvls", tol=1e-14, lsmr_tol=None,
-                     max_iter=10_000)
-    assert res.success
-    return res.x
 
 
-def random_spd(n, rng):
-    A = rng.standard_normal((n, n))
-    return A @ A.T / n + 0.5 * np.eye(n)
 
 
 def floating_psd(n, rng):
