@@ -39,7 +39,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # b
 
 import argparse
 import csv
-import multiprocessing as mp
 import statistics
 import sys
 import time
@@ -56,6 +55,7 @@ from plateqp.linalg import Factor
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
+from bench_contact import run_in_subprocess
 from bench_contact import scene as grid_scene
 
 KKT_KEYS = ("stationarity", "spring", "primal", "dual", "complementarity", "natural")
@@ -175,20 +175,7 @@ def _other(args, q):
 
 
 def run_other(args, timeout):
-    # "spawn": a fresh interpreter; a forked child of a process that has run CHOLMOD hung here
-    ctx = mp.get_context("spawn")
-    q = ctx.Queue()
-    p = ctx.Process(target=_other, args=(args, q))
-    p.start()
-    p.join(timeout)
-    if p.is_alive():
-        p.terminate()
-        p.join()
-        return {"status": f"timeout > {timeout:g} s"}
-    try:
-        return q.get(timeout=5)
-    except Exception:
-        return {"status": "crashed"}
+    return run_in_subprocess(_other, args, timeout)
 
 
 # ----------------------------------------------------------------------------- output
