@@ -14,12 +14,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .assembly import Model
-from .backends import ACCURACIES, get_backend, registry
+from .backends import get_backend, registry
+from .backends.base import accuracy_tol
 from .backends.base import Status
 from .errors import MechanismError, NoEquilibriumError, ProblemError, SolverError
 from .errors import PlateQPWarning
 from .formulations import FORMULATIONS, Contact, Scaled, formulate
-from .kkt import KKT_TOL, equilibrium_possible, kkt_report
+from .kkt import equilibrium_possible, kkt_report
 from .results import Result
 
 NO_EQUILIBRIUM = ("the one-sided supports cannot carry this load: net uplift, or the load "
@@ -73,8 +74,7 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     if not. Whatever it is set to, a backend's claim of "no equilibrium" is checked against
     the same statics, and a false claim is a SolverError, never a NoEquilibriumError.
     """
-    if accuracy not in ACCURACIES:
-        raise ProblemError(f"unknown accuracy {accuracy!r}; choose one of {ACCURACIES}")
+    accuracy_tol(accuracy)  # ProblemError for a bad one, before any work
     t0 = time.perf_counter()
     data = Scaled.from_model(model)
     possible, why = equilibrium_possible(data)
@@ -145,7 +145,7 @@ def _result(model: Model, data: Scaled, c: Contact, status, backend, formulation
     res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))
     # in contact: the reaction carries load, or the support touches (gap ≈ 0), both judged at
     # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports)
-    tol = max(KKT_TOL[accuracy], 1e-9)
+    tol = max(accuracy_tol(accuracy), 1e-9)
     active = (R > tol * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= tol * max(data.W, 1e-300))
     return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
                   accuracy=accuracy, reactions=R, gaps=gaps, compressions=s, active=active, residual=res)

@@ -36,7 +36,7 @@ def solve_two_sided(model: Model, factor: Factor | None = None) -> tuple[np.ndar
     return u, factor.residual(u, model.f), factor
 
 
-def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accuracy: str = "default",
+def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accuracy: str | float = "default",
           options: dict | None = None, model: Model | None = None, check_statics: bool = True) -> Result:
     """Solve a scene.
 
@@ -46,7 +46,9 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     backend : a name from :func:`plateqp.available_backends` ("auto": Lemke on the condensed
         problem when it is small, else the best installed QP backend)
     formulation : "primal", "condensed", "dual" or "auto"
-    accuracy : "low", "default" or "high" (each backend maps it to its own tolerances)
+    accuracy : "low", "default" or "high" (KKT tolerance 1e-3, 1e-6, 1e-9), or a tolerance
+        between 1e-14 and 0.1 (each backend maps it to its own settings: the nearest preset's,
+        with its tolerances scaled; see :func:`plateqp.backends.base.preset`)
     options : passed to the backend untouched
     model : a model built before from the same scene (skips the assembly)
     check_statics : check first, by statics alone, that the one-sided supports can carry the

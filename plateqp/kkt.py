@@ -22,7 +22,7 @@ residuals of 3e-12 and reactions 1e-7 off; the natural residual sees that.
 
 with the deflection scale δ = max(‖B u‖∞, ‖g0‖∞, max |w| of the plate) and the force scale
 ρ_R = max(‖R‖∞, 10⁻¹² ‖f‖₁). A result is ``ok`` when the worst residual is at most the
-tolerance of its accuracy preset (``KKT_TOL``). Unlike qpsolvers' own check, this tests the
+tolerance of its accuracy (a preset's, ``KKT_TOL``, or the number given). Unlike qpsolvers' own check, this tests the
 sign of every reaction and complementarity support by support.
 """
 
@@ -30,10 +30,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from .backends.base import PRESET_TOL, accuracy_tol
 from .formulations import Contact, Scaled
 from .results import KKTReport
 
-KKT_TOL = {"low": 1e-3, "default": 1e-6, "high": 1e-9}
+#: The tolerance of each accuracy preset; a numeric accuracy is its own tolerance.
+KKT_TOL = PRESET_TOL
 
 
 def kkt_report(data: Scaled, c: Contact, accuracy: str) -> KKTReport:
@@ -41,7 +43,7 @@ def kkt_report(data: Scaled, c: Contact, accuracy: str) -> KKTReport:
     u, R, s = c.u, c.R, c.s
     if not (np.all(np.isfinite(u)) and np.all(np.isfinite(R))):
         inf = float("inf")
-        return KKTReport(inf, inf, inf, inf, inf, inf, KKT_TOL[accuracy], 1.0)
+        return KKTReport(inf, inf, inf, inf, inf, inf, accuracy_tol(accuracy), 1.0)
     BtR = data.B.T @ R
     r = data.K @ u - data.f + BtR
     st = np.linalg.norm(r) / max(np.linalg.norm(data.f), np.linalg.norm(BtR), 1e-300)
@@ -60,7 +62,7 @@ def kkt_report(data: Scaled, c: Contact, accuracy: str) -> KKTReport:
         dual=float(max(0.0, -R.min(initial=0.0)) / rscale),
         complementarity=float(np.abs(R * gap).max(initial=0.0) / (rscale * delta)),
         natural=float(natural),
-        tol=KKT_TOL[accuracy],
+        tol=accuracy_tol(accuracy),
         scale=delta * data.W,
     )
 

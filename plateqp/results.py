@@ -70,7 +70,7 @@ class Result:
     status: Status = Status.OPTIMAL
     backend: str = "direct"
     formulation: str = "two-sided"
-    accuracy: str = "default"
+    accuracy: str | float = "default"
     reactions: np.ndarray = field(default_factory=lambda: np.zeros(0))
     gaps: np.ndarray = field(default_factory=lambda: np.zeros(0))
     compressions: np.ndarray = field(default_factory=lambda: np.zeros(0))

@@ -18,7 +18,7 @@ import pytest
 import scipy.sparse as sp
 
 from plateqp.backends.base import LCP, QP, Status
-from plateqp.errors import SolverError
+from plateqp.errors import ProblemError, SolverError
 
 # ---------------------------------------------------------------------------------------
 # Tolerances, in one table: (atol on x, atol on multipliers) at accuracy "high".
@@ -309,7 +309,7 @@ def test_infeasible_is_never_optimal(backend):
 
 
 def test_unknown_accuracy_is_rejected(backend):
-    with pytest.raises(SolverError):
+    with pytest.raises(ProblemError):
         backend.solve(one_active_inequality()[0], accuracy="ultra")
 
 
@@ -383,7 +383,7 @@ for m in ("osqp", "clarabel", "cvxpy", "qpsolvers"):
     sys.modules[m] = None  # makes `import m` raise ImportError
 import importlib, numpy as np
 from plateqp.backends.base import QP
-from plateqp.errors import SolverError
+from plateqp.errors import ProblemError, SolverError
 names = []
 for mod in ("osqp_", "clarabel_", "cvxpy_", "qpsolvers_"):
     for b in importlib.import_module("plateqp.backends." + mod).backends():

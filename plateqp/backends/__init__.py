@@ -9,7 +9,7 @@ from __future__ import annotations
 import importlib
 
 from ..errors import SolverError
-from .base import ACCURACIES, LCP, QP, Backend, RawSolution, Status
+from .base import ACCURACIES, LCP, PRESET_TOL, QP, Backend, RawSolution, Status, accuracy_tol
 
 # module name -> the backends it provides (a family such as qpsolvers provides many)
 _MODULES = ("lemke", "bpp", "pgs", "pdas", "osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
@@ -55,6 +55,8 @@ def available_backends() -> list[str]:
 
 __all__ = [
     "ACCURACIES",
+    "PRESET_TOL",
+    "accuracy_tol",
     "LCP",
     "QP",
     "Backend",

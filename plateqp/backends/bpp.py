@@ -141,7 +141,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import NoEquilibriumError, ProblemError
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, plateqp_version
+from .base import LCP, QP, RawSolution, Status, accuracy_tol, plateqp_version, preset
 
 __all__ = ["name", "accepts", "ACCURACY", "OPTIONS", "available", "version", "solve", "bpp",
            "natural_residual", "backends"]
@@ -227,10 +227,9 @@ def natural_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray, w: np.ndarray)
     return float(num / scale)
 
 
-def _check_accuracy(accuracy: str) -> dict:
-    if accuracy not in ACCURACIES:
-        raise ProblemError(f"unknown accuracy {accuracy!r}; expected one of {ACCURACIES}")
-    return dict(ACCURACY[accuracy])
+def _check_accuracy(accuracy: str | float) -> dict:
+    accuracy_tol(accuracy)  # a clear error for a bad accuracy
+    return preset(ACCURACY, accuracy, scale=("feas_tol", "accept_tol"))
 
 
 class _Block:
@@ -509,7 +508,7 @@ def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default
         ``{"step": k, "free": |F|, "infeasible": |H1 ∪ H2|, "pivot": "block" |
         "single" | None, "exchanged": [indices], "singular": bool}``
         (``pivot`` and ``exchanged``: the exchange made *after* the step).
-    accuracy : {"low", "default", "high"}, optional
+    accuracy : {"low", "default", "high"} or float, optional
         Preset of :data:`ACCURACY`; the keywords below override it.
     feas_tol, accept_tol : float, optional
         See :data:`ACCURACY`.
@@ -663,7 +662,7 @@ def solve(problem, accuracy: str = "default", options: dict | None = None) -> Ra
     ----------
     problem : LCP
         The problem; a :class:`~plateqp.backends.base.QP` is rejected.
-    accuracy : {"low", "default", "high"}
+    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
         Preset of :data:`ACCURACY`.
     options : dict, optional
         Overrides, keys among :data:`OPTIONS`: ``active`` (warm start),

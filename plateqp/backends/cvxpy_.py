@@ -25,7 +25,8 @@ import scipy.sparse as sp
 
 from ..errors import SolverError
 from . import clarabel_, osqp_
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, via_qp
+from .base import ACCURACIES, LCP, QP, RawSolution, Status, accuracy_tol, via_qp
+from .base import preset as preset_for
 
 try:
     import cvxpy as cp
@@ -167,13 +168,12 @@ def solve_qp(
     """Solve a :class:`QP` through cvxpy with ``solver`` (None: cvxpy's choice)."""
     if cp is None:
         raise SolverError("cvxpy backends are not installed (pip install cvxpy)")
-    if accuracy not in ACCURACIES:
-        raise SolverError(f"unknown accuracy {accuracy!r}; expected one of {ACCURACIES}")
+    accuracy_tol(accuracy)  # a clear error for a bad accuracy
     prob, x, cons, ilb, iub = _build(qp)
     try:
         used = solver if solver is not None else prob.get_problem_data(solver=None)[1].solver.name()
         table = ACCURACY.get(used)
-        preset = dict(table[accuracy]) if table else {}
+        preset = preset_for(table, accuracy) if table else {}
         opts = {**preset, **(options or {})}
         # some interfaces read the options again when unpacking: compile with them
         data, chain, inverse_data = prob.get_problem_data(solver=used, solver_opts=dict(opts))

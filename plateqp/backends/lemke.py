@@ -103,7 +103,7 @@ from itertools import chain
 import numpy as np
 
 from ..errors import NoEquilibriumError, ProblemError
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, plateqp_version
+from .base import LCP, QP, RawSolution, Status, accuracy_tol, plateqp_version, preset
 
 __all__ = ["name", "accepts", "ACCURACY", "available", "version", "solve", "lemke", "backends"]
 
@@ -254,10 +254,9 @@ def _basis_matrix(M: np.ndarray, d: np.ndarray, basis: np.ndarray) -> np.ndarray
     return B
 
 
-def _check_accuracy(accuracy: str) -> dict:
-    if accuracy not in ACCURACIES:
-        raise ProblemError(f"unknown accuracy {accuracy!r}; expected one of {ACCURACIES}")
-    return dict(ACCURACY[accuracy])
+def _check_accuracy(accuracy: str | float) -> dict:
+    accuracy_tol(accuracy)  # a clear error for a bad accuracy
+    return preset(ACCURACY, accuracy, scale=("accept_tol",))
 
 
 # --------------------------------------------------------------------------- the method
@@ -288,7 +287,7 @@ def lemke(M, q, covering=None, max_iter=None, trace=False, *, accuracy="default"
         ``{"step": k, "entering": (kind, i), "leaving": (kind, i), "z0": value}``
         with ``kind`` one of ``"z"``, ``"w"``, ``"z0"`` (``i`` is ``None`` for
         ``z0``) and ``value`` the artificial variable after the pivot.
-    accuracy : {"low", "default", "high"}, optional
+    accuracy : {"low", "default", "high"} or float, optional
         Preset of :data:`ACCURACY`; the keyword tolerances below override it.
     pivot_tol, zero_tol, refactor_every, accept_tol : optional
         See :data:`ACCURACY`.
@@ -438,7 +437,7 @@ def solve(problem, accuracy: str = "default", options: dict | None = None) -> Ra
     ----------
     problem : LCP
         The problem; a :class:`~plateqp.backends.base.QP` is rejected.
-    accuracy : {"low", "default", "high"}
+    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
         Preset of :data:`ACCURACY`.
     options : dict, optional
         Overrides, keys among :data:`OPTIONS`: ``covering``, ``max_iter``,

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SolverError
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, via_qp
+from .base import ACCURACIES, LCP, QP, RawSolution, Status, accuracy_tol, preset, via_qp
 
 try:
     import osqp
@@ -61,10 +61,9 @@ STATUS_MAP: dict[str, Status] = {
 }
 
 
-def _settings(accuracy: str, options: dict | None) -> dict:
-    if accuracy not in ACCURACIES:
-        raise SolverError(f"unknown accuracy {accuracy!r}; expected one of {ACCURACIES}")
-    return {**OVERRIDES, **ACCURACY[accuracy], **(options or {})}
+def _settings(accuracy: str | float, options: dict | None) -> dict:
+    accuracy_tol(accuracy)  # a clear error for a bad accuracy
+    return {**OVERRIDES, **preset(ACCURACY, accuracy), **(options or {})}
 
 
 def _finite_or_none(v) -> np.ndarray | None:

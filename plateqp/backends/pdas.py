@@ -163,7 +163,7 @@ import scipy.sparse as sp
 from .. import linalg as _linalg
 from ..errors import ProblemError, SolverError
 from ..linalg import Factor
-from .base import ACCURACIES, QP, RawSolution, Status, plateqp_version
+from .base import QP, RawSolution, Status, accuracy_tol, plateqp_version, preset
 
 
 def _bindings() -> list[str]:
@@ -1028,7 +1028,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         First active set, one entry per row of ``G`` (defaults: see the module docstring).
     trace : bool
         Record each step in ``extras["trace"]``: ``{"step", "active", "infeasible", "solve", "exchange"}``.
-    accuracy : {"low", "default", "high"}
+    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
         Preset of :data:`ACCURACY`; ``feas_tol`` and ``accept_tol`` override it.
     **options
         ``feas_tol``, ``accept_tol`` and the keys of :data:`SETTINGS`.
@@ -1050,9 +1050,8 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         A bad option value.
     """
     t0 = time.perf_counter()
-    if accuracy not in ACCURACIES:
-        raise ProblemError(f"unknown accuracy {accuracy!r}; expected one of {ACCURACIES}")
-    tol = dict(ACCURACY[accuracy])
+    accuracy_tol(accuracy)  # a clear error for a bad accuracy
+    tol = preset(ACCURACY, accuracy, scale=("feas_tol", "accept_tol"))
     settings = dict(SETTINGS)
     for key, val in options.items():
         if key in tol:
@@ -1133,7 +1132,7 @@ def solve(problem, accuracy: str = "default", options: dict | None = None) -> Ra
     ----------
     problem : QP
         Sparse ``P``, ``G`` with ``m ≤ min(n, max_rows)`` rows, ``h``; nothing else.
-    accuracy : {"low", "default", "high"}
+    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
         Preset of :data:`ACCURACY`.
     options : dict, optional
         Keys among :data:`OPTIONS` (see :func:`pdas`).

@@ -82,7 +82,7 @@ import numpy as np
 from scipy.linalg.blas import daxpy
 
 from ..errors import ProblemError
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, plateqp_version
+from .base import LCP, QP, RawSolution, Status, accuracy_tol, plateqp_version, preset
 from .bpp import natural_residual
 
 __all__ = ["name", "accepts", "ACCURACY", "OPTIONS", "available", "version", "solve", "pgs", "backends"]
@@ -122,10 +122,9 @@ def backends() -> list:
     return [sys.modules[__name__]]
 
 
-def _check_accuracy(accuracy: str) -> dict:
-    if accuracy not in ACCURACIES:
-        raise ProblemError(f"unknown accuracy {accuracy!r}; expected one of {ACCURACIES}")
-    return dict(ACCURACY[accuracy])
+def _check_accuracy(accuracy: str | float) -> dict:
+    accuracy_tol(accuracy)  # a clear error for a bad accuracy
+    return preset(ACCURACY, accuracy, scale=("tol",))
 
 
 def _sweep(rows: list, step: list, z: list, w: np.ndarray) -> None:
@@ -162,7 +161,7 @@ def pgs(M, q, omega=1.0, max_iter=None, time_limit=None, z0=None, *, accuracy="d
         :data:`TIME_LIMIT`), checked after every sweep.
     z0 : array_like, shape (n,), optional
         Warm start (negative entries are set to zero). Default ``z = 0``.
-    accuracy : {"low", "default", "high"}, optional
+    accuracy : {"low", "default", "high"} or float, optional
         Preset of :data:`ACCURACY`.
     tol : float, optional
         Overrides the preset's stopping tolerance.
@@ -268,7 +267,7 @@ def solve(problem, accuracy: str = "default", options: dict | None = None) -> Ra
     ----------
     problem : LCP
         The problem; a :class:`~plateqp.backends.base.QP` is rejected.
-    accuracy : {"low", "default", "high"}
+    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
         Preset of :data:`ACCURACY`.
     options : dict, optional
         Overrides, keys among :data:`OPTIONS`: ``omega``, ``max_iter``,

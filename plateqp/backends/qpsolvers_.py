@@ -21,7 +21,8 @@ import scipy.sparse as sp
 
 from ..errors import SolverError
 from . import clarabel_, osqp_
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, via_qp
+from .base import ACCURACIES, LCP, QP, RawSolution, Status, accuracy_tol, via_qp
+from .base import preset as preset_for
 
 try:
     import qpsolvers
@@ -257,10 +258,9 @@ def solve_qp(qp: QP, solver: str, accuracy: str = "default", options: dict | Non
         raise SolverError("qpsolvers backends are not installed (pip install qpsolvers)")
     if solver not in qpsolvers.available_solvers:
         raise SolverError(f"qpsolvers has no solver {solver!r} here; it has {qpsolvers.available_solvers}")
-    if accuracy not in ACCURACIES:
-        raise SolverError(f"unknown accuracy {accuracy!r}; expected one of {ACCURACIES}")
+    accuracy_tol(accuracy)  # a clear error for a bad accuracy
     table = ACCURACY.get(solver)
-    preset = dict(table[accuracy]) if table else {}
+    preset = preset_for(table, accuracy) if table else {}
     opts = {**preset, **(options or {})}
     has_box = qp.lb is not None or qp.ub is not None
     infinite = any(v is not None and not np.all(np.isfinite(v)) for v in (qp.lb, qp.ub))
