@@ -48,7 +48,9 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     formulation : "primal", "condensed", "dual" or "auto"
     accuracy : "low", "default" or "high" (KKT tolerance 1e-3, 1e-6, 1e-9), or a tolerance
         between 1e-14 and 0.1 (each backend maps it to its own settings: the nearest preset's,
-        with its tolerances scaled; see :func:`plateqp.backends.base.preset`)
+        with its tolerances scaled; see :func:`plateqp.backends.base.preset`), or "auto": a
+        tenth of the discretisation error of the scene's mesh, estimated from the two coarser
+        meshes (:func:`plateqp.target.auto_tolerance`; ``extras["discretisation_error"]``)
     options : passed to the backend untouched
     model : a model built before from the same scene (skips the assembly)
     check_statics : check first, by statics alone, that the one-sided supports can carry the
@@ -69,8 +71,19 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
                       times={"build": t_build, "solve": t2 - t1, "total": t2 - t0})
     from .contact import solve_contact
 
+    auto = isinstance(accuracy, str) and accuracy == "auto"
+    if auto:
+        from .target import auto_tolerance
+
+        t_est = time.perf_counter()
+        accuracy, estimate = auto_tolerance(scene, backend=backend, formulation=formulation)
+        t_est = time.perf_counter() - t_est
     result = solve_contact(model, backend=backend, formulation=formulation, accuracy=accuracy,
                            options=options, check_statics=check_statics)
+    if auto:
+        result.extras["accuracy"] = "auto"
+        result.extras["discretisation_error"] = estimate.as_dict() if estimate is not None else None
+        result.times["estimate"] = t_est
     result.times["build"] = t_build
     result.times["total"] = time.perf_counter() - t0
     return result

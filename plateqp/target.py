@@ -1,0 +1,262 @@
+"""Discretisation error against solver error: pick the solver tolerance, or the mesh, for a target.
+
+The finite-element answer of a plate converges as the mesh is refined; the solver's answer
+converges to the finite-element one as its tolerance tightens. Past the point where the
+solver's error is a small fraction of the mesh's, a tighter tolerance buys nothing
+(benchmarks/README.md, "Discretisation against solver error"). This module estimates the
+mesh's error by Richardson's argument on meshes that halve: if q(h) = q* + C hᵖ, then
+
+    |q(h) − q*| ≈ |q(h) − q(2h)| / (2ᵖ − 1),
+
+and uses it two ways:
+
+* :func:`auto_tolerance` (``solve(..., accuracy="auto")``): estimate the error of the scene's
+  own mesh from the two coarser meshes (h·2, h·4; a quarter and a sixteenth of the work)
+  and ask the solver for a fraction of it;
+* :func:`solve_to_target` (``plateqp solve --target REL``): refine from a coarse mesh until the
+  estimated error of max |w| and of the reactions is below REL, solving each mesh at a solver
+  tolerance of a tenth of REL: the coarsest mesh and the loosest setting that reach it.
+
+The quantities are the ones engineers read: the largest deflection max |w|, and the
+reactions (discrete supports: the largest change of any support's reaction, relative to the
+largest reaction; a tensionless bed: the largest bed pressure). The order p defaults to 1.5:
+below the elements' order 2 under the point-like reactions of contact (measured 1.73 for
+ACM under a point load, tests/test_plate.py), so the estimate errs on the safe side.
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .backends.base import TOL_RANGE, accuracy_tol
+from .errors import PlateQPWarning, ProblemError, SceneError
+from .results import Result
+from .scene import Scene
+
+#: Assumed convergence order of the quantities (see the module docstring).
+ORDER = 1.5
+#: accuracy="auto" asks the solver for this fraction of the estimated mesh error.
+FRACTION = 0.1
+#: The loosest tolerance accuracy="auto" will ask for (a KKT residual of 1e-3 is "low").
+LOOSEST = 1e-3
+
+
+@dataclass
+class Quantities:
+    """What the error is measured on, for one solved mesh."""
+
+    mesh: tuple[int, int]
+    w_max: float  # max |w| over the plate
+    reactions: np.ndarray  # discrete supports' reactions, scene order
+    p_max: float | None  # the bed's largest pressure (None without a bed)
+    w_nodes: np.ndarray | None = None  # w at the nodes, (ny+1, nx+1)
+
+    @classmethod
+    def of(cls, res: Result) -> Quantities:
+        sc = res.scene
+        R, p = np.zeros(0), None
+        if np.asarray(res.reactions).size:
+            src = res.model.contacts.source
+            R = np.asarray(res.reactions, dtype=float)[src == "support"]
+            if sc.foundation is not None:  # pressure = k × compression of the bed
+                p = float(sc.foundation.k * np.asarray(res.compressions)[src == "bed"].max(initial=0.0))
+        w = res.w_nodes()
+        return cls((sc.mesh.nx, sc.mesh.ny), float(np.nanmax(np.abs(w))), R, p, w)
+
+
+def changes(coarse: Quantities, fine: Quantities) -> dict[str, float]:
+    """Relative changes from ``coarse`` to ``fine`` (twice as many cells a side).
+
+    ``w``: of the deflection at the coarse mesh's nodes (which are nodes of the fine one),
+    relative to max |w| — the field, not only its maximum, so that a maximum sitting on a
+    support held at its gap cannot hide the change; ``reactions``: the largest change of a
+    support's reaction relative to the largest reaction; ``bed``: of the largest bed pressure.
+    """
+    out = {"w": _rel(fine.w_max, coarse.w_max), "reactions": 0.0, "bed": 0.0}
+    cw, fw = coarse.w_nodes, fine.w_nodes
+    if cw is not None and fw is not None and fw.shape == (2 * cw.shape[0] - 1, 2 * cw.shape[1] - 1):
+        d = np.abs(fw[::2, ::2] - cw)
+        out["w"] = max(out["w"], float(np.nanmax(d)) / max(fine.w_max, coarse.w_max, 1e-300))
+    if fine.reactions.size and coarse.reactions.size == fine.reactions.size:
+        scale = max(np.abs(fine.reactions).max(), np.abs(coarse.reactions).max(), 1e-300)
+        out["reactions"] = float(np.abs(fine.reactions - coarse.reactions).max() / scale)
+    if fine.p_max is not None and coarse.p_max is not None:
+        out["bed"] = _rel(fine.p_max, coarse.p_max)
+    return out
+
+
+@dataclass
+class ErrorEstimate:
+    """Estimated relative discretisation errors of a mesh, from two solved meshes.
+
+    ``w``: of max |w|; ``reactions``: of the discrete supports' reactions (max over supports,
+    relative to the largest); ``bed``: of the bed's largest pressure; ``worst``: the largest.
+    """
+
+    mesh: tuple[int, int]
+    from_meshes: tuple[tuple[int, int], tuple[int, int]]
+    order: float
+    w: float
+    reactions: float = 0.0
+    bed: float = 0.0
+
+    @property
+    def worst(self) -> float:
+        return max(self.w, self.reactions, self.bed)
+
+    def as_dict(self) -> dict:
+        return {"mesh": list(self.mesh), "from_meshes": [list(m) for m in self.from_meshes], "order": self.order,
+                "w": self.w, "reactions": self.reactions, "bed": self.bed, "worst": self.worst}
+
+
+def _rel(a: float, b: float) -> float:
+    return abs(a - b) / max(abs(a), abs(b), 1e-300)
+
+
+def richardson(coarse: Quantities, fine: Quantities, order: float = ORDER, steps: int = 0) -> ErrorEstimate:
+    """The error of the mesh ``steps`` halvings finer than ``fine`` (0: of ``fine`` itself),
+    from the change between ``coarse`` (twice the cell size) and ``fine``."""
+    f = 1.0 / ((2.0 ** order - 1.0) * 2.0 ** (order * steps))
+    d = changes(coarse, fine)
+    nx, ny = fine.mesh
+    mesh = (nx * 2 ** steps, ny * 2 ** steps)
+    return ErrorEstimate(mesh, (coarse.mesh, fine.mesh), order, f * d["w"], f * d["reactions"], f * d["bed"])
+
+
+def with_mesh(scene: Scene, nx: int, ny: int) -> Scene:
+    sc = copy.deepcopy(scene)
+    sc.mesh.nx, sc.mesh.ny = int(nx), int(ny)
+    sc.validate()
+    return sc
+
+
+def _solve(scene: Scene, backend: str, formulation: str, tol: float) -> Result:
+    from .driver import solve
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlateQPWarning)  # the status says it
+        return solve(scene, backend=backend, formulation=formulation, accuracy=tol)
+
+
+def auto_tolerance(scene: Scene, backend: str = "auto", formulation: str = "auto",
+                   fraction: float = FRACTION, order: float = ORDER) -> tuple[float, ErrorEstimate | None]:
+    """The solver tolerance for ``accuracy="auto"``: ``fraction`` × the estimated relative
+    discretisation error of the scene's mesh, within [1e-12, :data:`LOOSEST`].
+
+    The estimate solves the scene on the meshes with twice and four times the cell size (at a
+    tight tolerance, with the same backend and formulation). A mesh too coarse to halve
+    twice (fewer than 4 cells a side), or coarse meshes that cannot be built, give
+    (:data:`LOOSEST`, None): on such a mesh the discretisation error dwarfs 1e-3 anyway.
+    """
+    nx, ny = scene.mesh.nx, scene.mesh.ny
+    if min(nx, ny) < 4:
+        return LOOSEST, None
+    qs = []
+    try:
+        for k in (4, 2):
+            res = _solve(with_mesh(scene, max(1, round(nx / k)), max(1, round(ny / k))), backend, formulation, 1e-9)
+            qs.append(Quantities.of(res))
+    except (SceneError, ProblemError):
+        return LOOSEST, None
+    est = richardson(qs[0], qs[1], order, steps=1)
+    est.mesh = (nx, ny)
+    tol = float(np.clip(fraction * est.worst, 1e-12, LOOSEST))
+    return tol, est
+
+
+@dataclass
+class TargetResult:
+    """What :func:`solve_to_target` did: the meshes it solved, each one's estimated error, and
+    the result on the mesh it chose (``result``; None if none reached the target)."""
+
+    target: float
+    tolerance: float
+    result: Result | None
+    rows: list[dict] = field(default_factory=list)
+    reached: bool = False
+
+    def __str__(self) -> str:
+        lines = [f"target {self.target:g} relative in max |w| and reactions; solver tolerance {self.tolerance:g}",
+                 f"{'mesh':>9s} {'max |w|':>12s} {'est. err w':>11s} {'est. err R':>11s} {'status':>10s} {'time':>8s}"]
+        for r in self.rows:
+            e = r["estimate"]
+            ew = "" if e is None else f"{e['w']:.1e}"
+            eR = "" if e is None else f"{max(e['reactions'], e['bed']):.1e}"
+            lines.append(f"{r['mesh'][0]:>4d}x{r['mesh'][1]:<4d} {r['w_max']:12.5g} {ew:>11s} {eR:>11s} "
+                         f"{r['status']:>10s} {r['time']:7.2f}s")
+        if self.reached:
+            lines.append(f"reached on {self.result.scene.mesh.nx}x{self.result.scene.mesh.ny}")
+        else:
+            lines.append("NOT reached on the meshes tried: raise --max-mesh, or loosen the target")
+        return "\n".join(lines)
+
+
+def start_mesh(scene: Scene, cells: int = 4) -> tuple[int, int]:
+    """``cells`` on the shorter side, the other in proportion to the scene's own mesh."""
+    nx, ny = scene.mesh.nx, scene.mesh.ny
+    if nx <= ny:
+        return cells, max(cells, round(cells * ny / nx))
+    return max(cells, round(cells * nx / ny)), cells
+
+
+def solve_to_target(scene: Scene, target: float, backend: str = "auto", formulation: str = "auto",
+                    start: tuple[int, int] | None = None, max_cells: int = 256,
+                    order: float = ORDER, progress=None) -> TargetResult:
+    """The coarsest mesh (halving from ``start``) whose estimated relative error of max |w|
+    and of the reactions is at most ``target``, each mesh solved at a tolerance of
+    ``target``/10.
+
+    Each mesh's error is estimated from the change since the mesh before (Richardson, order
+    ``order``, or the order observed on the last three meshes when that is lower, down to 1:
+    never a higher one, which pre-asymptotic meshes can fake). The answer is the result on the first mesh whose estimate meets the target; meshes that
+    cannot be built (a pin off their nodes) are skipped. ``progress``: called with each row.
+    """
+    tol = accuracy_tol(target)
+    if not target < 1.0:
+        raise ProblemError(f"target {target:g} must be a relative error below 1")
+    solver_tol = float(np.clip(target / 10.0, TOL_RANGE[0], LOOSEST))
+    nx, ny = start or start_mesh(scene)
+    out = TargetResult(target=tol, tolerance=solver_tol, result=None)
+    prev: list[Quantities] = []
+    while max(nx, ny) <= max_cells:
+        t0 = time.perf_counter()
+        try:
+            sc = with_mesh(scene, nx, ny)
+            res = _solve(sc, backend, formulation, solver_tol)
+        except SceneError as exn:
+            out.rows.append({"mesh": (nx, ny), "w_max": float("nan"), "estimate": None, "status": "skipped",
+                             "time": time.perf_counter() - t0, "error": str(exn)})
+            nx, ny = 2 * nx, 2 * ny
+            continue
+        q = Quantities.of(res)
+        est = None
+        if prev and prev[-1].mesh == (nx // 2, ny // 2):
+            p = order
+            if len(prev) >= 2 and prev[-2].mesh == (nx // 4, ny // 4):
+                d1, d2 = changes(prev[-2], prev[-1]), changes(prev[-1], q)
+                for k in d2:
+                    if d2[k] > 1e-12 and d1[k] > 1e-12:
+                        p = min(p, max(1.0, float(np.log2(d1[k] / d2[k]))))
+            est = richardson(prev[-1], q, p)
+        row = {"mesh": (nx, ny), "w_max": q.w_max, "estimate": est.as_dict() if est else None,
+               "status": res.status.value, "time": time.perf_counter() - t0, "error": None}
+        out.rows.append(row)
+        if progress is not None:
+            progress(row)
+        prev.append(q)
+        out.result = res
+        if est is not None and est.worst <= target and res.ok:
+            out.reached = True
+            break
+        nx, ny = 2 * nx, 2 * ny
+    if not out.reached:
+        warnings.warn(f"target {target:g} not reached up to {max_cells} cells a side", PlateQPWarning, stacklevel=2)
+    return out
+
+
+__all__ = ["ErrorEstimate", "Quantities", "TargetResult", "auto_tolerance", "richardson", "solve_to_target"]

@@ -1,0 +1,126 @@
+"""Discretisation error against solver error: ``accuracy="auto"`` and ``solve_to_target``.
+
+External reference: Navier's double series for a simply supported square plate, under a
+uniform load and under a central point load; by superposition the reaction of a rigid
+one-sided support at the centre, set at a gap g0 below the plate, is
+R = (w_q − g0) / α with w_q the centre deflection under the load and α that under a unit
+point load (while w_q > g0).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import plateqp as pq
+from plateqp.errors import ProblemError
+from plateqp.target import auto_tolerance, solve_to_target
+
+A, Q, NU = 1.0, 50.0, 0.3
+PLATE = pq.Plate(a=A, b=A, h=0.02, E=1.0e7, nu=NU)
+D = PLATE.D
+
+
+def _odd(n):
+    return np.arange(1, n + 1, 2, dtype=float)
+
+
+def navier_uniform_centre(n=401):
+    """w at the centre of a SS square plate under q: 16 q a⁴/(π⁶ D) Σ (−1)^… /(m n (m²+n²)²)."""
+    m = _odd(n)[:, None]
+    k = _odd(n)[None, :]
+    sign = (-1.0) ** ((m - 1) / 2 + (k - 1) / 2)
+    return 16 * Q * A**4 / (math.pi**6 * D) * float(np.sum(sign / (m * k * (m**2 + k**2) ** 2)))
+
+
+def navier_point_centre(n=4001):
+    """w at the centre under a unit central point load: 4 a²/(π⁴ D) Σ_{m,n odd} 1/(m²+n²)²."""
+    m = _odd(n)[:, None]
+    k = _odd(n)[None, :]
+    return 4 * A**2 / (math.pi**4 * D) * float(np.sum(1.0 / (m**2 + k**2) ** 2))
+
+
+W_Q = navier_uniform_centre()
+ALPHA = navier_point_centre()
+G0 = 0.5 * W_Q
+R_EXACT = (W_Q - G0) / ALPHA
+
+
+def centre_scene(n=8, element="acm", support=True):
+    return pq.Scene(name="centre", plate=PLATE, mesh=pq.MeshSpec(n, n, element),
+                    edges={k: "simple" for k in ("left", "right", "bottom", "top")},
+                    loads=[pq.UniformLoad(Q)],
+                    supports=[pq.Support(0.5, 0.5, gap=G0)] if support else [])
+
+
+def test_references():
+    """The series against Timoshenko's table: 0.00406 q a⁴/D and 0.01160 P a²/D."""
+    assert W_Q * D / (Q * A**4) == pytest.approx(0.0040624, rel=2e-5)
+    assert ALPHA * D / A**2 == pytest.approx(0.0116008, rel=2e-5)
+
+
+@pytest.mark.parametrize("element", ["acm", "bfs"])
+@pytest.mark.parametrize("target", [1e-2, 1e-3])
+def test_target_is_met(element, target):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        out = solve_to_target(centre_scene(element=element), target)
+    assert out.reached and out.result.ok
+    assert abs(out.result.reactions[0] / R_EXACT - 1) <= target
+    assert out.tolerance == pytest.approx(target / 10)
+    assert out.result.accuracy == pytest.approx(target / 10)
+
+
+@pytest.mark.parametrize("element", ["acm", "bfs"])
+def test_estimates_err_on_the_safe_side(element):
+    """From 16 cells a side on, each mesh's estimated reaction error is at least the true one."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        out = solve_to_target(centre_scene(element=element), 1e-4, max_cells=64)
+    rows = [r for r in out.rows if r["estimate"] is not None and r["mesh"][0] >= 16]
+    assert len(rows) == 3
+    for r in rows:
+        sc = centre_scene(r["mesh"][0], element)
+        true = abs(pq.solve(sc, backend="lemke", accuracy="high").reactions[0] / R_EXACT - 1)
+        assert r["estimate"]["reactions"] >= true, (r, true)
+
+
+def test_target_on_a_two_sided_plate():
+    """No contact: max |w| of the SS plate within the target of Navier's centre deflection."""
+    out = solve_to_target(centre_scene(support=False), 1e-3)
+    assert out.reached
+    assert abs(out.result.w_max()[0] / W_Q - 1) <= 1e-3
+
+
+@pytest.mark.parametrize("bad", [0.0, 1.0, 2.0, float("nan"), -1e-3])
+def test_bad_target(bad):
+    with pytest.raises(ProblemError):
+        solve_to_target(centre_scene(), bad)
+
+
+def test_auto_accuracy_lets_the_mesh_dominate():
+    """accuracy="auto" on a 16² mesh: a tolerance looser than the default preset's, yet the
+    answer as close to Navier as the exact (Lemke) answer on the same mesh."""
+    backend = next((b for b in ("clarabel", "osqp") if b in pq.available_backends()), None)
+    if backend is None:
+        pytest.skip("no iterative QP backend installed")
+    sc = centre_scene(16)
+    tol, est = auto_tolerance(sc)
+    assert est is not None and tol == pytest.approx(0.1 * est.worst)
+    assert tol > 1e-6
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        res = pq.solve(sc, backend=backend, formulation="primal", accuracy="auto")
+    exact = pq.solve(sc, backend="lemke", accuracy="high")
+    assert res.accuracy == pytest.approx(tol) and res.extras["accuracy"] == "auto"
+    assert res.extras["discretisation_error"]["worst"] == pytest.approx(est.worst)
+    mesh_err = abs(exact.reactions[0] / R_EXACT - 1)
+    assert abs(res.reactions[0] / R_EXACT - 1) <= 1.1 * mesh_err
+
+
+def test_auto_on_a_coarse_mesh_is_low():
+    tol, est = auto_tolerance(centre_scene(2))
+    assert est is None and tol == 1e-3
