@@ -19,7 +19,7 @@ from .backends import registry
 from .backends.base import Status
 from .contact import formulations_for
 from .driver import solve
-from .errors import NoEquilibriumError, PlateQPError, SolverError
+from .errors import NoEquilibriumError, PlateQPError, SceneError, SolverError
 from .scene import Scene
 
 
@@ -171,6 +171,44 @@ def cmd_sweep(args) -> int:
     return 0
 
 
+def _scene_or_builtin(text: str) -> Scene:
+    """A scene file, or the name of a built-in scene (``plateqp demo`` lists them)."""
+    path = Path(text)
+    if not path.exists():
+        if text in scenes.names():
+            return scenes.load(text)
+        raise SceneError(f"{text}: no such file, nor a built-in scene ({', '.join(scenes.names())})")
+    return Scene.from_toml(path)
+
+
+def cmd_export(args) -> int:
+    """``plateqp export``: the contact problem as a QPS file or a qpbenchmark test set."""
+    from .export import ExportError, contact_qp, write_qpbenchmark, write_qps
+
+    out = Path(args.out)
+    if args.format == "qpbenchmark" and (not args.testset.isidentifier() or args.testset.startswith("_")):
+        raise ExportError(f"--testset {args.testset!r}: must be a Python identifier (qpbenchmark imports it)")
+    if args.format == "qps":
+        if out.is_dir():
+            raise ExportError(f"--out {out}: is a directory; --format qps writes one file")
+        if out.exists() and not args.force:
+            raise ExportError(f"--out {out}: exists; use --force to overwrite it")
+    elif out.exists() and (not out.is_dir() or any(out.iterdir())) and not args.force:
+        raise ExportError(f"--out {out}: exists and is not an empty directory; use --force to write into it")
+    scene = _scene_or_builtin(args.scene)
+    exported = contact_qp(scene, args.formulation, name=args.name)
+    if args.format == "qps":
+        out.parent.mkdir(parents=True, exist_ok=True)
+        path = write_qps(exported, out)
+    else:
+        path = write_qpbenchmark([exported], out, name=args.testset, force=args.force)
+    qp = exported.qp
+    print(f"wrote {path}: {exported.name} ({exported.formulation}), {qp.n} variables, "
+          f"{0 if qp.G is None else qp.G.shape[0]} inequality rows, "
+          f"{'sparse' if qp.sparse else 'dense'} P ({qp.P.nnz if qp.sparse else np.count_nonzero(qp.P)} nonzeros)")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="plateqp", description="Thin plates on one-sided supports, contact as a convex QP.")
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -200,11 +238,21 @@ def main(argv=None) -> int:
     w.add_argument("--no-refine", action="store_true", help="report changes between values without bisection")
     w.add_argument("--workers", type=int, default=2, help="local worker processes (1: serial)")
     w.add_argument("--json", action="store_true")
+    x = sub.add_parser("export", help="write the contact problem as a QPS file or a qpbenchmark test set")
+    x.add_argument("scene", help="a scene file, or the name of a built-in scene")
+    x.add_argument("--formulation", default="primal", choices=["primal", "condensed", "dual"])
+    x.add_argument("--format", default="qps", choices=["qps", "qpbenchmark"],
+                   help="qps: one Maros-Meszaros QPS file; qpbenchmark: a directory with the .npz and the test-set module")
+    x.add_argument("--out", required=True, metavar="PATH", help="the .qps file, or the test set's directory")
+    x.add_argument("--name", help="problem name (default: SCENE_FORMULATION)")
+    x.add_argument("--testset", default="plateqp_contact", help="qpbenchmark test-set module name")
+    x.add_argument("--force", action="store_true", help="overwrite an existing file / write into a non-empty directory")
     b = sub.add_parser("backends", help="list the backends and the formulations each takes")
     b.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
     try:
-        return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends}[args.cmd](args)
+        return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends,
+                "export": cmd_export}[args.cmd](args)
     except NoEquilibriumError as exn:
         print(f"plateqp: no equilibrium: {exn}", file=sys.stderr)
         return 3
