@@ -1,7 +1,8 @@
-"""The ``plateqp`` command: demo, solve, backends.
+"""The ``plateqp`` command: demo, solve, sweep, export, backends.
 
 Errors go to stderr as one line (what is wrong and where) with exit code 2 for bad input,
-3 for no equilibrium, 4 for a solver failure.
+3 for no equilibrium, 4 for a solver failure, 5 for an answer that missed the asked accuracy
+(or a ``--target`` not reached).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import numpy as np
 
 from . import scenes
 from .backends import registry
-from .backends.base import Status
+from .backends.base import Status, accuracy_tol
 from .contact import formulations_for
 from .driver import solve
 from .errors import NoEquilibriumError, PlateQPError, SceneError, SolverError
@@ -29,6 +30,26 @@ def _probe(text: str) -> tuple[float, float]:
     except ValueError:
         raise argparse.ArgumentTypeError(f"--probe wants X,Y (got {text!r})") from None
     return x, y
+
+
+def _accuracy(text: str):
+    """--accuracy: a preset, "auto", or a tolerance such as 1e-7."""
+    if text in ("low", "default", "high", "auto"):
+        return text
+    try:
+        return accuracy_tol(text)
+    except PlateQPError as exn:
+        raise argparse.ArgumentTypeError(f"{exn} (or auto)") from None
+
+
+def _target(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 1e-8 <= v < 1.0:
+        raise argparse.ArgumentTypeError(f"--target wants a relative error between 1e-8 and 1 (got {text!r})")
+    return v
 
 
 def result_dict(result, probes=()) -> dict:
@@ -52,6 +73,8 @@ def result_dict(result, probes=()) -> dict:
         "iterations": result.iterations,
         "times": {k: result.times.get(k) for k in ("build", "solve", "total")},
     }
+    if result.extras.get("accuracy") == "auto":
+        d["discretisation_error"] = result.extras.get("discretisation_error")
     return d
 
 
@@ -80,22 +103,46 @@ def _summary(result, probes=()) -> str:
 
 
 def cmd_solve(args) -> int:
-    scene = Scene.from_toml(args.scene)
+    scene = _scene_or_builtin(args.scene)
     opts = json.loads(args.options) if args.options else None
+    reached = True
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the status says it; the warning would repeat it on stderr
-        result = solve(scene, backend=args.backend, formulation=args.formulation, accuracy=args.accuracy,
-                       options=opts)
+        if args.target is not None:
+            from .target import solve_to_target
+
+            if opts:
+                raise PlateQPError("--target chooses the backend's tolerance itself: drop --options")
+            if args.accuracy != "default":
+                raise PlateQPError("--target chooses the solver tolerance (a tenth of the target): drop --accuracy")
+            tr = solve_to_target(scene, args.target, backend=args.backend, formulation=args.formulation,
+                                 max_cells=args.max_mesh,
+                                 progress=None if args.json else lambda r: print(
+                                     f"  {r['mesh'][0]}x{r['mesh'][1]}: {r['status']} in {r['time']:.2f} s",
+                                     file=sys.stderr, flush=True))
+            reached, result = tr.reached, tr.result
+            if result is None:
+                raise PlateQPError(f"--target: no mesh up to {args.max_mesh} cells a side could be solved")
+        else:
+            result = solve(scene, backend=args.backend, formulation=args.formulation, accuracy=args.accuracy,
+                           options=opts)
     if args.json:
-        print(json.dumps(result_dict(result, args.probe), indent=1))
+        d = result_dict(result, args.probe)
+        if args.target is not None:
+            d["target"] = {"target": tr.target, "reached": tr.reached, "tolerance": tr.tolerance,
+                           "mesh": [result.scene.mesh.nx, result.scene.mesh.ny],
+                           "meshes": [{**r, "mesh": list(r["mesh"])} for r in tr.rows]}
+        print(json.dumps(d, indent=1))
     else:
+        if args.target is not None:
+            print(tr)
         print(_summary(result, args.probe))
     if args.out:
         out = Path(args.out)
         out.mkdir(parents=True, exist_ok=True)
         (out / f"{scene.name}.json").write_text(json.dumps(result_dict(result, args.probe), indent=1))
         np.save(out / f"{scene.name}-w.npy", result.w_nodes())
-    return 0 if result.status in (Status.OPTIMAL,) else 5
+    return 0 if result.status in (Status.OPTIMAL,) and reached else 5
 
 
 def cmd_demo(args) -> int:
@@ -152,7 +199,7 @@ def _sweep_values(args) -> list:
 def cmd_sweep(args) -> int:
     from .studies import sweep
 
-    scene = Scene.from_toml(args.scene)
+    scene = _scene_or_builtin(args.scene)
     values = _sweep_values(args)
     opts = json.loads(args.options) if args.options else None
     res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
@@ -215,11 +262,17 @@ def main(argv=None) -> int:
     d = sub.add_parser("demo", help="solve a built-in scene and print a summary")
     d.add_argument("name", nargs="?", help=f"one of: {', '.join(scenes.names())} (default: all)")
     d.add_argument("--out", help="folder for the reports")
-    s = sub.add_parser("solve", help="solve a scene file")
-    s.add_argument("scene")
+    s = sub.add_parser("solve", help="solve a scene file (or a built-in scene)")
+    s.add_argument("scene", help="a scene file, or the name of a built-in scene")
     s.add_argument("--backend", default="auto")
     s.add_argument("--formulation", default="auto", choices=["auto", "primal", "condensed", "dual"])
-    s.add_argument("--accuracy", default="default", choices=["low", "default", "high"])
+    s.add_argument("--accuracy", default="default", type=_accuracy,
+                   help="low, default, high (KKT tolerance 1e-3, 1e-6, 1e-9), a tolerance such as 1e-7, "
+                        "or auto (a tenth of the mesh's estimated discretisation error)")
+    s.add_argument("--target", type=_target, metavar="REL",
+                   help="pick the coarsest mesh (halving from 4 cells a side) whose estimated relative error "
+                        "of max |w| and of the reactions is at most REL, solved at a tolerance of REL/10")
+    s.add_argument("--max-mesh", type=int, default=256, metavar="N", help="--target: most cells a side")
     s.add_argument("--probe", type=_probe, action="append", default=[], metavar="X,Y")
     s.add_argument("--options", help="backend options as a JSON object, passed through untouched")
     s.add_argument("--json", action="store_true")
@@ -232,7 +285,8 @@ def main(argv=None) -> int:
     wv.add_argument("--range", metavar="A:B:N[:log]", help="N values from A to B, evenly or log spaced")
     w.add_argument("--backend", default="auto")
     w.add_argument("--formulation", default="auto", choices=["auto", "primal", "condensed", "dual"])
-    w.add_argument("--accuracy", default="default", choices=["low", "default", "high"])
+    w.add_argument("--accuracy", default="default", type=_accuracy,
+                   help="low, default, high, a tolerance such as 1e-7, or auto")
     w.add_argument("--options", help="backend options as a JSON object, passed through untouched")
     w.add_argument("--rtol", type=float, default=1e-3, help="relative width of each breakpoint's bracket")
     w.add_argument("--no-refine", action="store_true", help="report changes between values without bisection")

@@ -34,7 +34,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .backends.base import TOL_RANGE, accuracy_tol
-from .errors import PlateQPWarning, ProblemError, SceneError
+from .errors import MechanismError, PlateQPWarning, ProblemError, SceneError, SolverError
+
+#: What a coarse mesh may fail with (too few dofs for the supports, a pin off its nodes): skipped.
+COARSE_FAILURES = (SceneError, ProblemError, SolverError, MechanismError)
 from .results import Result
 from .scene import Scene
 
@@ -150,7 +153,7 @@ def auto_tolerance(scene: Scene, backend: str = "auto", formulation: str = "auto
 
     The estimate solves the scene on the meshes with twice and four times the cell size (at a
     tight tolerance, with the same backend and formulation). A mesh too coarse to halve
-    twice (fewer than 4 cells a side), or coarse meshes that cannot be built, give
+    twice (fewer than 4 cells a side), or coarse meshes that cannot be built or solved, give
     (:data:`LOOSEST`, None): on such a mesh the discretisation error dwarfs 1e-3 anyway.
     """
     nx, ny = scene.mesh.nx, scene.mesh.ny
@@ -161,7 +164,7 @@ def auto_tolerance(scene: Scene, backend: str = "auto", formulation: str = "auto
         for k in (4, 2):
             res = _solve(with_mesh(scene, max(1, round(nx / k)), max(1, round(ny / k))), backend, formulation, 1e-9)
             qs.append(Quantities.of(res))
-    except (SceneError, ProblemError):
+    except COARSE_FAILURES:
         return LOOSEST, None
     est = richardson(qs[0], qs[1], order, steps=1)
     est.mesh = (nx, ny)
@@ -214,7 +217,8 @@ def solve_to_target(scene: Scene, target: float, backend: str = "auto", formulat
     Each mesh's error is estimated from the change since the mesh before (Richardson, order
     ``order``, or the order observed on the last three meshes when that is lower, down to 1:
     never a higher one, which pre-asymptotic meshes can fake). The answer is the result on the first mesh whose estimate meets the target; meshes that
-    cannot be built (a pin off their nodes) are skipped. ``progress``: called with each row.
+    cannot be built or solved (a pin off their nodes, more supports than the backend takes
+    on so few dofs) are skipped. ``progress``: called with each row.
     """
     tol = accuracy_tol(target)
     if not target < 1.0:
@@ -228,7 +232,7 @@ def solve_to_target(scene: Scene, target: float, backend: str = "auto", formulat
         try:
             sc = with_mesh(scene, nx, ny)
             res = _solve(sc, backend, formulation, solver_tol)
-        except SceneError as exn:
+        except COARSE_FAILURES as exn:
             out.rows.append({"mesh": (nx, ny), "w_max": float("nan"), "estimate": None, "status": "skipped",
                              "time": time.perf_counter() - t0, "error": str(exn)})
             nx, ny = 2 * nx, 2 * ny

@@ -124,3 +124,29 @@ def test_auto_accuracy_lets_the_mesh_dominate():
 def test_auto_on_a_coarse_mesh_is_low():
     tol, est = auto_tolerance(centre_scene(2))
     assert est is None and tol == 1e-3
+
+
+def test_cli_target_and_accuracy(tmp_path, capsys):
+    """``plateqp solve --target`` reports the mesh it chose and the estimate; numbers and "auto"
+    are accepted by --accuracy; bad values are exit code 2 with a message."""
+    import json
+
+    from plateqp.cli import main
+
+    path = tmp_path / "centre.toml"
+    centre_scene(8, "bfs").to_toml(path)
+    assert main(["solve", str(path), "--target", "1e-3", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["target"]["reached"] and d["target"]["tolerance"] == pytest.approx(1e-4)
+    assert abs(d["reactions"][0] / R_EXACT - 1) <= 1e-3
+    assert d["target"]["mesh"] == [r["mesh"] for r in d["target"]["meshes"]][-1]
+    assert main(["solve", str(path), "--accuracy", "1e-7", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["accuracy"] == 1e-7
+    assert main(["solve", str(path), "--accuracy", "auto", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["discretisation_error"]["mesh"] == [8, 8]
+    for bad in (["--accuracy", "1e-20"], ["--accuracy", "best"], ["--target", "0"], ["--target", "x"]):
+        with pytest.raises(SystemExit) as exc:
+            main(["solve", str(path), *bad])
+        assert exc.value.code == 2
+    assert main(["solve", str(path), "--target", "1e-3", "--accuracy", "high"]) == 2
+    assert "drop --accuracy" in capsys.readouterr().err
