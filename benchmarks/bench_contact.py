@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import csv
 import multiprocessing as mp
+import queue
 import time
 import warnings
 from pathlib import Path
@@ -70,21 +71,32 @@ def _run(args, q):
 def run_in_subprocess(target, args, timeout):
     """Run target(args, queue) in a fresh interpreter with a time limit; its dict, or a status.
 
-    "spawn", not fork: a forked child of a process that had run CHOLMOD hung here.
+    "spawn", not fork: a forked child of a process that had run CHOLMOD hung here. The answer
+    is read while the child runs: a child whose answer is larger than the pipe's buffer
+    cannot exit before it is read (joining first deadlocked on a 257² deflection field).
     """
     ctx = mp.get_context("spawn")
     q = ctx.Queue()
     p = ctx.Process(target=target, args=(args, q))
     p.start()
-    p.join(timeout)
+    t_end = time.perf_counter() + timeout
+    out = None
+    while out is None and time.perf_counter() < t_end:
+        try:
+            out = q.get(timeout=0.2)
+        except queue.Empty:
+            if not p.is_alive():  # exited: its answer (if any) is in the pipe by now
+                try:
+                    out = q.get(timeout=1.0)
+                except queue.Empty:
+                    break
+    p.join(5.0)
     if p.is_alive():
         p.terminate()
         p.join()
-        return {"status": f"timeout > {timeout:g} s"}
-    try:
-        return q.get(timeout=5)
-    except Exception:
-        return {"status": "crashed"}
+    if out is None:
+        return {"status": f"timeout > {timeout:g} s" if time.perf_counter() >= t_end else "crashed"}
+    return out
 
 
 def run_case(args, timeout):
