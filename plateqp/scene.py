@@ -214,12 +214,17 @@ class Scene:
             self._fail(where, f"must be >= 0 (got {v!r})")
         return float(v)
 
-    def _inside(self, where: str, x, y) -> None:
+    def _inside(self, where: str, x, y, grid=None, covered: bool | None = None) -> None:
+        """Fail unless (x, y) lies on the plate. ``grid``: the scene's grid, built once per
+        validation (building one per point cost ~0.15 ms, ~10 ms for 64 supports);
+        ``covered``: the point's answer of ``grid.covers`` when already known (a batch)."""
         a, b = self.plate.a, self.plate.b
         tol = 1e-12 * max(a, b)
         if not (-tol <= x <= a + tol and -tol <= y <= b + tol):
             self._fail(where, f"point ({x}, {y}) lies outside the plate [0, {a}] x [0, {b}]")
-        if self.in_opening(x, y):
+        if covered is None:
+            covered = not self.in_opening(x, y) if grid is None else grid.covers(x, y)
+        if not covered:
             self._fail(where, f"point ({x}, {y}) lies in an opening (no plate there)")
 
     def in_opening(self, x: float, y: float) -> bool:
@@ -227,6 +232,22 @@ class Scene:
         from .mesh import Grid
 
         return not Grid.from_scene(self).covers(x, y)
+
+    @staticmethod
+    def _covered(grid, points) -> list[bool] | None:
+        """``grid.covers`` of every point at once (one vectorised ``locate``, the same answer
+        point by point), or None if a coordinate is not a finite number (the per-field checks
+        then report it in order)."""
+        xs, ys = [], []
+        for x, y in points:
+            for v in (x, y):
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                    return None
+            xs.append(x)
+            ys.append(y)
+        if not xs:
+            return []
+        return (grid.locate(xs, ys)[0] >= 0).tolist()
 
     def validate(self) -> None:
         """Check every field; raises SceneError naming the first bad one."""
@@ -268,7 +289,7 @@ class Scene:
             self._num(f"pins.{i}.x", pin.x)
             self._num(f"pins.{i}.y", pin.y)
             self._num(f"pins.{i}.w", pin.w)
-            self._inside(f"pins.{i}", pin.x, pin.y)
+            self._inside(f"pins.{i}", pin.x, pin.y, grid)
             if grid.node_at(pin.x, pin.y) is None:
                 hx, hy = grid.hx, grid.hy
                 self._fail(f"pins.{i}", f"({pin.x}, {pin.y}) is not a mesh node (node spacing {hx:g} x {hy:g});"
@@ -281,7 +302,7 @@ class Scene:
                 self._num(f"{where}.P", ld.P)
                 self._num(f"{where}.x", ld.x)
                 self._num(f"{where}.y", ld.y)
-                self._inside(where, ld.x, ld.y)
+                self._inside(where, ld.x, ld.y, grid)
             else:
                 self._num(f"{where}.q", ld.q)
             if isinstance(ld, PatchLoad):
@@ -295,12 +316,13 @@ class Scene:
                     self._fail(where, "the patch lies entirely in an opening (no plate there to load)")
         seen: dict[tuple[float, float], int] = {}
         tol = 1e-9 * max(p.a, p.b)
+        covered = self._covered(grid, [(getattr(s, "x", None), getattr(s, "y", None)) for s in self.supports])
         for i, s in enumerate(self.supports):
             where = f"supports.{i}"
             self._num(f"{where}.x", s.x)
             self._num(f"{where}.y", s.y)
             self._num(f"{where}.gap", s.gap)
-            self._inside(where, s.x, s.y)
+            self._inside(where, s.x, s.y, grid, None if covered is None else covered[i])
             if isinstance(s.stiffness, str):
                 if s.stiffness != "rigid":
                     self._fail(f"{where}.stiffness", f"must be \"rigid\" or a positive number (got {s.stiffness!r})")

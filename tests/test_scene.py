@@ -261,3 +261,31 @@ def test_edge_tables_and_strings_agree(tmp_path):
     a = pq.Scene.from_toml(write(tmp_path, BASE))
     b = pq.Scene.from_toml(write(tmp_path, BASE.replace('left = "clamped"', 'left = { kind = "clamped" }'), "b.toml"))
     assert a == b
+
+
+def test_validation_locates_all_supports_at_once_with_the_same_answer():
+    """validate() locates every support in one vectorised call on one grid: the same answer,
+    point by point, as in_opening, on cell boundaries and the openings' edges too."""
+    import numpy as np
+
+    opening = pq.Opening(0.5, 1.0, 0.5, 1.0)  # removes the cells whose centres lie in it
+    base = pq.Scene(plate=pq.Plate(a=1.0, b=1.0), mesh=pq.MeshSpec(4, 4), openings=[opening],
+                    loads=[pq.UniformLoad(q=1.0)])
+    pts = [(x, y) for x in np.linspace(0.0, 1.0, 9) for y in np.linspace(0.0, 1.0, 9)]
+    on_plate = [(x, y) for x, y in pts if not base.in_opening(x, y)]
+    off_plate = [(x, y) for x, y in pts if base.in_opening(x, y)]
+    assert len(on_plate) > 20 and len(off_plate) > 4  # both kinds, boundaries included
+    ok = pq.Scene(plate=base.plate, mesh=base.mesh, openings=[opening], loads=base.loads,
+                  supports=[pq.Support(x, y) for x, y in on_plate])
+    assert len(ok.supports) == len(on_plate)
+    for x, y in off_plate[:3]:  # one bad support among good ones: named by its own index
+        sup = [pq.Support(*p) for p in on_plate[:5]] + [pq.Support(x, y)] + [pq.Support(*p) for p in on_plate[5:8]]
+        with pytest.raises(pq.SceneError, match=r"supports\.5: point .* lies in an opening"):
+            pq.Scene(plate=base.plate, mesh=base.mesh, openings=[opening], loads=base.loads, supports=sup)
+    # a bad coordinate after a good one still names the first bad field, in order
+    sup = [pq.Support(0.1, 0.1), pq.Support("x", 0.2), pq.Support(0.75, 0.75)]
+    with pytest.raises(pq.SceneError, match=r"supports\.1\.x: must be a number"):
+        pq.Scene(plate=base.plate, mesh=base.mesh, openings=[opening], loads=base.loads, supports=sup)
+    sup = [pq.Support(0.1, 0.1), pq.Support(0.75, 0.75, gap=math.nan)]
+    with pytest.raises(pq.SceneError, match=r"supports\.1\.gap: must be finite"):
+        pq.Scene(plate=base.plate, mesh=base.mesh, openings=[opening], loads=base.loads, supports=sup)

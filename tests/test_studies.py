@@ -269,6 +269,88 @@ def test_warm_start_is_the_backends_own_state_on_the_dual(monkeypatch):
         np.testing.assert_allclose(row["reactions"], ref.reactions, rtol=0, atol=1e-9 * ref.reactions.max())
 
 
+WARM = [("bpp", "condensed"), ("pdas", "primal")]
+
+
+@pytest.mark.parametrize("backend, formulation", WARM)
+@pytest.mark.parametrize("path, values", [
+    (STIFF, ["rigid", 1e5, 3e4, 1e4, 3e3, 1e3]),
+    ("supports.12.gap", [0.0, 0.01, 0.02, 0.03, 0.05]),  # settlement of the middle support
+])
+def test_warm_and_cold_sweeps_equal_independent_lemke_solves(backend, formulation, path, values):
+    """Warm-started, re-used-cold and from-scratch sweeps all give each value's own answer:
+    an independent Lemke solve (fresh model, no warm start), reactions and contact sets."""
+    if backend not in pq.available_backends():
+        pytest.skip(f"{backend} is not installed here")
+    sc = fig5()
+    refs = [solve(set_param(sc, path, v), backend="lemke", formulation="condensed") for v in values]
+    assert len({tuple(r.active) for r in refs}) >= 3  # the contact set changes along the sweep
+    for kw in ({}, {"warm_start": False}, {"reuse": False}):
+        res = sweep(sc, path, values, backend=backend, formulation=formulation, executor="serial",
+                    progress=False, refine_breakpoints=False, **kw)
+        for row, ref in zip(res.rows, refs):
+            assert row["status"] == "optimal", kw
+            np.testing.assert_allclose(row["reactions"], ref.reactions, rtol=0, atol=1e-8 * ref.reactions.max(),
+                                       err_msg=str(kw))
+            assert row["active"] == ref.active.tolist(), kw
+            t = row["times"]
+            parts = t["build"] + t["formulate"] + t["solve"] + t["recover"] + t["post"]
+            assert 0 <= t["scene"] <= t["build"] and parts <= t["total"] * (1 + 1e-9)
+
+
+def test_warm_start_makes_an_unchanged_contact_set_one_step():
+    """A settlement sweep: started from the step before, every value whose contact set is that
+    of the value before takes one step (the start is the answer), and the sweep takes fewer
+    steps in all than the same sweep started cold; bisection finds the same breakpoints."""
+    sc = fig5()
+    path, values = "supports.12.gap", list(np.linspace(0.0, 0.05, 11))
+    for backend, formulation in WARM:
+        if backend not in pq.available_backends():
+            continue
+        kw = {"backend": backend, "formulation": formulation, "executor": "serial", "progress": False}
+        warm = sweep(sc, path, values, refine_breakpoints=False, **kw)
+        cold = sweep(sc, path, values, refine_breakpoints=False, warm_start=False, **kw)
+        assert warm.active == cold.active
+        same = [k for k in range(1, len(values)) if warm.active[k] == warm.active[k - 1]]
+        assert len(same) >= 4
+        assert all(warm.rows[k]["iterations"] == 1 for k in same), [r["iterations"] for r in warm.rows]
+        its_warm = sum(r["iterations"] for r in warm.rows)
+        its_cold = sum(r["iterations"] for r in cold.rows)
+        assert its_warm < its_cold, (backend, its_warm, its_cold)
+        assert warm.rows[0]["iterations"] == cold.rows[0]["iterations"]  # the first value starts cold
+    bw = sweep(sc, path, values[:4], rtol=1e-2, **kw).breakpoints
+    bc = sweep(sc, path, values[:4], rtol=1e-2, warm_start=False, **kw).breakpoints
+    assert bw and bw == bc
+
+
+def test_sweep_s1_max_equals_result_nodal_on_a_plate_with_an_opening():
+    """With re-use the rows' max nodal σ1 comes from operators built once per mesh: the same
+    number as Result.nodal of an independent solve, here with cut-out cells and a bed."""
+    sc = pq.Scene(plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(8, 8),
+                  edges={"left": pq.Edge("simple")}, openings=[pq.Opening(0.6, 1.0, 0.6, 1.0)],
+                  loads=[pq.UniformLoad(q=5.0), pq.PointLoad(P=2.0, x=0.3, y=0.7)],
+                  supports=[pq.Support(1.0, 0.25, gap=0.001), pq.Support(0.25, 1.0)],
+                  foundation=pq.Foundation(k=3e4, region=[0.5, 1.0, 0.0, 0.5]))
+    res = sweep(sc, "foundation.k", [1e4, 3e4, 1e5], executor="serial", progress=False, refine_breakpoints=False)
+    for row, v in zip(res.rows, [1e4, 3e4, 1e5]):
+        ref = solve(set_param(sc, "foundation.k", v))
+        assert row["s1_max"] == pytest.approx(float(np.nanmax(ref.nodal("s1"))), rel=1e-12)
+
+
+@pytest.mark.parametrize("bad", ["yes", 1, None, np.array([True])])
+def test_warm_start_must_be_a_bool(bad):
+    with pytest.raises(pq.ProblemError, match="warm_start must be True or False"):
+        sweep(fig5(), STIFF, [1e4], executor="serial", progress=False, warm_start=bad)
+
+
+def test_warm_start_false_sends_no_start(monkeypatch):
+    fake = _WarmRecorder()
+    monkeypatch.setitem(pq.registry(), "bpp", fake)
+    sweep(fig5(), STIFF, ["rigid", 1e5, 1e4], backend="bpp", executor="serial", progress=False,
+          refine_breakpoints=False, warm_start=False)
+    assert fake.seen == [None, None, None]
+
+
 def test_a_failed_value_is_recorded_and_the_sweep_goes_on():
     res = sweep(fig5(), "loads.0.P", [10000.0, -1e6, 20000.0], executor="serial", progress=False)
     bad = res.rows[1]
