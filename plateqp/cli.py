@@ -205,7 +205,7 @@ def cmd_sweep(args) -> int:
     res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
                 accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
                 max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
-                refine_breakpoints=not args.no_refine, rtol=args.rtol)
+                refine_breakpoints=not args.no_refine, rtol=args.rtol, warm_start=not args.no_warm_start)
     if args.json:
         print(json.dumps(res.to_dict(), indent=1))
     else:
@@ -291,6 +291,8 @@ def main(argv=None) -> int:
     w.add_argument("--rtol", type=float, default=1e-3, help="relative width of each breakpoint's bracket")
     w.add_argument("--no-refine", action="store_true", help="report changes between values without bisection")
     w.add_argument("--workers", type=int, default=2, help="local worker processes (1: serial)")
+    w.add_argument("--no-warm-start", action="store_true",
+                   help="start each value's solve cold (warm starts: bpp and pdas, from the previous contact set)")
     w.add_argument("--json", action="store_true")
     x = sub.add_parser("export", help="write the contact problem as a QPS file or a qpbenchmark test set")
     x.add_argument("scene", help="a scene file, or the name of a built-in scene")

@@ -530,6 +530,13 @@ def test_cli_sweep_json(capsys, tmp_path):
     out = capsys.readouterr()
     assert code == 0 and "sweep of supports.12.gap: 3 values" in out.out
 
+    # warm or cold, bpp gives the same answers
+    runs = [json.loads((main(["sweep", str(path), "--param", STIFF, "--values", "1e6,5e5,1e5", "--json",
+                              "--workers", "1", "--backend", "bpp", *flag]), capsys.readouterr().out)[1])
+            for flag in ([], ["--no-warm-start"])]
+    for warm, cold in zip(runs[0]["rows"], runs[1]["rows"]):
+        np.testing.assert_allclose(warm["reactions"], cold["reactions"], rtol=1e-9, atol=1e-6)
+
     code = main(["sweep", str(path), "--param", "loads.0.P", "--range", "1e3:1e5:3:log", "--json", "--no-refine"])
     d = json.loads(capsys.readouterr().out)
     assert [r["value"] for r in d["rows"]] == pytest.approx([1e3, 1e4, 1e5])
