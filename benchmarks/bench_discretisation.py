@@ -1,0 +1,170 @@
+"""Discretisation error against solver error, on the scene families (plateqp.families).
+
+For each family and mesh n² (8 … 128), the scene is solved by an exact in-house solver (pdas on
+the primal: the finite-element answer of that mesh) and by an iterative backend at a ladder of
+tolerances (1e-2 … 1e-10). Every answer is compared with a converged reference (the same
+scene on a 256² mesh, pdas at 1e-12): the error of the deflection field (at the 8² mesh's
+nodes, relative to max |w|) and of the reactions (discrete supports: max change relative to the
+largest; the bed: its largest pressure). The exact answer's error is the mesh's own error; an
+iterative answer's error falls with the tolerance until it meets it, and no further.
+
+Also records, per mesh, the tolerance ``accuracy="auto"`` would choose (a tenth of the
+Richardson estimate from the two coarser meshes, plateqp.target).
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_discretisation.py            # all families
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_discretisation.py --families grid_rigid --max-mesh 64
+
+Writes benchmarks/results/discretisation.csv and benchmarks/figures/discretisation-<family>.png.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+
+from bench_contact import run_in_subprocess  # noqa: E402
+
+TOLS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10)
+REF_MESH = 256
+COARSEST = 8
+
+
+def _quantities(res):
+    from plateqp.target import Quantities
+
+    q = Quantities.of(res)
+    return {"w": q.w_nodes, "w_max": q.w_max, "R": q.reactions, "p": q.p_max}
+
+
+def errors(q, ref):
+    """Relative errors of a mesh's quantities against the reference's."""
+    step = (ref["w"].shape[0] - 1) // (COARSEST)
+    s = (q["w"].shape[0] - 1) // COARSEST
+    ew = float(np.nanmax(np.abs(q["w"][::s, ::s] - ref["w"][::step, ::step])) / ref["w_max"])
+    eR = float(np.abs(q["R"] - ref["R"]).max() / np.abs(ref["R"]).max()) if ref["R"].size else float("nan")
+    ep = abs(q["p"] / ref["p"] - 1) if ref["p"] else float("nan")
+    return ew, eR, ep
+
+
+def _solve_group(args, out):
+    """In a fresh interpreter: one family × mesh × backend, every tolerance (or the exact one)."""
+    name, n, backend, formulation, tols = args
+    warnings.simplefilter("ignore")
+    import plateqp as pq
+    from plateqp.assembly import build_model
+    from plateqp.families import family
+
+    sc = family(name, n)
+    model = build_model(sc)
+    rows = []
+    pq.solve(family(name, 8), backend=backend, formulation=formulation, accuracy=1e-3)  # warm-up imports
+    for tol in tols:
+        try:
+            r = pq.solve(sc, backend=backend, formulation=formulation, accuracy=tol, model=model)
+            q = _quantities(r)
+            rows.append({"tol": tol, "status": r.status.value, "solve": r.times["solve"],
+                         "kkt": r.kkt.worst, "q": q})
+        except Exception as exn:  # recorded, not hidden
+            rows.append({"tol": tol, "status": f"error: {type(exn).__name__}: {str(exn)[:80]}"})
+    out.put({"rows": rows})
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--families", default="grid_rigid,grid_elastic,floating,bed")
+    ap.add_argument("--max-mesh", type=int, default=128)
+    ap.add_argument("--backend", default="clarabel", help="the iterative backend (primal formulation)")
+    ap.add_argument("--timeout", type=float, default=300.0, help="seconds per family × mesh × backend")
+    ap.add_argument("--out", default=str(HERE / "results" / "discretisation.csv"))
+    args = ap.parse_args(argv)
+    import plateqp as pq
+    from plateqp.target import auto_tolerance
+    from plateqp.families import family
+
+    meshes = [n for n in (8, 16, 32, 64, 128) if n <= args.max_mesh]
+    fams = args.families.split(",")
+    out_rows = []
+    for name in fams:
+        t0 = time.perf_counter()
+        ref = run_in_subprocess(_solve_group, (name, REF_MESH, "pdas", "primal", (1e-12,)), 3 * args.timeout)
+        if "rows" not in ref or "q" not in ref["rows"][0]:
+            print(f"{name}: reference failed: {ref}")
+            continue
+        rq = ref["rows"][0]["q"]
+        print(f"{name}: reference {REF_MESH}² in {time.perf_counter() - t0:.1f} s, max |w| {rq['w_max']:.4g}")
+        for n in meshes:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                auto, _ = auto_tolerance(family(name, n), backend="pdas", formulation="primal")
+            for backend, tols in (("pdas", (1e-12,)), (args.backend, TOLS)):
+                got = run_in_subprocess(_solve_group, (name, n, backend, "primal", tols), args.timeout)
+                for r in got.get("rows", [{"tol": t, "status": got.get("status", "timeout")} for t in tols]):
+                    row = {"family": name, "mesh": n, "backend": backend, "tol": r["tol"], "status": r["status"],
+                           "solve_s": r.get("solve"), "kkt_worst": r.get("kkt"), "auto_tol": auto}
+                    if "q" in r:
+                        row["err_w"], row["err_R"], row["err_bed"] = errors(r["q"], rq)
+                    out_rows.append(row)
+                    print(f"  {name} {n:4d}² {backend:9s} tol {r['tol']:.0e} {r['status']:>10s} "
+                          f"err w {row.get('err_w', float('nan')):.2e} R {row.get('err_R', float('nan')):.2e} "
+                          f"bed {row.get('err_bed', float('nan')):.2e}  auto tol {auto:.1e}", flush=True)
+    keys = ["family", "mesh", "backend", "tol", "status", "solve_s", "kkt_worst", "err_w", "err_R", "err_bed", "auto_tol"]
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    with open(args.out, "w", newline="") as fh:
+        w = csv.DictWriter(fh, keys)
+        w.writeheader()
+        for r in out_rows:
+            w.writerow({k: r.get(k) for k in keys})
+    plot(out_rows, fams, args.backend)
+    return 0
+
+
+def plot(rows, fams, backend):
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return
+    figdir = HERE / "figures"
+    figdir.mkdir(exist_ok=True)
+    for name in fams:
+        fr = [r for r in rows if r["family"] == name and "err_w" in r]
+        if not fr:
+            continue
+        key = "err_bed" if name == "bed" else "err_R"
+        label = "bed pressure" if name == "bed" else "reactions"
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        meshes = sorted({r["mesh"] for r in fr})
+        colours = plt.cm.viridis(np.linspace(0, 0.9, len(meshes)))
+        for n, col in zip(meshes, colours):
+            it = sorted((r for r in fr if r["mesh"] == n and r["backend"] == backend), key=lambda r: -r["tol"])
+            ex = [r for r in fr if r["mesh"] == n and r["backend"] == "pdas"]
+            if it:
+                ax.loglog([r["tol"] for r in it], [max(r[key], 1e-16) for r in it], "o-", color=col, label=f"{n}²")
+            if ex:
+                ax.axhline(max(ex[0][key], 1e-16), color=col, ls=":", lw=1)
+            if it:
+                ax.axvline(it[0]["auto_tol"], color=col, ls="--", lw=0.8)
+        ax.invert_xaxis()
+        ax.set_xlabel(f"{backend} tolerance (accuracy=…)")
+        ax.set_ylabel(f"relative error of {label} vs {REF_MESH}² reference")
+        ax.set_title(f"{name}: solver error meets mesh error (dotted: exact solve of each mesh;\n"
+                     "dashed: tolerance chosen by accuracy=\"auto\")", fontsize=9)
+        ax.legend(title="mesh", fontsize=8)
+        fig.tight_layout()
+        fig.savefig(figdir / f"discretisation-{name}.png", dpi=90)
+        plt.close(fig)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
