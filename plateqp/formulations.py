@@ -65,8 +65,11 @@ class Scaled:
 
     Dofs u = S ũ with S = W (deflection), W/L (slopes), W/L² (twist); energies by F0·W.
     K̃ = S K S / (F0 W), f̃ = S f / F0·(1/W)·W, B̃ = B S / W, g̃ = g0 / W, ρ̃ = ρ D / L², R̃ = R / F0.
-    W is the larger of the deflection the total load would cause (about 0.01 F_tot L²/D) and
-    the largest gap, so both deflections and gaps are of order one.
+    W is the deflection the plate can actually have (:func:`deflection_scale`): the largest of
+    the deflection the total load would cause (about 0.01 F_tot L²/D), the prescribed edge and
+    pin displacements, the largest heave, and for a floating plate the largest gap. A
+    settlement larger than that is never reached and does not set W (a support 1e2 × the free
+    deflection below a held plate once made every deflection 1e-2 in scaled units).
     """
 
     K: sp.csr_matrix
@@ -83,6 +86,8 @@ class Scaled:
     # the model's own K and B: the key of the condensation cache (see _cached)
     K_src: sp.csr_matrix | None = field(default=None, repr=False, compare=False)
     B_src: sp.csr_matrix | None = field(default=None, repr=False, compare=False)
+    # the deflection the load alone would cause (0.01 F L²/D), in units of W (≤ 1)
+    w_load: float = 1.0
 
     @classmethod
     def from_model(cls, model: Model) -> Scaled:
@@ -95,20 +100,21 @@ class Scaled:
         nd = model.element.ndof_node
         kind = model.free % nd
         orders = np.array([dx + dy for dx, dy in model.element.node_dofs])
-        w_load = np.abs(model.f[kind == 0]).sum()
-        W = max(DEFLECTION_COEFFICIENT * w_load * L**2 / D, np.abs(c.g0).max(initial=0.0), 1e-300)
-        if W <= 1e-300:
-            W = 1e-3 * L  # no load and no gaps: any scale will do
+        modes = model.rigid_modes()
+        W, W_load = deflection_scale(model, floating=modes.shape[1] > 0)
         F0 = W * D / L**2
         S = W / L ** orders[kind]
         Sm = sp.diags(S)
         K = (Sm @ model.K @ Sm / (F0 * W)).tocsr()
         f = S * model.f / (F0 * W)
         B = (c.B @ Sm / W).tocsr()
-        modes = model.rigid_modes() / S[:, None]
+        modes = modes / S[:, None]
         if modes.shape[1]:
             modes = modes / np.linalg.norm(modes, axis=0)
-        return cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, kind == 0, model.K, c.B)
+        data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, kind == 0, model.K, c.B,
+                   w_load=W_load / W)
+        check_distinct_contacts(data, model)
+        return data
 
     @property
     def n(self) -> int:
@@ -157,7 +163,7 @@ class Formulation:
 
 class Primal(Formulation):
     def __init__(self, data: Scaled) -> None:
-        n, m = data.n, data.m
+        m = data.m
         el = np.flatnonzero(data.rho > 0)
         ne = el.size
         P = sp.block_diag([data.K, sp.identity(ne)], format="csc")
@@ -186,10 +192,18 @@ class Condensed(Formulation):
         y0 = fac.solve(fo)
         r = ft[:m] - Koc.T @ y0
         rho = data.rho
-        A = np.eye(m) + S * rho[None, :]
-        M = np.linalg.solve(A, S)
-        q = np.linalg.solve(A, r - S @ data.g0)
-        M = 0.5 * (M + M.T)
+        # M = (I + Sρ)⁻¹S has rows of very different sizes when soft and rigid supports mix
+        # (a soft row is ~1/ρ, a rigid one ~S): solved plainly, each entry carries an error of
+        # eps·‖M‖, which left the soft rows' reactions 1e-6 off and the deflections recovered
+        # from them (w = g0 + ρR − z) 5e-8 off, with ρ a²/D = 1e8 next to rigid supports. With
+        # the columns of A scaled by σ = 1/(1 + ρ diag S), every row is accurate to its own size.
+        sigma = 1.0 / (1.0 + rho * np.maximum(np.diag(S), 0.0))
+        A = np.eye(m) * sigma[None, :] + S * (rho * sigma)[None, :]
+        M = sigma[:, None] * np.linalg.solve(A, S)
+        q = sigma * np.linalg.solve(A, r - S @ data.g0)
+        # symmetrise from the row that is accurate relative to the entry (the smaller σ)
+        lo, hi = sigma[:, None] < sigma[None, :], sigma[:, None] > sigma[None, :]
+        M = np.where(lo, M, np.where(hi, M.T, 0.5 * (M + M.T)))
         self.lcp = LCP(M, q)
         self.qp = self.lcp.as_qp()
         self._T, self._fac, self._Koc, self._fo, self._m = T, fac, Koc, fo, m
@@ -197,7 +211,14 @@ class Condensed(Formulation):
     def recover(self, raw: RawSolution) -> Contact:
         d = self.data
         z = raw.x
-        R = self.lcp.M @ z + self.lcp.q
+        M, q = self.lcp.M, self.lcp.q
+        R = M @ z + q
+        # R = M z + q cancels where a support does not touch: what is left there is rounding
+        # (a bound of it: m·eps·(|M||z| + |q|)), not a reaction. Left in, it failed the KKT check
+        # of a plate that touches nothing (its force scale is then 1e-12 of the load) and
+        # marked lifted supports as in contact; it is set to the zero it stands for.
+        noise = 4 * d.m * np.finfo(float).eps * (np.abs(M) @ np.abs(z) + np.abs(q))
+        R[np.abs(R) <= noise] = 0.0
         w_c = d.g0 + d.rho * R - z
         u_o = self._fac.solve(self._fo - self._Koc @ w_c)
         u = self._T @ np.concatenate([w_c, u_o])
@@ -259,6 +280,16 @@ def _condense(data: Scaled):
     except np.linalg.LinAlgError as exn:
         raise ProblemError("the contact points are too close together to condense onto "
                            "(their interpolation rows are dependent); use the primal formulation") from exn
+    # nearly dependent rows (two contact points much closer than a cell): the gaps are then
+    # nearly dependent variables, S grows like cond², and the LCP is rounding (measured: two
+    # elastic supports 1e-8 of a cell apart made I + Sρ exactly singular). The primal and the
+    # dual keep such points apart through their springs; the condensed form refuses clearly.
+    rowmax = np.maximum(np.abs(Bm).max(axis=1).toarray().ravel(), 1e-300)
+    cond = (np.abs(Bm.toarray() / rowmax[:, None]).sum(axis=0).max()
+            * np.abs(Binv * rowmax[None, :]).sum(axis=0).max())  # 1-norm, rows equilibrated
+    if cond > CONDENSE_COND_MAX:
+        raise ProblemError(f"the contact points are too close together to condense onto (their interpolation "
+                           f"rows are dependent to 1/{cond:.0e}); use the primal or the dual formulation")
     Binv[np.abs(Binv) < 1e-14 * np.abs(Binv).max()] = 0.0
     Binv = sp.csr_matrix(Binv)
     X = (Binv @ Bo).tocsr()
@@ -296,6 +327,77 @@ def _flexibility(data: Scaled):
         cols = slice(j0, min(m, j0 + _BLOCK))
         G[:, cols] = B @ fac.solve(BT[:, cols].toarray())
     return fac, 0.5 * (G + G.T)
+
+
+def deflection_scale(model: Model, floating: bool) -> tuple[float, float]:
+    """The deflection scale W of :class:`Scaled` (what the plate's deflection can reach), and the
+    part of it due to the load alone, 0.01 F L²/D.
+
+    The largest of 0.01 F L²/D (F the applied load, Σ|f| on the deflection dofs), the prescribed
+    displacements (slopes × L), the heaves (−g0 > 0) and, for a floating plate, every gap (it
+    can settle onto its supports as a body). Settlements of a held plate do not count: one it
+    cannot reach would only make every deflection small in scaled units.
+    """
+    p = model.scene.plate
+    L = max(p.a, p.b)
+    nd = model.element.ndof_node
+    orders = np.array([dx + dy for dx, dy in model.element.node_dofs])
+    w_dofs = np.arange(0, model.n_full, nd)  # the deflection dof of every node (kind 0)
+    load = np.abs(model.f_full[w_dofs]).sum()
+    prescribed = np.abs(model.values) * L ** orders[model.fixed % nd]
+    g0 = model.contacts.g0
+    gaps = np.abs(g0) if floating else np.maximum(-g0, 0.0)
+    W_load = DEFLECTION_COEFFICIENT * load * L**2 / p.D
+    W = max(W_load, prescribed.max(initial=0.0), gaps.max(initial=0.0))
+    if W == 0.0:  # no load, nothing prescribed, only settlements: nothing moves, any scale will do
+        W = np.abs(g0).max(initial=0.0) or 1e-3 * L
+    return float(W), float(W_load)
+
+
+#: Condition number (1-norm, rows equilibrated) of the contact rows on their master dofs above
+#: which the condensed form refuses: its matrix grows like cond², so 1e5 leaves ~1e-6 of the
+#: digits (two supports about 1e-4 of a cell apart); the primal and the dual still solve them.
+CONDENSE_COND_MAX = 1e5
+
+#: Two contact points whose difference mode is this much more flexible than either point (row
+#: difference of B squared, plus their springs, relative to one point's flexibility) cannot be told
+#: apart: how the load splits between them is then decided by rounding (relative error ~ ε / this,
+#: 2e-4). Two rigid supports 1e-9 of a cell apart split it 10 % differently from backend to
+#: backend, every one passing the KKT check of the time. 1e-12 is reached by two rigid supports
+#: about 2e-5 of a cell apart; closer than about half a cell the KKT check compares the
+#: reactions with an exact solve instead (:func:`plateqp.kkt.close_pairs_error`).
+DEPENDENT_ROWS = 1e-12
+
+
+def check_distinct_contacts(data: Scaled, model: Model) -> None:
+    """ProblemError if two contact points are too close (and too stiff) to carry separate reactions."""
+    c = model.contacts
+    if data.m < 2:
+        return
+    from scipy.spatial import cKDTree
+
+    h = min(model.grid.hx, model.grid.hy)
+    pairs = cKDTree(c.xy).query_pairs(1e-3 * h, output_type="ndarray")
+    if not len(pairs):
+        return
+    B = data.B.tocsr()
+    B2 = B.multiply(B).tocsr()
+    kb = np.maximum(B2 @ data.K.diagonal(), 1e-300)  # local stiffness, as in kkt.local_stiffness
+    nb = np.maximum(np.asarray(B2.sum(axis=1)).ravel(), 1e-300)
+    for i, j in pairs:
+        e = B[i] - B[j]
+        rel = float(e.multiply(e).sum()) / max(nb[i], nb[j])
+        flex = max(1.0 / kb[i] + data.rho[i], 1.0 / kb[j] + data.rho[j])
+        ratio = (rel / max(kb[i], kb[j]) + data.rho[i] + data.rho[j]) / flex
+        if ratio < DEPENDENT_ROWS:
+            names = [f"supports.{c.index[k]}" if c.source[k] == "support"
+                     else f"the foundation node at ({c.xy[k, 0]:g}, {c.xy[k, 1]:g})" for k in (i, j)]
+            d = float(np.hypot(*(c.xy[i] - c.xy[j])))
+            raise ProblemError(
+                f"{names[0]} and {names[1]} are {d:.2g} apart ({d / h:.1g} of a mesh cell) and too stiff to "
+                f"tell apart: the plate's deflections there differ by {np.sqrt(rel):.0e} of the deflection, "
+                "so how the load splits between them is decided by rounding, not by the plate; merge them "
+                "into one support, move them apart, or make them elastic")
 
 
 def _masters(B: sp.csr_matrix) -> np.ndarray:

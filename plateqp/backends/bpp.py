@@ -52,8 +52,9 @@ Singular blocks (positive semidefinite M)
 For symmetric PSD ``M`` (a floating plate: the rigid motions span the null
 space of the condensed stiffness) a principal block ``M_FF`` is singular
 exactly when the supports in ``T`` cannot hold the plate. Such a block is
-detected by a Cholesky pivot below ``1000 · sing_tol · max diag`` (or a failed
-Cholesky) and then decomposed ``M_FF = V Λ Vᵀ``; eigenvalues at most
+detected by a squared pivot below ``1000 · sing_tol`` in the Cholesky factor of
+the equilibrated block ``D M_FF D``, ``D = diag(M_FF)^-½`` (or a failed Cholesky),
+and then decomposed ``M_FF = V Λ Vᵀ``; eigenvalues at most
 ``sing_tol · λ_max`` count as zero, ``N`` spans their eigenvectors and
 ``P = N Nᵀ``. With ``b = −q_F``:
 
@@ -168,8 +169,8 @@ ACCURACY: dict[str, dict[str, float]] = {
 #: Keys accepted in the ``options`` dict of :func:`solve`.
 OPTIONS = ("active", "max_iter", "p", "sing_tol", "trace") + tuple(ACCURACY["default"])
 
-#: A Cholesky pivot below ``SING_TRIGGER · sing_tol · max diag(M_FF)`` sends the block to the
-#: eigen-decomposition, which decides whether it is singular.
+#: A squared Cholesky pivot of the equilibrated block (unit diagonal) below ``SING_TRIGGER ·
+#: sing_tol`` sends the block to the eigen-decomposition, which decides whether it is singular.
 SING_TRIGGER = 1e3
 
 #: Proximal-point fallback (used only when the pivoting fails, i.e. for singular M): at most
@@ -242,12 +243,17 @@ class _Block:
         self.negative = 0.0  # most negative eigenvalue / λ_max, eigen path only
         if A.shape[0] == 0:
             return
-        dmax = max(np.abs(np.diagonal(A)).max(), np.finfo(float).tiny)
+        diag = np.diagonal(A)
         if symmetric:
+            # Cholesky of the equilibrated block D A D (D = diag(A)^-½), judged by its pivots:
+            # a block whose diagonal spans 1e-2 … 1e8 (rigid supports next to soft springs in
+            # the dual) is not near-singular, but a pivot test against max diag(A) said so and
+            # sent it to the eigen path, which lost 1e-8 relative in the soft rows' reactions.
+            d = np.where(diag > 0, 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0)), 1.0)
             try:
-                c = sla.cho_factor(A, lower=True, check_finite=False)
-                if np.diagonal(c[0]).min() ** 2 > SING_TRIGGER * sing_tol * dmax:
-                    self.kind, self._fac = "cholesky", c
+                c = sla.cho_factor(d[:, None] * A * d[None, :], lower=True, check_finite=False)
+                if np.diagonal(c[0]).min() ** 2 > SING_TRIGGER * sing_tol and np.all(diag > 0):
+                    self.kind, self._fac, self._d = "cholesky", c, d
                     return
             except np.linalg.LinAlgError:
                 pass
@@ -277,7 +283,8 @@ class _Block:
         if self.kind == "empty":
             return np.zeros(0)
         if self.kind == "cholesky":
-            return sla.cho_solve(self._fac, b, check_finite=False)
+            d = self._d if b.ndim == 1 else self._d[:, None]
+            return d * sla.cho_solve(self._fac, d * b, check_finite=False)
         if self.kind == "lu":
             return sla.lu_solve(self._fac, b, check_finite=False)
         return self._V @ ((self._V.T @ b) / self._lam)

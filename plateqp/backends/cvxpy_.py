@@ -181,6 +181,9 @@ def solve_qp(
         raise SolverError(
             f"cvxpy cannot pass this problem to {solver or 'its default solver'}: {exn}"
         ) from exn
+    except (MemoryError, OverflowError) as exn:  # e.g. CVXOPT's index overflow at 128² (n = 49k)
+        raise SolverError(f"cvxpy/{solver or 'default'} cannot hold this problem (n = {qp.n}): {exn}; "
+                          "use a sparse backend (osqp, clarabel, pdas) or the condensed formulation") from exn
     try:
         t0 = time.perf_counter()
         # solve_via_data may write its defaults into the dict it gets: give it a copy
@@ -194,6 +197,9 @@ def solve_qp(
         )
     except (ValueError, TypeError, AttributeError, KeyError) as exn:  # bad option, wrong types
         raise SolverError(f"cvxpy/{used} failed: {exn}") from exn
+    except (MemoryError, OverflowError) as exn:  # DAQP and PROXQP densify P: 286 GiB at 256²
+        raise SolverError(f"cvxpy/{used} cannot hold this problem (n = {qp.n}): {exn}; "
+                          "use a sparse backend (osqp, clarabel, pdas) or the condensed formulation") from exn
 
     extras = {"solver": used, "preset": preset if table else "defaults", "options": opts}
     with warnings.catch_warnings():

@@ -213,6 +213,13 @@ def _matrices(qp: QP, solver: str):
     # A dense-only solver (quadprog, daqp, ecos here) cannot take a sparse matrix at all:
     # densifying is the price of using it, paid here and nowhere else.
     use_sparse = sparse_ok and (qp.sparse or not dense_ok)
+    if not use_sparse:
+        rows = qp.n + sum(0 if M is None else M.shape[0] for M in (qp.G, qp.A))
+        need = 8.0 * qp.n * rows
+        if need > DENSE_BYTES_MAX:
+            raise SolverError(f"qpsolvers/{solver} takes dense matrices only: this problem (n = {qp.n}) would "
+                              f"need {need / 2**30:.0f} GiB; use a sparse backend (osqp, clarabel, pdas) or "
+                              "the condensed formulation")
 
     def conv(M):
         if M is None:
@@ -223,6 +230,10 @@ def _matrices(qp: QP, solver: str):
 
     return conv(qp.P), conv(qp.G), conv(qp.A)
 
+
+#: Densifying for a dense-only solver (quadprog, daqp, ecos here) is refused above this many bytes
+#: of matrices: at 256² the primal's P alone would be 286 GiB (a MemoryError, or minutes of swap).
+DENSE_BYTES_MAX = 2.0 * 2**30
 
 #: Solvers that qpsolvers refuses to give infinite bounds: their finite bounds go into G.
 FINITE_BOUNDS_ONLY = frozenset({"ecos"})
@@ -285,6 +296,8 @@ def solve_qp(qp: QP, solver: str, accuracy: str = "default", options: dict | Non
             raise SolverError(f"qpsolvers/{solver} rejected the problem: {exn}") from exn
         except (qpsolvers.ParamError, TypeError, ValueError, AttributeError) as exn:
             raise SolverError(f"qpsolvers/{solver} failed: {exn}") from exn
+        except (MemoryError, OverflowError) as exn:
+            raise SolverError(f"qpsolvers/{solver} cannot hold this problem (n = {qp.n}): {exn}") from exn
     caught = [str(w.message) for w in caught_w]
     name, iterations = _solver_status(solver, sol, caught)
     status = STATUS_MAP.get(solver, _FOUND).get(name, Status.ERROR)
