@@ -88,6 +88,9 @@ class Scaled:
     B_src: sp.csr_matrix | None = field(default=None, repr=False, compare=False)
     # the deflection the load alone would cause (0.01 F L²/D), in units of W (≤ 1)
     w_load: float = 1.0
+    # each contact point's distance to the nearest other held point (another contact point, or
+    # a node whose w is prescribed), in units of L: bounds the plate's local stiffness there
+    spacing: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     @classmethod
     def from_model(cls, model: Model) -> Scaled:
@@ -112,7 +115,7 @@ class Scaled:
         if modes.shape[1]:
             modes = modes / np.linalg.norm(modes, axis=0)
         data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, kind == 0, model.K, c.B,
-                   w_load=W_load / W)
+                   w_load=W_load / W, spacing=contact_spacing(model) / L)
         check_distinct_contacts(data, model)
         return data
 
@@ -327,6 +330,23 @@ def _flexibility(data: Scaled):
         cols = slice(j0, min(m, j0 + _BLOCK))
         G[:, cols] = B @ fac.solve(BT[:, cols].toarray())
     return fac, 0.5 * (G + G.T)
+
+
+def contact_spacing(model: Model) -> np.ndarray:
+    """Distance from each contact point to the nearest other point that holds the plate: another
+    contact point, or a node whose deflection is prescribed (edges, pins); the plate's size
+    where there is none."""
+    from scipy.spatial import cKDTree
+
+    c = model.contacts
+    nd = model.element.ndof_node
+    held = model.fixed[model.fixed % nd == 0] // nd
+    pts = np.vstack([c.xy, model.grid.node_xy()[held]])
+    p = model.scene.plate
+    if pts.shape[0] < 2:
+        return np.full(c.m, max(p.a, p.b))
+    d, _ = cKDTree(pts).query(c.xy, k=2)
+    return np.where(d[:, 1] > 0, d[:, 1], max(p.a, p.b))
 
 
 def deflection_scale(model: Model, floating: bool) -> tuple[float, float]:
