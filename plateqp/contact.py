@@ -26,29 +26,64 @@ from .results import Result
 NO_EQUILIBRIUM = ("the one-sided supports cannot carry this load: net uplift, or the load "
                   "resultant lies outside the supports' reach, so the plate would lift off")
 
-# formulation="auto": condense while the dense condensed matrix stays small
-AUTO_CONDENSED_MAX = 400
-# backend="auto": first installed of these for QPs; Lemke for LCPs
-AUTO_QP_BACKENDS = ("clarabel", "qpsolvers:clarabel", "osqp", "cvxpy")
+# The "auto" rules, measured by benchmarks/bench_scaling.py (benchmarks/README.md, "Scaling":
+# grid_rigid scenes, n = 16…256, m = 25…3969, accuracy 1e-6, formulate + solve time).
+# * backend="auto": on a single solve PDAS on the sparse primal was the fastest exact route
+#   everywhere (BPP on the condensed LCP, condensation included: 1.5–4× slower for m ≤ 81,
+#   6–23× for m ≥ 225). The condensed route is kept while m ≤ AUTO_LCP_MAX all the same: its
+#   condensation is cached and re-used by every solve that shares the model (sweeps, gap
+#   regulation: a dense m × m solve per value instead of a factorisation), and BPP's answer
+#   did not depend on its warm start (bit-identical serial and parallel sweeps in
+#   tests/test_studies.py, where warm-started PDAS differed at 1e-13). Condensed and dual
+#   problems go to the first of AUTO_LCP_BACKENDS (BPP: 7–10× faster than Lemke from m = 225
+#   on, as exact), primal ones to the first of AUTO_QP_BACKENDS.
+# * a named QP backend (osqp, clarabel, qpsolvers:*, …): the condensed problem paid while
+#   m ≤ AUTO_CONDENSED_FRACTION × free dofs: the break-even of OSQP, Clarabel and ProxQP was
+#   m ≈ 25–50 at 3 k dofs, ≈ 100 at 12 k, ≈ 225–960 at 49 k; never beyond AUTO_CONDENSED_MAX
+#   (the dense work grows like m³, its memory like 8 m² bytes).
+# * a backend that takes only one of them (lemke, bpp, pgs: LCPs; pdas: the primal) gets it.
+AUTO_LCP_MAX = 100
+AUTO_CONDENSED_FRACTION = 0.01
+AUTO_CONDENSED_MAX = 1000
+AUTO_QP_BACKENDS = ("pdas", "clarabel", "qpsolvers:clarabel", "osqp", "cvxpy")
+AUTO_LCP_BACKENDS = ("bpp", "lemke")
+
+
+def condensed_pays(data: Scaled, backend: str = "auto") -> bool:
+    """True where formulation="auto" condenses: few contact points (see the rules above).
+
+    ``backend="auto"``: m ≤ AUTO_LCP_MAX; a named QP backend: m ≤ AUTO_CONDENSED_FRACTION ×
+    free dofs and m ≤ AUTO_CONDENSED_MAX.
+    """
+    if backend == "auto":
+        return data.m <= AUTO_LCP_MAX
+    return data.m <= min(AUTO_CONDENSED_MAX, AUTO_CONDENSED_FRACTION * data.n)
+
+
+def _first_installed(names: tuple[str, ...]) -> str | None:
+    return next((b for b in names if b in registry() and registry()[b].available()), None)
 
 
 def _choose(data: Scaled, backend: str, formulation: str) -> tuple[str, str]:
     if formulation == "auto":
-        if data.m <= AUTO_CONDENSED_MAX and (backend == "auto" or "condensed" in formulations_for(backend)):
+        takes = list(FORMULATIONS) if backend == "auto" else formulations_for(backend)
+        if "condensed" not in takes:
+            formulation = "primal" if "primal" in takes else takes[0]
+        elif "primal" not in takes:
             formulation = "condensed"
         else:
-            formulation = "primal"
+            formulation = "condensed" if condensed_pays(data, backend) else "primal"
     if formulation not in FORMULATIONS:
         raise ProblemError(f"unknown formulation {formulation!r}; choose one of {FORMULATIONS}")
     if backend == "auto":
         if formulation in ("condensed", "dual"):
-            backend = "lemke"
+            backend = _first_installed(AUTO_LCP_BACKENDS) or "lemke"
         else:
-            avail = [b for b in AUTO_QP_BACKENDS if b in registry() and registry()[b].available()]
-            if not avail:
+            # pdas takes at most as many contact rows as dofs (a coarse mesh under many supports)
+            backend = _first_installed(tuple(b for b in AUTO_QP_BACKENDS if b != "pdas" or data.m <= data.n))
+            if backend is None:
                 raise SolverError("the primal formulation needs a QP backend; none is installed "
                                   "(pip install 'plateqp[solvers]')")
-            backend = avail[0]
     return backend, formulation
 
 
