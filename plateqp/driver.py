@@ -43,9 +43,11 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     Parameters
     ----------
     scene : the :class:`~plateqp.scene.Scene`
-    backend : a name from :func:`plateqp.available_backends` ("auto": Lemke on the condensed
-        problem when it is small, else the best installed QP backend)
-    formulation : "primal", "condensed", "dual" or "auto"
+    backend : a name from :func:`plateqp.available_backends` ("auto": bpp on the condensed
+        problem while there are at most 100 contact points, else pdas on the sparse primal;
+        the rule and its measurements: :mod:`plateqp.contact`, benchmarks/README.md "Scaling")
+    formulation : "primal", "condensed", "dual" or "auto" (with a named backend: the form it
+        takes; with a QP backend that takes all, condensed while m ≤ 1 % of the dofs and ≤ 1000)
     accuracy : "low", "default" or "high" (KKT tolerance 1e-3, 1e-6, 1e-9), or a tolerance
         between 1e-14 and 0.1 (each backend maps it to its own settings: the nearest preset's,
         with its tolerances scaled; see :func:`plateqp.backends.base.preset`), or "auto": a
