@@ -161,7 +161,7 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         warnings.warn(f"{backend} on the {formulation} problem: {status.value} "
                       f"(worst KKT residual {rep.worst:.2e}, asked {rep.tol:.0e})", PlateQPWarning, stacklevel=3)
     t3 = time.perf_counter()
-    res = _result(model, data, c, status, backend, formulation, accuracy)
+    res = to_result(model, data, c, status, backend, formulation, accuracy)
     res.kkt = rep
     res.iterations = raw.iterations
     res.extras = {"solver_status": raw.solver_status, **raw.extras}
@@ -169,8 +169,9 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     return res
 
 
-def _result(model: Model, data: Scaled, c: Contact, status, backend, formulation, accuracy) -> Result:
-    """Back to the user's units."""
+def to_result(model: Model, data: Scaled, c: Contact, status, backend, formulation, accuracy) -> Result:
+    """A contact solution of the scaled problem back in the user's units, as a :class:`Result`
+    (public: :mod:`plateqp.export` maps any solver's answer back with it)."""
     u = data.dof_scale * c.u
     R = data.F0 * c.R
     s = data.W * c.s
@@ -205,7 +206,7 @@ def solve_bilateral(model: Model) -> Result:
     for _ in range(2):  # refinement
         x = x + lu.solve(rhs - A @ x)
     c = Contact(x[:n], x[n:], data.rho * x[n:])
-    res = _result(model, data, c, Status.OPTIMAL, "direct", "bilateral", "high")
+    res = to_result(model, data, c, Status.OPTIMAL, "direct", "bilateral", "high")
     res.active = np.ones(m, dtype=bool)
     res.times = {"solve": time.perf_counter() - t0}
     return res

@@ -118,7 +118,7 @@ class ExportedQP:
         form only (they are the scaled reactions). The status is OPTIMAL if the KKT residuals
         meet ``accuracy``, else INACCURATE.
         """
-        from .contact import _result
+        from .contact import to_result
         from .kkt import kkt_report
 
         if self.form is None:
@@ -132,7 +132,7 @@ class ExportedQP:
         c = self.form.recover(raw)
         rep = kkt_report(self.data, c, accuracy)
         status = Status.OPTIMAL if rep.ok else Status.INACCURATE
-        res = _result(self.model, self.data, c, status, solver, self.formulation, accuracy)
+        res = to_result(self.model, self.data, c, status, solver, self.formulation, accuracy)
         res.kkt = rep
         return res
 
