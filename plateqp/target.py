@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .backends.base import TOL_RANGE, accuracy_tol
+from .backends.base import TOL_RANGE
 from .errors import MechanismError, PlateQPWarning, ProblemError, SceneError, SolverError
 
 #: What a coarse mesh may fail with (too few dofs for the supports, a pin off its nodes): skipped.
@@ -220,9 +220,9 @@ def solve_to_target(scene: Scene, target: float, backend: str = "auto", formulat
     cannot be built or solved (a pin off their nodes, more supports than the backend takes
     on so few dofs) are skipped. ``progress``: called with each row.
     """
-    tol = accuracy_tol(target)
-    if not target < 1.0:
-        raise ProblemError(f"target {target:g} must be a relative error below 1")
+    if not (isinstance(target, (int, float)) and 1e-12 <= target < 1.0):
+        raise ProblemError(f"target {target!r} must be a relative error from 1e-12 to below 1")
+    tol = float(target)
     solver_tol = float(np.clip(target / 10.0, TOL_RANGE[0], LOOSEST))
     nx, ny = start or start_mesh(scene)
     out = TargetResult(target=tol, tolerance=solver_tol, result=None)

@@ -65,7 +65,10 @@ def nearest_preset(accuracy: str | float) -> str:
     """The preset whose tolerance is nearest (in decades) to ``accuracy``'s."""
     if isinstance(accuracy, str) and accuracy in PRESET_TOL:
         return accuracy
-    tol = accuracy_tol(accuracy)
+    return _nearest(accuracy_tol(accuracy))
+
+
+def _nearest(tol: float) -> str:
     return min(PRESET_TOL, key=lambda a: abs(np.log10(tol / PRESET_TOL[a])))
 
 
@@ -81,13 +84,14 @@ def preset(table: dict[str, dict], accuracy: str | float, scale: tuple[str, ...]
     its own row. A number ``tol`` gets the row of the nearest preset with every tolerance
     setting multiplied by ``tol / PRESET_TOL[preset]`` (floored at 1e-15): the keys in
     ``scale``, or by default every float setting in (0, 1) whose name holds "tol", "eps" or
-    "gap". Iteration limits and switches are the preset's.
+    "gap". Iteration limits and switches are the preset's. A bad accuracy is a ProblemError.
     """
-    name = nearest_preset(accuracy)
+    if isinstance(accuracy, str) and accuracy in PRESET_TOL:
+        return dict(table[accuracy])
+    tol = accuracy_tol(accuracy)
+    name = _nearest(tol)
     row = dict(table[name])
-    if isinstance(accuracy, str) and accuracy == name:
-        return row
-    ratio = accuracy_tol(accuracy) / PRESET_TOL[name]
+    ratio = tol / PRESET_TOL[name]
     for key, value in row.items():
         if (key in scale) if scale is not None else _is_tolerance(key, value):
             row[key] = max(float(value) * ratio, 1e-15)

@@ -142,7 +142,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import NoEquilibriumError, ProblemError
-from .base import LCP, QP, RawSolution, Status, accuracy_tol, plateqp_version, preset
+from .base import LCP, QP, RawSolution, Status, plateqp_version, preset
 
 __all__ = ["name", "accepts", "ACCURACY", "OPTIONS", "available", "version", "solve", "bpp",
            "natural_residual", "backends"]
@@ -229,7 +229,6 @@ def natural_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray, w: np.ndarray)
 
 
 def _check_accuracy(accuracy: str | float) -> dict:
-    accuracy_tol(accuracy)  # a clear error for a bad accuracy
     return preset(ACCURACY, accuracy, scale=("feas_tol", "accept_tol"))
 
 

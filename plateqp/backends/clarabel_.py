@@ -28,7 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SolverError
-from .base import LCP, QP, RawSolution, Status, accuracy_tol, preset, via_qp
+from .base import LCP, QP, RawSolution, Status, preset, via_qp
 
 try:
     import clarabel
@@ -71,7 +71,6 @@ STATUS_MAP: dict[str, Status] = {
 
 
 def _settings(accuracy: str | float, options: dict | None):
-    accuracy_tol(accuracy)  # a clear error for a bad accuracy
     chosen = {**OVERRIDES, **preset(ACCURACY, accuracy), **(options or {})}
     settings = clarabel.DefaultSettings()
     for key, value in chosen.items():

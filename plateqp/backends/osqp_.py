@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SolverError
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, accuracy_tol, preset, via_qp
+from .base import ACCURACIES, LCP, QP, RawSolution, Status, preset, via_qp
 
 try:
     import osqp
@@ -62,7 +62,6 @@ STATUS_MAP: dict[str, Status] = {
 
 
 def _settings(accuracy: str | float, options: dict | None) -> dict:
-    accuracy_tol(accuracy)  # a clear error for a bad accuracy
     return {**OVERRIDES, **preset(ACCURACY, accuracy), **(options or {})}
 
 

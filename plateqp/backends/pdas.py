@@ -163,7 +163,7 @@ import scipy.sparse as sp
 from .. import linalg as _linalg
 from ..errors import ProblemError, SolverError
 from ..linalg import Factor
-from .base import QP, RawSolution, Status, accuracy_tol, plateqp_version, preset
+from .base import QP, RawSolution, Status, plateqp_version, preset
 
 
 def _bindings() -> list[str]:
@@ -1050,7 +1050,6 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         A bad option value.
     """
     t0 = time.perf_counter()
-    accuracy_tol(accuracy)  # a clear error for a bad accuracy
     tol = preset(ACCURACY, accuracy, scale=("feas_tol", "accept_tol"))
     settings = dict(SETTINGS)
     for key, val in options.items():

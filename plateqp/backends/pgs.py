@@ -82,7 +82,7 @@ import numpy as np
 from scipy.linalg.blas import daxpy
 
 from ..errors import ProblemError
-from .base import LCP, QP, RawSolution, Status, accuracy_tol, plateqp_version, preset
+from .base import LCP, QP, RawSolution, Status, plateqp_version, preset
 from .bpp import natural_residual
 
 __all__ = ["name", "accepts", "ACCURACY", "OPTIONS", "available", "version", "solve", "pgs", "backends"]
@@ -123,7 +123,6 @@ def backends() -> list:
 
 
 def _check_accuracy(accuracy: str | float) -> dict:
-    accuracy_tol(accuracy)  # a clear error for a bad accuracy
     return preset(ACCURACY, accuracy, scale=("tol",))
 
 
