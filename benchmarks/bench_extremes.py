@@ -229,7 +229,7 @@ def _held(scene, active):
     import scipy.sparse.linalg as spla
 
     from plateqp.assembly import build_model
-    from plateqp.formulations import Scaled
+    from plateqp.contact import Scaled
 
     model = build_model(scene)
     d = Scaled.from_model(model)
@@ -433,8 +433,8 @@ def _first_row(kind, params):
         from plateqp.assembly import build_model
         from plateqp.backends import clarabel_
         from plateqp.backends.base import QP
-        from plateqp.formulations import Contact, Scaled
-        from plateqp.kkt import kkt_report
+        from plateqp.contact import ContactSolution as Contact, Scaled
+        from plateqp.contact.kkt import kkt_report
 
         E = params["E"]
         sc = grid(E=E, gaps=PATTERN * w_free() * E0 / E)

@@ -12,7 +12,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 import numpy as np, plateqp as pq
 from bench_contact import scene
 from plateqp.assembly import build_model
-from plateqp.formulations import Scaled, formulate
+from plateqp.contact import Scaled, formulate
 from plateqp.backends import lemke, bpp, pgs
 from plateqp.backends.bpp import natural_residual
 

@@ -83,7 +83,7 @@ def _case(args, q):
     warnings.simplefilter("ignore")
     import resource
 
-    from plateqp import formulations
+    from plateqp.contact import formulations
     from plateqp.assembly import build_model
     from plateqp.contact import solve_contact
 

@@ -96,7 +96,7 @@ def _ladder(args, q):
     """Child: build the scene once, then solve it at every rung; one message per rung."""
     fam, n, k, backend, formulation, tols = args
     warnings.simplefilter("ignore")
-    from plateqp import formulations
+    from plateqp.contact import formulations
     from plateqp.assembly import build_model
     from plateqp.backends import get_backend
     from plateqp.contact import solve_contact

@@ -21,7 +21,7 @@ code("""import numpy as np
 import cvxpy as cp
 import plateqp as pq
 from plateqp.assembly import build_model
-from plateqp.formulations import Scaled, formulate
+from plateqp.contact import Scaled, formulate
 
 # a free plate on a 3 x 3 grid of rigid supports; one corner support settled, a point load
 supports = [pq.Support(x, y, gap=(0.002 if (x, y) == (1.0, 1.0) else 0.0))
@@ -100,7 +100,7 @@ code("""import numpy as np
 import plateqp as pq
 from plateqp.backends import lemke
 from plateqp.assembly import build_model
-from plateqp.formulations import Scaled, formulate
+from plateqp.contact import Scaled, formulate
 
 supports = [pq.Support(x, y, gap=(-0.05 if (x, y) in ((0.5, 0.0), (1.0, 0.0)) else 0.0))
             for x in (0.5, 0.75, 1.0) for y in (0.0, 0.5, 1.0)]

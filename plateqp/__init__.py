@@ -9,14 +9,14 @@ Conventions: the plate occupies [0, a] × [0, b]; w, loads and support compressi
 positive downward; a gap g0 > 0 is settlement, g0 < 0 heave; reactions R ≥ 0 push the plate up.
 """
 
+from .accuracy import Accuracy, Status
 from .backends import available_backends, get_backend, registry
-from .backends.base import Status
-from .driver import solve
 from .errors import (
     MechanismError,
     NoEquilibriumError,
     PlateQPError,
     PlateQPWarning,
+    ExportError,
     ProblemError,
     SceneError,
     SolverError,
@@ -35,20 +35,13 @@ from .scene import (
     Support,
     UniformLoad,
 )
+from .solving import solve, solve_bilateral
 
 __version__ = "0.1.0"
 
 
-def solve_bilateral(scene: Scene) -> Result:
-    """The paper's comparison: the same scene with every one-sided support made two-sided."""
-    from .assembly import build_model
-    from .contact import solve_bilateral as _sb
-
-    return _sb(build_model(scene))
-
-
 __all__ = [
-    "Edge", "Foundation", "KKTReport", "MechanismError", "MeshSpec", "NoEquilibriumError", "Opening",
+    "Accuracy", "Edge", "ExportError", "Foundation", "KKTReport", "MechanismError", "MeshSpec", "NoEquilibriumError", "Opening",
     "PatchLoad", "Pin", "Plate", "PlateQPError", "PlateQPWarning", "PointLoad", "ProblemError", "Result",
     "Scene", "SceneError", "SolverError", "Status", "Support", "UniformLoad", "available_backends",
     "get_backend", "registry", "solve", "solve_bilateral",

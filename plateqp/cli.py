@@ -17,9 +17,9 @@ import numpy as np
 
 from . import scenes
 from .backends import registry
-from .backends.base import Status, accuracy_tol
+from .accuracy import Status, accuracy_tol
 from .contact import formulations_for
-from .driver import solve
+from .solving import solve
 from .errors import NoEquilibriumError, PlateQPError, SceneError, SolverError
 from .scene import Scene
 
@@ -50,32 +50,6 @@ def _target(text: str) -> float:
     if not 1e-8 <= v < 1.0:
         raise argparse.ArgumentTypeError(f"--target wants a relative error between 1e-8 and 1 (got {text!r})")
     return v
-
-
-def result_dict(result, probes=()) -> dict:
-    """The JSON shape of ``plateqp solve --json`` (DESIGN.md)."""
-    w, x, y = result.w_max()
-    d = {
-        "scene": result.scene.name,
-        "backend": result.backend,
-        "formulation": result.formulation,
-        "accuracy": result.accuracy,
-        "status": result.status.value,
-        "w_max": w,
-        "w_max_x": x,
-        "w_max_y": y,
-        "probes": [{"x": px, "y": py, "w": float(result.deflection(px, py))} for px, py in probes],
-        "reactions": result.reactions.tolist(),
-        "active": result.active.tolist(),
-        "gaps": result.gaps.tolist(),
-        "residual": result.residual,
-        "kkt": result.kkt.as_dict() if result.kkt is not None else None,
-        "iterations": result.iterations,
-        "times": {k: result.times.get(k) for k in ("build", "solve", "total")},
-    }
-    if result.extras.get("accuracy") == "auto":
-        d["discretisation_error"] = result.extras.get("discretisation_error")
-    return d
 
 
 def _summary(result, probes=()) -> str:
@@ -127,7 +101,7 @@ def cmd_solve(args) -> int:
             result = solve(scene, backend=args.backend, formulation=args.formulation, accuracy=args.accuracy,
                            options=opts)
     if args.json:
-        d = result_dict(result, args.probe)
+        d = result.to_dict(args.probe)
         if args.target is not None:
             d["target"] = {"target": tr.target, "reached": tr.reached, "tolerance": tr.tolerance,
                            "mesh": [result.scene.mesh.nx, result.scene.mesh.ny],
@@ -140,7 +114,7 @@ def cmd_solve(args) -> int:
     if args.out:
         out = Path(args.out)
         out.mkdir(parents=True, exist_ok=True)
-        (out / f"{scene.name}.json").write_text(json.dumps(result_dict(result, args.probe), indent=1))
+        (out / f"{scene.name}.json").write_text(json.dumps(result.to_dict(args.probe), indent=1))
         np.save(out / f"{scene.name}-w.npy", result.w_nodes())
     return 0 if result.status in (Status.OPTIMAL,) and reached else 5
 
@@ -230,7 +204,8 @@ def _scene_or_builtin(text: str) -> Scene:
 
 def cmd_export(args) -> int:
     """``plateqp export``: the contact problem as a QPS file or a qpbenchmark test set."""
-    from .export import ExportError, contact_qp, write_qpbenchmark, write_qps
+    from .errors import ExportError
+    from .export import contact_qp, write_qpbenchmark, write_qps
 
     out = Path(args.out)
     if args.format == "qpbenchmark" and (not args.testset.isidentifier() or args.testset.startswith("_")):

@@ -554,7 +554,6 @@ def run(names: list[str] | None = None, out: Path | None = None) -> int:
     met its accuracy, else 5 (the exit code of ``plateqp solve`` for a missed accuracy).
     Raises :class:`~plateqp.errors.SceneError` for an unknown scene name, before any work.
     """
-    from .cli import result_dict
 
     names = list(names) if names else scenes.names()
     for n in names:
@@ -580,9 +579,9 @@ def run(names: list[str] | None = None, out: Path | None = None) -> int:
     for r in runs:
         for stem, png in r.figures.items():
             (out / f"{stem}.png").write_bytes(png)
-        rep = {"one_sided": result_dict(r.one)}
+        rep = {"one_sided": r.one.to_dict()}
         if r.two is not None:
-            rep["two_sided"] = result_dict(r.two)
+            rep["two_sided"] = r.two.to_dict()
             rep["comparison"] = _json_safe(asdict(r.comparison))
         (out / f"{r.name}.json").write_text(json.dumps(rep, indent=1))
     (out / "report.html").write_text(report_html(runs, table), encoding="utf-8")

@@ -38,3 +38,7 @@ class NoEquilibriumError(PlateQPError):
 
 class PlateQPWarning(UserWarning):
     """Warnings raised by plateqp (e.g. an inaccurate solve)."""
+
+
+class ExportError(PlateQPError, ValueError):
+    """An export was asked for something it cannot do (bad name, existing output, bad file)."""

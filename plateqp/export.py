@@ -23,7 +23,7 @@ Two formats:
   ``qpbenchmark <dir>/<name>.py run``. It needs only numpy, scipy and qpbenchmark, not plateqp.
 
 The problem exported is the one plateqp's backends see (:func:`contact_qp`): the
-nondimensional data of :class:`plateqp.formulations.Scaled` (deflections by W, forces by F0,
+nondimensional data of :class:`plateqp.contact.scaling.Scaled` (deflections by W, forces by F0,
 lengths by L), formulated as ``primal``, ``condensed`` or ``dual`` and taken in its QP form
 (the condensed and dual LCPs as the bound-constrained QPs ½ zᵀMz + qᵀz, z ≥ 0). The scales and
 the variables' names travel with the file (QPS comment lines, the ``meta`` entry of the
@@ -41,8 +41,9 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from .backends.base import QP, RawSolution, Status
-from .errors import PlateQPError, ProblemError
+from .accuracy import Status
+from .backends.base import QP, RawSolution
+from .errors import ExportError, PlateQPError, ProblemError
 
 FORMATS = ("qps", "qpbenchmark")
 
@@ -56,10 +57,6 @@ QPBENCHMARK_TOLERANCES = {
 }
 
 _NAME_OK = re.compile(r"[^A-Za-z0-9_.\-]")
-
-
-class ExportError(PlateQPError, ValueError):
-    """An export was asked for something it cannot do (bad name, existing output, bad file)."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -118,8 +115,7 @@ class ExportedQP:
         form only (they are the scaled reactions). The status is OPTIMAL if the KKT residuals
         meet ``accuracy``, else INACCURATE.
         """
-        from .contact import to_result
-        from .kkt import kkt_report
+        from .contact import finish
 
         if self.form is None:
             raise ExportError("this problem was read from a file: build it with contact_qp() to map solutions back")
@@ -129,12 +125,7 @@ class ExportedQP:
         if self.formulation == "primal" and z is None:
             raise ExportError("the primal form needs z, the multipliers of G x <= h (the scaled reactions)")
         raw = RawSolution(Status.OPTIMAL, x=x, z=None if z is None else np.asarray(z, dtype=float))
-        c = self.form.recover(raw)
-        rep = kkt_report(self.data, c, accuracy)
-        status = Status.OPTIMAL if rep.ok else Status.INACCURATE
-        res = to_result(self.model, self.data, c, status, solver, self.formulation, accuracy)
-        res.kkt = rep
-        return res
+        return finish(self.model, self.form, raw, accuracy, solver)
 
 
 def _safe_name(name: str) -> str:
@@ -146,8 +137,8 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
     """The contact problem of a scene (or a built Model) in standard QP form.
 
     The very problem :func:`plateqp.solve` hands a QP backend for this formulation: the data
-    are scaled by :meth:`Scaled.from_model <plateqp.formulations.Scaled.from_model>` and
-    formulated by :func:`plateqp.formulations.formulate`.
+    are scaled by :meth:`Scaled.from_model <plateqp.contact.scaling.Scaled.from_model>` and
+    formulated by :func:`plateqp.contact.formulations.formulate`.
 
     Parameters
     ----------
@@ -156,8 +147,7 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
     name : problem name (default: the scene's name and the formulation)
     """
     from .assembly import Model, build_model
-    from .formulations import FORMULATIONS, Scaled, formulate
-    from .kkt import equilibrium_possible
+    from .contact import FORMULATIONS, Scaled, equilibrium_possible, formulate
 
     if formulation not in FORMULATIONS:
         raise ProblemError(f"unknown formulation {formulation!r}; choose one of {FORMULATIONS}")

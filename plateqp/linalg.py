@@ -174,3 +174,27 @@ class Factor:
         """Relative residual ‖K x − b‖ / ‖b‖."""
         nb = np.linalg.norm(b)
         return float(np.linalg.norm(self.K @ x - b) / (nb if nb > 0 else 1.0))
+
+
+def solve_saddle(K, B, rho, f, g, refine: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """(u, R) of the saddle-point system [K Bᵀ; B −diag(ρ)] (u, R) = (f, g).
+
+    The equilibrium of a plate held at the rows of B (deflection B u = g + ρ R, R of either
+    sign): works where K alone is singular, as long as the rows hold it. Sparse LU with
+    ``refine`` steps of iterative refinement. A singular system is a MechanismError.
+    """
+    K = sp.csc_matrix(K)
+    B = sp.csr_matrix(B)
+    n, m = K.shape[0], B.shape[0]
+    A = sp.bmat([[K, B.T], [B, -sp.diags(np.asarray(rho, dtype=float))]], format="csc")
+    rhs = np.concatenate([np.asarray(f, dtype=float), np.asarray(g, dtype=float)])
+    try:
+        lu = spla.splu(A)
+        x = lu.solve(rhs)
+        for _ in range(refine):
+            x = x + lu.solve(rhs - A @ x)
+    except RuntimeError as exn:
+        raise MechanismError(f"the held rows do not hold the structure: the saddle-point system is singular ({exn})") from exn
+    if not np.all(np.isfinite(x)):
+        raise MechanismError("the held rows do not hold the structure: the saddle-point solve is not finite")
+    return x[:n], x[n:]

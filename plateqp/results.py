@@ -17,13 +17,13 @@ from typing import Any
 
 import numpy as np
 
-from .backends.base import Status
+from .accuracy import Status
 from .elements import bending_matrix
 
 
 @dataclass
 class KKTReport:
-    """Residuals of the contact KKT conditions, in the plate's own terms (see :mod:`plateqp.kkt`)."""
+    """Residuals of the contact KKT conditions, in the plate's own terms (see :mod:`plateqp.contact.kkt`)."""
 
     stationarity: float = 0.0
     spring: float = 0.0
@@ -192,6 +192,34 @@ class Result:
     @property
     def ok(self) -> bool:
         return self.status == Status.OPTIMAL
+
+    def to_dict(self, probes=()) -> dict:
+        """The JSON shape of ``plateqp solve --json`` (see DESIGN.md): scene, backend, formulation,
+        accuracy, status, w_max and its x, y, ``probes`` (w at each (x, y) given), reactions,
+        active, gaps, residual, kkt, iterations, times (build, solve, total); with
+        ``accuracy="auto"`` also the discretisation error estimate."""
+        w, x, y = self.w_max()
+        d = {
+            "scene": self.scene.name,
+            "backend": self.backend,
+            "formulation": self.formulation,
+            "accuracy": self.accuracy,
+            "status": self.status.value,
+            "w_max": w,
+            "w_max_x": x,
+            "w_max_y": y,
+            "probes": [{"x": px, "y": py, "w": float(self.deflection(px, py))} for px, py in probes],
+            "reactions": np.asarray(self.reactions).tolist(),
+            "active": np.asarray(self.active).tolist(),
+            "gaps": np.asarray(self.gaps).tolist(),
+            "residual": self.residual,
+            "kkt": self.kkt.as_dict() if self.kkt is not None else None,
+            "iterations": self.iterations,
+            "times": {k: self.times.get(k) for k in ("build", "solve", "total")},
+        }
+        if self.extras.get("accuracy") == "auto":
+            d["discretisation_error"] = self.extras.get("discretisation_error")
+        return d
 
 
 def _unwrap(v):

@@ -75,7 +75,7 @@ from typing import Any
 import numpy as np
 
 from .assembly import Model, build_model
-from .driver import solve
+from .solving import solve
 from .errors import NoEquilibriumError, PlateQPError, PlateQPWarning, ProblemError, SceneError
 from .scene import EDGE_NAMES, Edge, PointLoad, Scene
 
@@ -554,7 +554,6 @@ def _solve_value(ctx: _Context, value, warm=None):
     is in the LCP's terms: on the dual formulation True means *not* in contact), else the
     contact set. Never raises for a failed solve: the row records the error and status.
     """
-    from .cli import result_dict
 
     t0 = time.perf_counter()
     try:
@@ -573,7 +572,7 @@ def _solve_value(ctx: _Context, value, warm=None):
             res = solve(scene, backend=ctx.backend, formulation=ctx.formulation, accuracy=ctx.accuracy,
                         options=opts or None, model=model)
         t_post = time.perf_counter()
-        row = {"value": value, **result_dict(res)}
+        row = {"value": value, **res.to_dict()}
         if model is not None:  # an adapted model shares the base's mesh: its operator serves
             if base.s1 is None:
                 base.s1 = _NodalS1(base.model)

@@ -99,8 +99,8 @@ def test_local_stiffness_bounds_the_exact_one_at_every_mesh(k):
 
     from plateqp.assembly import build_model
     from plateqp.families import family
-    from plateqp.formulations import Scaled
-    from plateqp.kkt import local_stiffness
+    from plateqp.contact import Scaled
+    from plateqp.contact.kkt import local_stiffness
 
     worst = {}
     for n in (16, 32, 64):

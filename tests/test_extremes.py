@@ -44,7 +44,7 @@ import plateqp as pq
 from plateqp.assembly import build_model
 from plateqp.backends import registry
 from plateqp.backends.base import RawSolution, Status
-from plateqp.formulations import Scaled
+from plateqp.contact import Scaled
 
 INSTALLED = set(pq.available_backends())
 IN_HOUSE = [("lemke", "condensed"), ("lemke", "dual"), ("bpp", "condensed"), ("bpp", "dual"),

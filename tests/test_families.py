@@ -173,8 +173,8 @@ def test_bad_arguments():
 # -- formulation="auto" / backend="auto" (plateqp.contact._choose), measured in bench_scaling ------
 
 def choice(scene, backend="auto", formulation="auto"):
-    from plateqp.contact import _choose
-    from plateqp.formulations import Scaled
+    from plateqp.contact import choose as _choose
+    from plateqp.contact import Scaled
 
     return _choose(Scaled.from_model(build_model(scene)), backend, formulation)
 

@@ -222,7 +222,7 @@ def test_no_equilibrium_is_detected_by_the_backend(route, name):
 
 def test_unbounded_certificate_on_the_qp():
     from plateqp.assembly import build_model
-    from plateqp.formulations import Primal, Scaled
+    from plateqp.contact import Primal, Scaled
 
     qp = Primal(Scaled.from_model(build_model(triangle(-100.0, 0.4, 0.3)))).qp
     raw = PD.solve(qp, "high")
@@ -251,7 +251,7 @@ def test_warm_start_from_the_final_active_set():
 
 def test_raw_solution_fields():
     from plateqp.assembly import build_model
-    from plateqp.formulations import Primal, Scaled
+    from plateqp.contact import Primal, Scaled
 
     qp = Primal(Scaled.from_model(build_model(grid_scene(12, 4)))).qp
     raw = PD.solve(qp, "high")
@@ -266,7 +266,7 @@ def test_raw_solution_fields():
 
 def test_iteration_limit_is_max_iter():
     from plateqp.assembly import build_model
-    from plateqp.formulations import Primal, Scaled
+    from plateqp.contact import Primal, Scaled
 
     qp = Primal(Scaled.from_model(build_model(grid_scene(24, 8)))).qp
     raw = PD.solve(qp, "high", options={"max_iter": 2})
@@ -326,7 +326,7 @@ def test_refuses_other_shapes():
 def test_takes_the_primal_formulation_only():
     from plateqp.assembly import build_model
     from plateqp.contact import formulations_for
-    from plateqp.formulations import Condensed, Scaled
+    from plateqp.contact import Condensed, Scaled
 
     assert formulations_for("pdas") == ["primal"]
     scene = grid_scene(8, 3)

@@ -16,7 +16,7 @@ import pytest
 
 import plateqp as pq
 from plateqp.assembly import build_model
-from plateqp.cli import main, result_dict
+from plateqp.cli import main
 from plateqp.studies import (
     adapt_model,
     convergence,
@@ -179,7 +179,7 @@ def test_sweep_rows_equal_individual_solves(path, values):
         assert row["active"] == ref.active.tolist()
         assert row["w_max"] == pytest.approx(ref.w_max()[0], rel=1e-9)
         assert row["s1_max"] == pytest.approx(np.nanmax(ref.nodal("s1")), rel=1e-9)
-        assert set(result_dict(ref)) | {"value", "s1_max", "kkt_worst", "error"} == set(row)
+        assert set(ref.to_dict()) | {"value", "s1_max", "kkt_worst", "error"} == set(row)
 
 
 class _WarmRecorder:
@@ -516,7 +516,7 @@ def test_cli_sweep_json(capsys, tmp_path):
     assert code == 0 and out.err == ""
     d = json.loads(out.out)
     assert set(d) == {"rows", "breakpoints"}
-    one = result_dict(solve(fig5()))
+    one = solve(fig5()).to_dict()
     assert [r["value"] for r in d["rows"]] == ["rigid", 1e6, 5e5]
     for r in d["rows"]:
         assert set(one) <= set(r) and r["status"] == "optimal"

@@ -19,57 +19,18 @@ bound is, so that stationarity reads ``P x + q + Gᵀ z + Aᵀ y + z_box = 0``.
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 import numpy as np
 import scipy.sparse as sp
 
+from ..accuracy import ACCURACIES, PRESET_TOL, TOL_RANGE, Accuracy, Status, accuracy_tol, nearest_preset
 from ..errors import ProblemError, SolverError
 
-ACCURACIES = ("low", "default", "high")
-
-#: The KKT tolerance of each accuracy preset (:mod:`plateqp.kkt` judges answers by it).
-PRESET_TOL: dict[str, float] = {"low": 1e-3, "default": 1e-6, "high": 1e-9}
-
-#: The range of a numeric accuracy: looser than 1e-1 is no answer, tighter than 1e-14 is
-#: below what double precision can certify on a plate problem.
-TOL_RANGE = (1e-14, 1e-1)
-
-
-def accuracy_tol(accuracy: str | float) -> float:
-    """The KKT tolerance of an accuracy: a preset's (:data:`PRESET_TOL`) or the number itself.
-
-    ``accuracy`` is "low", "default", "high", or a number in :data:`TOL_RANGE` (the tolerance
-    of the plate's relative KKT residuals, see :mod:`plateqp.kkt`). Anything else is a
-    ProblemError that names the choices.
-    """
-    if isinstance(accuracy, str):
-        if accuracy in PRESET_TOL:
-            return PRESET_TOL[accuracy]
-        try:
-            accuracy = float(accuracy)  # "1e-7" from a command line or a TOML file
-        except ValueError:
-            raise ProblemError(f"unknown accuracy {accuracy!r}; choose one of {ACCURACIES} "
-                               f"or a tolerance between {TOL_RANGE[0]:.0e} and {TOL_RANGE[1]:.0e}") from None
-    if isinstance(accuracy, bool) or not isinstance(accuracy, (int, float, np.floating)):
-        raise ProblemError(f"accuracy must be one of {ACCURACIES} or a number, not {accuracy!r}")
-    tol = float(accuracy)
-    if not (TOL_RANGE[0] <= tol <= TOL_RANGE[1]):
-        raise ProblemError(f"accuracy {tol:g} is outside {TOL_RANGE[0]:.0e} … {TOL_RANGE[1]:.0e}")
-    return tol
-
-
-def nearest_preset(accuracy: str | float) -> str:
-    """The preset whose tolerance is nearest (in decades) to ``accuracy``'s."""
-    if isinstance(accuracy, str) and accuracy in PRESET_TOL:
-        return accuracy
-    return _nearest(accuracy_tol(accuracy))
-
-
-def _nearest(tol: float) -> str:
-    return min(PRESET_TOL, key=lambda a: abs(np.log10(tol / PRESET_TOL[a])))
+# the shared words, re-exported here for the backends' convenience (they live in plateqp.accuracy)
+__all__ = ["ACCURACIES", "PRESET_TOL", "TOL_RANGE", "Accuracy", "Status", "accuracy_tol", "nearest_preset",
+           "LCP", "QP", "Backend", "RawSolution", "preset", "via_qp", "plateqp_version"]
 
 
 def _is_tolerance(key: str, value) -> bool:
@@ -77,8 +38,9 @@ def _is_tolerance(key: str, value) -> bool:
             and any(t in key.lower() for t in ("tol", "eps", "gap")))
 
 
-def preset(table: dict[str, dict], accuracy: str | float, scale: tuple[str, ...] | None = None) -> dict:
-    """A backend's native settings for an accuracy.
+def preset(table: dict[str, dict], accuracy: str | float | Accuracy, scale: tuple[str, ...] | None = None) -> dict:
+    """A backend's native settings for an accuracy (a preset name, a number or an
+    :class:`~plateqp.accuracy.Accuracy`).
 
     ``table`` maps each preset name to settings in the solver's own names. A preset name gets
     its own row. A number ``tol`` gets the row of the nearest preset with every tolerance
@@ -86,31 +48,15 @@ def preset(table: dict[str, dict], accuracy: str | float, scale: tuple[str, ...]
     ``scale``, or by default every float setting in (0, 1) whose name holds "tol", "eps" or
     "gap". Iteration limits and switches are the preset's. A bad accuracy is a ProblemError.
     """
-    if isinstance(accuracy, str) and accuracy in PRESET_TOL:
-        return dict(table[accuracy])
-    tol = accuracy_tol(accuracy)
-    name = _nearest(tol)
-    row = dict(table[name])
-    ratio = tol / PRESET_TOL[name]
+    acc = Accuracy.parse(accuracy)
+    row = dict(table[acc.preset])
+    if acc.is_preset:
+        return row
+    ratio = acc.tol / PRESET_TOL[acc.preset]
     for key, value in row.items():
         if (key in scale) if scale is not None else _is_tolerance(key, value):
             row[key] = max(float(value) * ratio, 1e-15)
     return row
-
-
-class Status(enum.Enum):
-    """Outcome of a solve. ``INACCURATE`` marks an answer that missed the asked accuracy."""
-
-    OPTIMAL = "optimal"
-    INACCURATE = "inaccurate"
-    INFEASIBLE = "infeasible"  # no equilibrium (primal infeasible / LCP ray termination)
-    UNBOUNDED = "unbounded"  # dual infeasible: the load cannot be carried
-    MAX_ITER = "max_iter"
-    ERROR = "error"
-
-    @property
-    def solved(self) -> bool:
-        return self in (Status.OPTIMAL, Status.INACCURATE)
 
 
 def _as_vec(v, n: int, name: str) -> np.ndarray | None:
@@ -237,7 +183,7 @@ class Backend(Protocol):
 
     def version(self) -> str | None: ...
 
-    def solve(self, problem: QP | LCP, accuracy: str = "default", options: dict | None = None) -> RawSolution: ...
+    def solve(self, problem: QP | LCP, accuracy: str | float | Accuracy = "default", options: dict | None = None) -> RawSolution: ...
 
 
 def via_qp(problem: QP | LCP, solve_qp) -> RawSolution:

@@ -110,7 +110,7 @@ relative natural residual (:func:`natural_residual`)
 
 which covers the signs of ``z`` and ``w`` and complementarity at once (gaps
 counted as the force ``M_ii z_i`` it would take to close them, like the
-natural residual of :mod:`plateqp.kkt`): ``OPTIMAL`` if ``r ≤ accept_tol``,
+natural residual of :mod:`plateqp.contact.kkt`): ``OPTIMAL`` if ``r ≤ accept_tol``,
 else ``INACCURATE``. A wrong ``OPTIMAL`` is therefore impossible whatever
 happened inside the pivoting.
 
@@ -212,7 +212,7 @@ def natural_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray, w: np.ndarray)
     Zero exactly at a solution; it sees a negative ``z_i`` or ``w_i`` and a
     violated complementarity alike. ``z`` is weighted by the diagonal so that
     both terms are in the units of ``w`` (for the condensed plate problem:
-    force, like the natural residual of :mod:`plateqp.kkt`) and the measure
+    force, like the natural residual of :mod:`plateqp.contact.kkt`) and the measure
     does not change when a row and its column are scaled. The scale is that of
     ``w`` and ``q`` (forces), never that of ``z``: an iterate that runs away
     (no solution) must not make its own residual look small. Shared by

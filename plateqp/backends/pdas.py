@@ -2,7 +2,7 @@ r"""Primal–dual active set (semismooth Newton) for the sparse primal contact Q
 
 The problem
 -----------
-The primal formulation's QP (:class:`plateqp.formulations.Primal`)
+The primal formulation's QP (:class:`plateqp.contact.formulations.Primal`)
 
 .. math::
 
@@ -145,7 +145,7 @@ A direct method: at every preset the final active set is solved to rounding. The
 :data:`ACCURACY` set only the tolerance under which a negative reaction or gap counts as zero
 (``feas_tol``) and the residual above which the answer is flagged ``INACCURATE``
 (``accept_tol``), checked on the answer itself: the relative natural residual
-``max |min(λ_i, c_i gap_i)| / max(‖λ‖∞, 10⁻¹² ‖f‖₁)`` (as :mod:`plateqp.kkt`) and the relative
+``max |min(λ_i, c_i gap_i)| / max(‖λ‖∞, 10⁻¹² ‖f‖₁)`` (as :mod:`plateqp.contact.kkt`) and the relative
 stationarity residual ``‖K u − f + Bᵀλ‖ / max(‖f‖, ‖Bᵀλ‖)``.
 """
 

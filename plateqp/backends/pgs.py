@@ -51,7 +51,7 @@ Stopping test: the relative natural residual
     r = \frac{\max_i |\min(M_{ii} z_i,\ w_i)|}{\max(\|w\|_\infty, \|q\|_\infty)}
 
 (the gap weighted by the diagonal so that both terms are forces, like the
-natural residual of :mod:`plateqp.kkt`; scaled by forces only, so that a
+natural residual of :mod:`plateqp.contact.kkt`; scaled by forces only, so that a
 runaway ``z`` cannot shrink it), checked after every sweep.
 
 Accuracy
@@ -59,7 +59,7 @@ Accuracy
 ``tol`` of each preset in :data:`ACCURACY`: the sweeps stop as soon as
 ``r ≤ tol`` (status ``OPTIMAL``). If ``max_iter`` sweeps or ``time_limit``
 seconds run out first, the status is ``MAX_ITER`` and the last iterate is
-returned in ``x``, ``w`` so that the KKT check of :mod:`plateqp.kkt` can show how
+returned in ``x``, ``w`` so that the KKT check of :mod:`plateqp.contact.kkt` can show how
 far it is; ``solver_status`` says which limit ended it. An LCP without a
 solution (net uplift) makes ``z`` grow without bound: it ends on a limit, never
 ``OPTIMAL``.

@@ -1,8 +1,9 @@
-"""``solve(scene, ...)``: build the model, pick the route, solve, recover, check.
+"""The public solve: ``solve(scene, ...)`` and ``solve_bilateral(scene)``.
 
 A scene without one-sided supports is solved directly (one sparse factorisation). A scene
 with them goes through a formulation (primal, condensed or dual) and a backend; see
-:mod:`plateqp.contact`.
+:mod:`plateqp.contact`. (This module is ``solving``, not ``solve``: a submodule named like
+the function ``plateqp.solve`` would shadow it.)
 """
 
 from __future__ import annotations
@@ -11,8 +12,12 @@ import time
 
 import numpy as np
 
+from .accuracy import Accuracy
 from .assembly import Model, build_model
+from .contact import solve_bilateral as _solve_bilateral
+from .contact import solve_contact
 from .errors import MechanismError
+from .estimate import auto_tolerance
 from .linalg import Factor
 from .results import Result
 from .scene import Scene
@@ -52,7 +57,7 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
         between 1e-14 and 0.1 (each backend maps it to its own settings: the nearest preset's,
         with its tolerances scaled; see :func:`plateqp.backends.base.preset`), or "auto": a
         tenth of the discretisation error of the scene's mesh, estimated from the two coarser
-        meshes (:func:`plateqp.target.auto_tolerance`; ``extras["discretisation_error"]``)
+        meshes (:func:`plateqp.estimate.auto_tolerance`; ``extras["discretisation_error"]``)
     options : passed to the backend untouched
     model : a model built before from the same scene (skips the assembly)
     check_statics : check first, by statics alone, that the one-sided supports can carry the
@@ -62,6 +67,9 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     -------
     Result, whose ``status`` says whether the KKT residuals meet the asked accuracy.
     """
+    auto = isinstance(accuracy, str) and accuracy == "auto"
+    if not auto:
+        accuracy = Accuracy.parse(accuracy)  # a bad accuracy fails before any work
     t0 = time.perf_counter()
     model = model or build_model(scene)
     t_build = time.perf_counter() - t0
@@ -69,16 +77,12 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
         t1 = time.perf_counter()
         u, res, _ = solve_two_sided(model)
         t2 = time.perf_counter()
-        return Result(scene, model, model.expand(u), residual=res, accuracy=accuracy,
+        return Result(scene, model, model.expand(u), residual=res,
+                      accuracy="auto" if auto else accuracy.asked,
                       times={"build": t_build, "solve": t2 - t1, "total": t2 - t0})
-    from .contact import solve_contact
-
-    auto = isinstance(accuracy, str) and accuracy == "auto"
     if auto:
-        from .target import auto_tolerance
-
         t_est = time.perf_counter()
-        accuracy, estimate = auto_tolerance(scene, backend=backend, formulation=formulation)
+        accuracy, estimate = auto_tolerance(scene, solve, backend=backend, formulation=formulation)
         t_est = time.perf_counter() - t_est
     result = solve_contact(model, backend=backend, formulation=formulation, accuracy=accuracy,
                            options=options, check_statics=check_statics)
@@ -89,3 +93,8 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     result.times["build"] = t_build
     result.times["total"] = time.perf_counter() - t0
     return result
+
+
+def solve_bilateral(scene: Scene, model: Model | None = None) -> Result:
+    """The paper's comparison: the same scene with every one-sided support made two-sided."""
+    return _solve_bilateral(model or build_model(scene))

@@ -46,95 +46,17 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .assembly import Model
-from .backends.base import LCP, QP, RawSolution
-from .errors import MechanismError, ProblemError
-from .linalg import Factor
+from ..backends.base import LCP, QP, RawSolution
+from ..errors import MechanismError, ProblemError
+from ..linalg import Factor
+from .scaling import Scaled
 
 FORMULATIONS = ("primal", "condensed", "dual")
 _BLOCK = 256  # right-hand sides solved together
-# A plate's deflection is about 0.004–0.012 × F L²/D (Timoshenko's coefficients for square
-# plates); scaling by F L²/D alone left deflections ~1e-3 and solvers' absolute tolerances
-# 1000× short of the KKT tolerances (measured on the heave scene).
-DEFLECTION_COEFFICIENT = 0.01
 
 
 @dataclass
-class Scaled:
-    """Nondimensional contact data: lengths by L, deflections by W, forces by F0 = W D / L².
-
-    Dofs u = S ũ with S = W (deflection), W/L (slopes), W/L² (twist); energies by F0·W.
-    K̃ = S K S / (F0 W), f̃ = S f / F0·(1/W)·W, B̃ = B S / W, g̃ = g0 / W, ρ̃ = ρ D / L², R̃ = R / F0.
-    W is the deflection the plate can actually have (:func:`deflection_scale`): the largest of
-    the deflection the total load would cause (about 0.01 F_tot L²/D), the prescribed edge and
-    pin displacements, the largest heave, and for a floating plate the largest gap. A
-    settlement larger than that is never reached and does not set W (a support 1e2 × the free
-    deflection below a held plate once made every deflection 1e-2 in scaled units).
-    """
-
-    K: sp.csr_matrix
-    f: np.ndarray
-    B: sp.csr_matrix
-    g0: np.ndarray
-    rho: np.ndarray
-    dof_scale: np.ndarray  # S (per free dof)
-    L: float
-    W: float
-    F0: float
-    modes: np.ndarray  # rigid modes of K (n, k), scaled dofs
-    is_w: np.ndarray  # (n,) bool: the dof is a deflection (not a slope or twist)
-    # the model's own K and B: the key of the condensation cache (see _cached)
-    K_src: sp.csr_matrix | None = field(default=None, repr=False, compare=False)
-    B_src: sp.csr_matrix | None = field(default=None, repr=False, compare=False)
-    # the deflection the load alone would cause (0.01 F L²/D), in units of W (≤ 1)
-    w_load: float = 1.0
-    # each contact point's distance to the nearest other held point (another contact point, or
-    # a node whose w is prescribed), in units of L: bounds the plate's local stiffness there
-    spacing: np.ndarray | None = field(default=None, repr=False, compare=False)
-
-    @classmethod
-    def from_model(cls, model: Model) -> Scaled:
-        c = model.contacts
-        if c is None:
-            raise ProblemError("the scene has no one-sided supports: nothing to formulate")
-        p = model.scene.plate
-        L = max(p.a, p.b)
-        D = p.D
-        nd = model.element.ndof_node
-        kind = model.free % nd
-        orders = np.array([dx + dy for dx, dy in model.element.node_dofs])
-        modes = model.rigid_modes()
-        W, W_load = deflection_scale(model, floating=modes.shape[1] > 0)
-        F0 = W * D / L**2
-        S = W / L ** orders[kind]
-        Sm = sp.diags(S)
-        K = (Sm @ model.K @ Sm / (F0 * W)).tocsr()
-        f = S * model.f / (F0 * W)
-        B = (c.B @ Sm / W).tocsr()
-        modes = modes / S[:, None]
-        if modes.shape[1]:
-            modes = modes / np.linalg.norm(modes, axis=0)
-        data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, kind == 0, model.K, c.B,
-                   w_load=W_load / W, spacing=contact_spacing(model) / L)
-        check_distinct_contacts(data, model)
-        return data
-
-    @property
-    def n(self) -> int:
-        return self.K.shape[0]
-
-    @property
-    def m(self) -> int:
-        return self.g0.shape[0]
-
-    @property
-    def floating(self) -> bool:
-        """True if the two-sided supports leave rigid motions free (K singular)."""
-        return self.modes.shape[1] > 0
-
-
-@dataclass
-class Contact:
+class ContactSolution:
     """The common output of the formulations' ``recover``: scaled fields, in the plate's terms."""
 
     u: np.ndarray  # scaled free dofs
@@ -160,7 +82,7 @@ class Formulation:
             return self.lcp
         raise ProblemError(f"the {self.name} formulation has no form this backend takes ({sorted(accepts)})")
 
-    def recover(self, raw: RawSolution) -> Contact:
+    def recover(self, raw: RawSolution) -> ContactSolution:
         raise NotImplementedError
 
 
@@ -176,13 +98,13 @@ class Primal(Formulation):
         super().__init__("primal", data, qp=QP(P=P, q=q, G=G, h=data.g0.copy()))
         self._el = el
 
-    def recover(self, raw: RawSolution) -> Contact:
+    def recover(self, raw: RawSolution) -> ContactSolution:
         d = self.data
         u = raw.x[: d.n]
         R = raw.z if raw.z is not None else np.full(d.m, np.nan)
         s = np.zeros(d.m)
         s[self._el] = np.sqrt(d.rho[self._el]) * raw.x[d.n:]
-        return Contact(u, R, s)
+        return ContactSolution(u, R, s)
 
 
 class Condensed(Formulation):
@@ -211,7 +133,7 @@ class Condensed(Formulation):
         self.qp = self.lcp.as_qp()
         self._T, self._fac, self._Koc, self._fo, self._m = T, fac, Koc, fo, m
 
-    def recover(self, raw: RawSolution) -> Contact:
+    def recover(self, raw: RawSolution) -> ContactSolution:
         d = self.data
         z = raw.x
         M, q = self.lcp.M, self.lcp.q
@@ -225,7 +147,7 @@ class Condensed(Formulation):
         w_c = d.g0 + d.rho * R - z
         u_o = self._fac.solve(self._fo - self._Koc @ w_c)
         u = self._T @ np.concatenate([w_c, u_o])
-        return Contact(u, R, d.rho * R)
+        return ContactSolution(u, R, d.rho * R)
 
 
 class Dual(Formulation):
@@ -243,11 +165,11 @@ class Dual(Formulation):
         self.qp = self.lcp.as_qp()
         self._fac, self._u0 = fac, u0
 
-    def recover(self, raw: RawSolution) -> Contact:
+    def recover(self, raw: RawSolution) -> ContactSolution:
         d = self.data
         R = raw.x
         u = self._u0 - self._fac.solve(d.B.T @ R)
-        return Contact(u, R, d.rho * R)
+        return ContactSolution(u, R, d.rho * R)
 
 
 # The condensed stiffness and the flexibility depend only on the model's K and B (not on the
@@ -331,94 +253,10 @@ def _flexibility(data: Scaled):
         G[:, cols] = B @ fac.solve(BT[:, cols].toarray())
     return fac, 0.5 * (G + G.T)
 
-
-def contact_spacing(model: Model) -> np.ndarray:
-    """Distance from each contact point to the nearest other point that holds the plate: another
-    contact point, or a node whose deflection is prescribed (edges, pins); the plate's size
-    where there is none."""
-    from scipy.spatial import cKDTree
-
-    c = model.contacts
-    nd = model.element.ndof_node
-    held = model.fixed[model.fixed % nd == 0] // nd
-    pts = np.vstack([c.xy, model.grid.node_xy()[held]])
-    p = model.scene.plate
-    if pts.shape[0] < 2:
-        return np.full(c.m, max(p.a, p.b))
-    d, _ = cKDTree(pts).query(c.xy, k=2)
-    return np.where(d[:, 1] > 0, d[:, 1], max(p.a, p.b))
-
-
-def deflection_scale(model: Model, floating: bool) -> tuple[float, float]:
-    """The deflection scale W of :class:`Scaled` (what the plate's deflection can reach), and the
-    part of it due to the load alone, 0.01 F L²/D.
-
-    The largest of 0.01 F L²/D (F the applied load, Σ|f| on the deflection dofs), the prescribed
-    displacements (slopes × L), the heaves (−g0 > 0) and, for a floating plate, every gap (it
-    can settle onto its supports as a body). Settlements of a held plate do not count: one it
-    cannot reach would only make every deflection small in scaled units.
-    """
-    p = model.scene.plate
-    L = max(p.a, p.b)
-    nd = model.element.ndof_node
-    orders = np.array([dx + dy for dx, dy in model.element.node_dofs])
-    w_dofs = np.arange(0, model.n_full, nd)  # the deflection dof of every node (kind 0)
-    load = np.abs(model.f_full[w_dofs]).sum()
-    prescribed = np.abs(model.values) * L ** orders[model.fixed % nd]
-    g0 = model.contacts.g0
-    gaps = np.abs(g0) if floating else np.maximum(-g0, 0.0)
-    W_load = DEFLECTION_COEFFICIENT * load * L**2 / p.D
-    W = max(W_load, prescribed.max(initial=0.0), gaps.max(initial=0.0))
-    if W == 0.0:  # no load, nothing prescribed, only settlements: nothing moves, any scale will do
-        W = np.abs(g0).max(initial=0.0) or 1e-3 * L
-    return float(W), float(W_load)
-
-
 #: Condition number (1-norm, rows equilibrated) of the contact rows on their master dofs above
 #: which the condensed form refuses: its matrix grows like cond², so 1e5 leaves ~1e-6 of the
 #: digits (two supports about 1e-4 of a cell apart); the primal and the dual still solve them.
 CONDENSE_COND_MAX = 1e5
-
-#: Two contact points whose difference mode is this much more flexible than either point (row
-#: difference of B squared, plus their springs, relative to one point's flexibility) cannot be told
-#: apart: how the load splits between them is then decided by rounding (relative error ~ ε / this,
-#: 2e-4). Two rigid supports 1e-9 of a cell apart split it 10 % differently from backend to
-#: backend, every one passing the KKT check of the time. 1e-12 is reached by two rigid supports
-#: about 2e-5 of a cell apart; closer than about half a cell the KKT check compares the
-#: reactions with an exact solve instead (:func:`plateqp.kkt.close_pairs_error`).
-DEPENDENT_ROWS = 1e-12
-
-
-def check_distinct_contacts(data: Scaled, model: Model) -> None:
-    """ProblemError if two contact points are too close (and too stiff) to carry separate reactions."""
-    c = model.contacts
-    if data.m < 2:
-        return
-    from scipy.spatial import cKDTree
-
-    h = min(model.grid.hx, model.grid.hy)
-    pairs = cKDTree(c.xy).query_pairs(1e-3 * h, output_type="ndarray")
-    if not len(pairs):
-        return
-    B = data.B.tocsr()
-    B2 = B.multiply(B).tocsr()
-    kb = np.maximum(B2 @ data.K.diagonal(), 1e-300)  # local stiffness, as in kkt.local_stiffness
-    nb = np.maximum(np.asarray(B2.sum(axis=1)).ravel(), 1e-300)
-    for i, j in pairs:
-        e = B[i] - B[j]
-        rel = float(e.multiply(e).sum()) / max(nb[i], nb[j])
-        flex = max(1.0 / kb[i] + data.rho[i], 1.0 / kb[j] + data.rho[j])
-        ratio = (rel / max(kb[i], kb[j]) + data.rho[i] + data.rho[j]) / flex
-        if ratio < DEPENDENT_ROWS:
-            names = [f"supports.{c.index[k]}" if c.source[k] == "support"
-                     else f"the foundation node at ({c.xy[k, 0]:g}, {c.xy[k, 1]:g})" for k in (i, j)]
-            d = float(np.hypot(*(c.xy[i] - c.xy[j])))
-            raise ProblemError(
-                f"{names[0]} and {names[1]} are {d:.2g} apart ({d / h:.1g} of a mesh cell) and too stiff to "
-                f"tell apart: the plate's deflections there differ by {np.sqrt(rel):.0e} of the deflection, "
-                "so how the load splits between them is decided by rounding, not by the plate; merge them "
-                "into one support, move them apart, or make them elastic")
-
 
 def _masters(B: sp.csr_matrix) -> np.ndarray:
     """One distinct dof per contact row, the one with the largest weight (greedy)."""

@@ -1,6 +1,6 @@
 r"""Residuals of the contact KKT conditions, on the plate's own terms.
 
-Evaluated on the nondimensional problem (:class:`plateqp.formulations.Scaled`: deflections by
+Evaluated on the nondimensional problem (:class:`plateqp.contact.scaling.Scaled`: deflections by
 W, forces by F0), with u the free dofs, R the reactions, s the spring compressions and
 gap = g0 + s − B u:
 
@@ -43,21 +43,22 @@ from __future__ import annotations
 
 import numpy as np
 
-from .backends.base import PRESET_TOL, accuracy_tol
-from .formulations import Contact, Scaled
-from .results import KKTReport
+from ..accuracy import PRESET_TOL, Accuracy
+from ..results import KKTReport
+from .formulations import ContactSolution
+from .scaling import Scaled
 
 #: The tolerance of each accuracy preset; a numeric accuracy is its own tolerance.
 KKT_TOL = PRESET_TOL
 
 
-def kkt_report(data: Scaled, c: Contact, accuracy: str) -> KKTReport:
+def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accuracy) -> KKTReport:
     """The KKT residuals of a scaled contact solution."""
     u, R, s = c.u, c.R, c.s
     if not (np.all(np.isfinite(u)) and np.all(np.isfinite(R))):
         inf = float("inf")
-        return KKTReport(inf, inf, inf, inf, inf, inf, accuracy_tol(accuracy), 1.0)
-    tol = accuracy_tol(accuracy)
+        return KKTReport(inf, inf, inf, inf, inf, inf, Accuracy.parse(accuracy).tol, 1.0)
+    tol = Accuracy.parse(accuracy).tol
     BtR = data.B.T @ R
     r = data.K @ u - data.f + BtR
     force = max(np.linalg.norm(data.f), np.linalg.norm(BtR), 1e-300)
@@ -156,29 +157,3 @@ def local_stiffness(data: Scaled) -> np.ndarray:
     if data.spacing is not None:
         kb = np.minimum(kb, CIRCLE / np.maximum(data.spacing, 1e-300) ** 2)
     return kb / (1.0 + data.rho * kb)
-
-
-def equilibrium_possible(data: Scaled) -> tuple[bool, str]:
-    """Can the one-sided supports carry the load at all? (statics, independent of any solver)
-
-    A plate held by its two-sided supports (K nonsingular) always has an equilibrium. A
-    floating plate, with rigid motions V left free, has one iff some reactions R ≥ 0 balance
-    the load in every rigid motion: Vᵀ Bᵀ R = Vᵀ f (force and moment balance). By Farkas'
-    lemma this is exactly the condition for the primal QP to be bounded below. Checked as a
-    small LP with SciPy's HiGHS.
-    """
-    V = data.modes
-    if V.shape[1] == 0:
-        return True, ""
-    from scipy.optimize import linprog
-
-    A = (data.B @ V).T  # (k, m)
-    b = V.T @ data.f
-    scale = max(np.abs(A).max(initial=0.0), 1e-300)
-    res = linprog(np.zeros(A.shape[1]), A_eq=A / scale, b_eq=b / scale, bounds=(0, None), method="highs")
-    if res.status == 0:
-        return True, ""
-    total = float(data.f[data.is_w].sum())  # net downward load (the two-sided supports hold none of it)
-    why = ("net uplift: the load pulls the plate off its supports" if total <= 0 else
-           "the load resultant lies outside the reach of the supports, so the plate would tip off them")
-    return False, why

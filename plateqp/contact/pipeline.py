@@ -1,0 +1,144 @@
+"""The contact solve, one direction: scale → route → formulate → solve → recover → check → Result.
+
+Also the two-sided comparison of the source paper: the same scene with every one-sided
+support made two-sided (each support holds the plate at its gap, in both directions).
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+
+import numpy as np
+
+from ..accuracy import Accuracy, Status
+from ..assembly import Model
+from ..backends import get_backend
+from ..backends.base import RawSolution
+from ..errors import MechanismError, NoEquilibriumError, PlateQPWarning, ProblemError, SolverError
+from ..linalg import solve_saddle
+from ..results import Result
+from .formulations import ContactSolution, Formulation, formulate
+from .kkt import kkt_report
+from .routing import choose, formulations_for
+from .scaling import Scaled
+from .statics import NO_EQUILIBRIUM, equilibrium_possible
+
+
+def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto",
+                  accuracy: str | float | Accuracy = "default", options: dict | None = None,
+                  check_statics: bool = True) -> Result:
+    """Solve the contact problem of a built model; see :func:`plateqp.solve`.
+
+    ``check_statics``: before solving, check by statics that the supports can carry the load
+    at all (:func:`plateqp.contact.statics.equilibrium_possible`) and raise NoEquilibriumError at once
+    if not. Whatever it is set to, a backend's claim of "no equilibrium" is checked against
+    the same statics, and a false claim is a SolverError, never a NoEquilibriumError.
+    """
+    acc = Accuracy.parse(accuracy)  # ProblemError for a bad one, before any work
+    t0 = time.perf_counter()
+    data = Scaled.from_model(model)
+    possible, why = equilibrium_possible(data)
+    if check_statics and not possible:
+        raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({why}; found by statics, before any solve)")
+    asked_backend, asked_formulation = backend, formulation
+    backend, formulation = choose(data, backend, formulation)
+    b = get_backend(backend)
+    if formulation not in formulations_for(b):
+        raise ProblemError(f"backend {backend!r} does not take the {formulation} formulation; "
+                           f"it takes: {', '.join(formulations_for(b))}")
+    try:
+        form = formulate(data, formulation)
+    except (ProblemError, MechanismError):
+        # "auto" chose to condense, but the contact points cannot be condensed onto (too close
+        # together, or they do not hold the plate): the primal form needs neither
+        if asked_formulation != "auto" or formulation == "primal" or (
+                asked_backend != "auto" and "primal" not in formulations_for(asked_backend)):
+            raise  # never swap a backend the user named for another one
+        backend, formulation = choose(data, asked_backend, "primal")
+        b = get_backend(backend)
+        form = formulate(data, formulation)
+    problem = form.problem(b.accepts)
+    t1 = time.perf_counter()
+    try:
+        raw = b.solve(problem, accuracy=acc, options=options or {})
+    except NoEquilibriumError as exn:
+        if possible:
+            raise SolverError(f"{backend} on the {formulation} problem claimed no equilibrium ({exn}), "
+                              "but statics says the supports can carry the load: the solver failed") from exn
+        raise NoEquilibriumError(f"{backend} on the {formulation} problem: {NO_EQUILIBRIUM} ({why})") from exn
+    t2 = time.perf_counter()
+    if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED) and possible:
+        raise SolverError(f"{backend} on the {formulation} problem ended {raw.status.value} "
+                          f"({raw.solver_status}), but statics says the supports can carry the load: "
+                          "the solver failed")
+    if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED):
+        raise NoEquilibriumError(f"{backend} on the {formulation} problem ended {raw.status.value} "
+                                 f"({raw.solver_status}): {NO_EQUILIBRIUM}")
+    if raw.x is None:
+        raise SolverError(f"{backend} on the {formulation} problem returned no solution: "
+                          f"{raw.status.value} ({raw.solver_status})")
+    res = finish(model, form, raw, acc, backend)
+    if res.status != Status.OPTIMAL:
+        warnings.warn(f"{backend} on the {formulation} problem: {res.status.value} "
+                      f"(worst KKT residual {res.kkt.worst:.2e}, asked {res.kkt.tol:.0e})", PlateQPWarning,
+                      stacklevel=3)
+    res.iterations = raw.iterations
+    res.extras = {"solver_status": raw.solver_status, **raw.extras}
+    res.times.update(formulate=t1 - t0, solve=t2 - t1, recover=time.perf_counter() - t2)
+    return res
+
+
+def finish(model: Model, form: Formulation, raw: RawSolution, accuracy: str | float | Accuracy,
+           backend: str) -> Result:
+    """Recover the plate's fields from a backend's answer, check them against the KKT conditions
+    and return the Result: OPTIMAL only if the residuals meet ``accuracy`` (a backend's own
+    INACCURATE, MAX_ITER or ERROR is kept). Shared by :func:`solve_contact` and by
+    :meth:`plateqp.io.export.ExportedQP.result` (another solver's answer to an exported QP)."""
+    acc = Accuracy.parse(accuracy)
+    c = form.recover(raw)
+    rep = kkt_report(form.data, c, acc)
+    status = raw.status
+    if status.solved:
+        status = Status.OPTIMAL if rep.ok else Status.INACCURATE
+    res = to_result(model, form.data, c, status, backend, form.name, acc)
+    res.kkt = rep
+    return res
+
+
+def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, backend: str, formulation: str,
+              accuracy: str | float | Accuracy) -> Result:
+    """A contact solution of the scaled problem back in the user's units, as a :class:`Result`."""
+    u = data.dof_scale * c.u
+    R = data.F0 * c.R
+    s = data.W * c.s
+    w = model.contacts.B @ u
+    gaps = model.contacts.g0 + s - w
+    stat = model.K @ u - model.f + model.contacts.B.T @ R
+    res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))
+    # in contact: the reaction carries load, or the support touches (gap ≈ 0), both judged at
+    # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports)
+    acc = Accuracy.parse(accuracy)
+    tol = max(acc.tol, 1e-9)
+    active = (R > tol * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= tol * max(data.W, 1e-300))
+    return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
+                  accuracy=acc.asked, reactions=R, gaps=gaps, compressions=s, active=active, residual=res)
+
+
+def solve_bilateral(model: Model) -> Result:
+    """Every one-sided support made two-sided: B u − ρ R = g0 exactly, R of either sign.
+
+    Solves the sparse saddle-point system [K Bᵀ; B −ρ] (u, R) = (f, g0), which works for a
+    floating plate too (as long as the supports hold it).
+    """
+    t0 = time.perf_counter()
+    data = Scaled.from_model(model)
+    try:
+        u, R = solve_saddle(data.K, data.B, data.rho, data.f, data.g0)
+    except MechanismError as exn:
+        raise ProblemError("the two-sided comparison is singular: the supports do not hold the plate") from exn
+    c = ContactSolution(u, R, data.rho * R)
+    res = to_result(model, data, c, Status.OPTIMAL, "direct", "bilateral", "high")
+    res.active = np.ones(data.m, dtype=bool)
+    res.times = {"solve": time.perf_counter() - t0}
+    return res

@@ -1,0 +1,85 @@
+"""Which backend and formulation: the "auto" rules, and what each backend can take.
+
+Nothing here solves anything; :mod:`plateqp.contact.pipeline` asks :func:`choose` before it
+formulates.
+"""
+
+from __future__ import annotations
+
+from ..backends import get_backend, registry
+from ..errors import ProblemError, SolverError
+from .formulations import FORMULATIONS
+from .scaling import Scaled
+
+# The "auto" rules, measured by benchmarks/bench_scaling.py (benchmarks/README.md, "Scaling":
+# grid_rigid scenes, n = 16…256, m = 25…3969, accuracy 1e-6, formulate + solve time).
+# * backend="auto": on a single solve PDAS on the sparse primal was the fastest exact route
+#   everywhere (BPP on the condensed LCP, condensation included: 1.5–4× slower for m ≤ 81,
+#   6–23× for m ≥ 225). The condensed route is kept while m ≤ AUTO_LCP_MAX all the same: its
+#   condensation is cached and re-used by every solve that shares the model (sweeps, gap
+#   regulation: a dense m × m solve per value instead of a factorisation), and BPP's answer
+#   did not depend on its warm start (bit-identical serial and parallel sweeps in
+#   tests/test_studies.py, where warm-started PDAS differed at 1e-13). Condensed and dual
+#   problems go to the first of AUTO_LCP_BACKENDS (BPP: 7–10× faster than Lemke from m = 225
+#   on, as exact), primal ones to the first of AUTO_QP_BACKENDS.
+# * a named QP backend (osqp, clarabel, qpsolvers:*, …): the condensed problem paid while
+#   m ≤ AUTO_CONDENSED_FRACTION × free dofs: the break-even of OSQP, Clarabel and ProxQP was
+#   m ≈ 25–50 at 3 k dofs, ≈ 100 at 12 k, ≈ 225–960 at 49 k; never beyond AUTO_CONDENSED_MAX
+#   (the dense work grows like m³, its memory like 8 m² bytes).
+# * a backend that takes only one of them (lemke, bpp, pgs: LCPs; pdas: the primal) gets it.
+AUTO_LCP_MAX = 100
+AUTO_CONDENSED_FRACTION = 0.01
+AUTO_CONDENSED_MAX = 1000
+AUTO_QP_BACKENDS = ("pdas", "clarabel", "qpsolvers:clarabel", "osqp", "cvxpy")
+AUTO_LCP_BACKENDS = ("bpp", "lemke")
+
+
+def condensed_pays(data: Scaled, backend: str = "auto") -> bool:
+    """True where formulation="auto" condenses: few contact points (see the rules above).
+
+    ``backend="auto"``: m ≤ AUTO_LCP_MAX; a named QP backend: m ≤ AUTO_CONDENSED_FRACTION ×
+    free dofs and m ≤ AUTO_CONDENSED_MAX.
+    """
+    if backend == "auto":
+        return data.m <= AUTO_LCP_MAX
+    return data.m <= min(AUTO_CONDENSED_MAX, AUTO_CONDENSED_FRACTION * data.n)
+
+
+def _first_installed(names: tuple[str, ...]) -> str | None:
+    return next((b for b in names if b in registry() and registry()[b].available()), None)
+
+
+def choose(data: Scaled, backend: str, formulation: str) -> tuple[str, str]:
+    if formulation == "auto":
+        takes = list(FORMULATIONS) if backend == "auto" else formulations_for(backend)
+        if "condensed" not in takes:
+            formulation = "primal" if "primal" in takes else takes[0]
+        elif "primal" not in takes:
+            formulation = "condensed"
+        else:
+            formulation = "condensed" if condensed_pays(data, backend) else "primal"
+    if formulation not in FORMULATIONS:
+        raise ProblemError(f"unknown formulation {formulation!r}; choose one of {FORMULATIONS}")
+    if backend == "auto":
+        if formulation in ("condensed", "dual"):
+            backend = _first_installed(AUTO_LCP_BACKENDS) or "lemke"
+        else:
+            # pdas takes at most as many contact rows as dofs (a coarse mesh under many supports)
+            backend = _first_installed(tuple(b for b in AUTO_QP_BACKENDS if b != "pdas" or data.m <= data.n))
+            if backend is None:
+                raise SolverError("the primal formulation needs a QP backend; none is installed "
+                                  "(pip install 'plateqp[solvers]')")
+    return backend, formulation
+
+
+def formulations_for(backend) -> list[str]:
+    """The formulations a backend can solve: every one for a QP backend, condensed and dual for
+    an LCP backend, restricted further by the backend's optional ``formulations`` attribute
+    (e.g. a solver built for the sparse primal). ``backend``: a Backend or its name."""
+    if isinstance(backend, (set, frozenset)):  # a bare ``accepts`` set
+        accepts, only = backend, None
+    else:
+        b = get_backend(backend) if isinstance(backend, str) else backend
+        accepts, only = b.accepts, getattr(b, "formulations", None)
+    return [f for f in FORMULATIONS if ("qp" in accepts or (f != "primal" and "lcp" in accepts))
+            and (only is None or f in only)]

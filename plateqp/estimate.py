@@ -1,0 +1,177 @@
+"""Discretisation error by mesh halving (Richardson): the estimator behind ``accuracy="auto"``.
+
+The finite-element answer of a plate converges as the mesh is refined; the solver's answer
+converges to the finite-element one as its tolerance tightens. Past the point where the
+solver's error is a small fraction of the mesh's, a tighter tolerance buys nothing
+(benchmarks/README.md, "Discretisation against solver error"). This module estimates the
+mesh's error by Richardson's argument on meshes that halve: if q(h) = q* + C hᵖ, then
+
+    |q(h) − q*| ≈ |q(h) − q(2h)| / (2ᵖ − 1),
+
+and uses it two ways:
+
+* :func:`auto_tolerance` (``solve(..., accuracy="auto")``): estimate the error of the scene's
+  own mesh from the two coarser meshes (h·2, h·4; a quarter and a sixteenth of the work)
+  and ask the solver for a fraction of it;
+* :func:`plateqp.studies.refinement.solve_to_target` (``plateqp solve --target REL``): refine from a coarse mesh until the
+  estimated error of max |w| and of the reactions is below REL, solving each mesh at a solver
+  tolerance of a tenth of REL: the coarsest mesh and the loosest setting that reach it.
+
+The quantities are the ones engineers read: the largest deflection max |w|, and the
+reactions (discrete supports: the largest change of any support's reaction, relative to the
+largest reaction; a tensionless bed: the largest bed pressure). The order p defaults to 1.5:
+below the elements' order 2 under the point-like reactions of contact (measured 1.73 for
+ACM under a point load, tests/test_plate.py), so the estimate errs on the safe side.
+"""
+
+from __future__ import annotations
+
+import copy
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from collections.abc import Callable
+
+from .errors import MechanismError, PlateQPWarning, ProblemError, SceneError, SolverError
+from .results import Result
+from .scene import Scene
+
+#: What a coarse mesh may fail with (too few dofs for the supports, a pin off its nodes): skipped.
+COARSE_FAILURES = (SceneError, ProblemError, SolverError, MechanismError)
+
+#: Assumed convergence order of the quantities (see the module docstring).
+ORDER = 1.5
+#: accuracy="auto" asks the solver for this fraction of the estimated mesh error.
+FRACTION = 0.1
+#: The loosest tolerance accuracy="auto" will ask for (a KKT residual of 1e-3 is "low").
+LOOSEST = 1e-3
+
+
+@dataclass
+class Quantities:
+    """What the error is measured on, for one solved mesh."""
+
+    mesh: tuple[int, int]
+    w_max: float  # max |w| over the plate
+    reactions: np.ndarray  # discrete supports' reactions, scene order
+    p_max: float | None  # the bed's largest pressure (None without a bed)
+    w_nodes: np.ndarray | None = None  # w at the nodes, (ny+1, nx+1)
+
+    @classmethod
+    def of(cls, res: Result) -> Quantities:
+        sc = res.scene
+        R, p = np.zeros(0), None
+        if np.asarray(res.reactions).size:
+            src = res.model.contacts.source
+            R = np.asarray(res.reactions, dtype=float)[src == "support"]
+            if sc.foundation is not None:  # pressure = k × compression of the bed
+                p = float(sc.foundation.k * np.asarray(res.compressions)[src == "bed"].max(initial=0.0))
+        w = res.w_nodes()
+        return cls((sc.mesh.nx, sc.mesh.ny), float(np.nanmax(np.abs(w))), R, p, w)
+
+
+def changes(coarse: Quantities, fine: Quantities) -> dict[str, float]:
+    """Relative changes from ``coarse`` to ``fine`` (twice as many cells a side).
+
+    ``w``: of the deflection at the coarse mesh's nodes (which are nodes of the fine one),
+    relative to max |w| — the field, not only its maximum, so that a maximum sitting on a
+    support held at its gap cannot hide the change; ``reactions``: the largest change of a
+    support's reaction relative to the largest reaction; ``bed``: of the largest bed pressure.
+    """
+    out = {"w": _rel(fine.w_max, coarse.w_max), "reactions": 0.0, "bed": 0.0}
+    cw, fw = coarse.w_nodes, fine.w_nodes
+    if cw is not None and fw is not None and fw.shape == (2 * cw.shape[0] - 1, 2 * cw.shape[1] - 1):
+        d = np.abs(fw[::2, ::2] - cw)
+        out["w"] = max(out["w"], float(np.nanmax(d)) / max(fine.w_max, coarse.w_max, 1e-300))
+    if fine.reactions.size and coarse.reactions.size == fine.reactions.size:
+        scale = max(np.abs(fine.reactions).max(), np.abs(coarse.reactions).max(), 1e-300)
+        out["reactions"] = float(np.abs(fine.reactions - coarse.reactions).max() / scale)
+    if fine.p_max is not None and coarse.p_max is not None:
+        out["bed"] = _rel(fine.p_max, coarse.p_max)
+    return out
+
+
+@dataclass
+class ErrorEstimate:
+    """Estimated relative discretisation errors of a mesh, from two solved meshes.
+
+    ``w``: of max |w|; ``reactions``: of the discrete supports' reactions (max over supports,
+    relative to the largest); ``bed``: of the bed's largest pressure; ``worst``: the largest.
+    """
+
+    mesh: tuple[int, int]
+    from_meshes: tuple[tuple[int, int], tuple[int, int]]
+    order: float
+    w: float
+    reactions: float = 0.0
+    bed: float = 0.0
+
+    @property
+    def worst(self) -> float:
+        return max(self.w, self.reactions, self.bed)
+
+    def as_dict(self) -> dict:
+        return {"mesh": list(self.mesh), "from_meshes": [list(m) for m in self.from_meshes], "order": self.order,
+                "w": self.w, "reactions": self.reactions, "bed": self.bed, "worst": self.worst}
+
+
+def _rel(a: float, b: float) -> float:
+    return abs(a - b) / max(abs(a), abs(b), 1e-300)
+
+
+def richardson(coarse: Quantities, fine: Quantities, order: float = ORDER, steps: int = 0) -> ErrorEstimate:
+    """The error of the mesh ``steps`` halvings finer than ``fine`` (0: of ``fine`` itself),
+    from the change between ``coarse`` (twice the cell size) and ``fine``."""
+    f = 1.0 / ((2.0 ** order - 1.0) * 2.0 ** (order * steps))
+    d = changes(coarse, fine)
+    nx, ny = fine.mesh
+    mesh = (nx * 2 ** steps, ny * 2 ** steps)
+    return ErrorEstimate(mesh, (coarse.mesh, fine.mesh), order, f * d["w"], f * d["reactions"], f * d["bed"])
+
+
+def with_mesh(scene: Scene, nx: int, ny: int) -> Scene:
+    sc = copy.deepcopy(scene)
+    sc.mesh.nx, sc.mesh.ny = int(nx), int(ny)
+    sc.validate()
+    return sc
+
+
+def quiet_solve(solve: Callable[..., Result], scene: Scene, backend: str, formulation: str, tol: float) -> Result:
+    """``solve(scene, backend=, formulation=, accuracy=tol)`` without PlateQPWarnings (the status says it)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlateQPWarning)
+        return solve(scene, backend=backend, formulation=formulation, accuracy=tol)
+
+
+def auto_tolerance(scene: Scene, solve: Callable[..., Result], backend: str = "auto", formulation: str = "auto",
+                   fraction: float = FRACTION, order: float = ORDER) -> tuple[float, ErrorEstimate | None]:
+    """The solver tolerance for ``accuracy="auto"``: ``fraction`` × the estimated relative
+    discretisation error of the scene's mesh, within [1e-12, :data:`LOOSEST`].
+
+    ``solve`` is :func:`plateqp.solve` (passed in, so that this module stays below it). The
+    estimate solves the scene on the meshes with twice and four times the cell size (at a
+    tight tolerance, with the same backend and formulation). A mesh too coarse to halve
+    twice (fewer than 4 cells a side), or coarse meshes that cannot be built or solved, give
+    (:data:`LOOSEST`, None): on such a mesh the discretisation error dwarfs 1e-3 anyway.
+    """
+    nx, ny = scene.mesh.nx, scene.mesh.ny
+    if min(nx, ny) < 4:
+        return LOOSEST, None
+    qs = []
+    try:
+        for k in (4, 2):
+            coarse = with_mesh(scene, max(1, round(nx / k)), max(1, round(ny / k)))
+            res = quiet_solve(solve, coarse, backend, formulation, 1e-9)
+            qs.append(Quantities.of(res))
+    except COARSE_FAILURES:
+        return LOOSEST, None
+    est = richardson(qs[0], qs[1], order, steps=1)
+    est.mesh = (nx, ny)
+    tol = float(np.clip(fraction * est.worst, 1e-12, LOOSEST))
+    return tol, est
+
+
+__all__ = ["COARSE_FAILURES", "ErrorEstimate", "Quantities", "auto_tolerance", "changes", "quiet_solve", "richardson",
+           "with_mesh"]
