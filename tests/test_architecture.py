@@ -1,0 +1,170 @@
+"""The layering of plateqp, checked on its source with ``ast`` (no import is executed).
+
+DESIGN.md: the data flow goes one way (scene → model → contact problem → backend → result →
+studies, plots, report, cli). These tests hold the package to it:
+
+- no import circle between plateqp's modules (imports inside functions count too: a lazy
+  import is still a dependency);
+- nothing below the command line imports ``plateqp.cli``;
+- the backends know QPs and LCPs, never plates: ``plateqp.backends`` imports only the shared
+  words (accuracy, errors), the linear algebra, and itself;
+- CHOLMOD's bindings (cvxopt, scikit-sparse) are imported in ``plateqp.linalg`` only;
+- no source file over :data:`MAX_LINES` lines (a file that needs a table of contents wants to
+  be two files).
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1] / "plateqp"
+MAX_LINES = 600
+
+#: What plateqp.backends may import from plateqp (besides itself).
+BACKEND_MAY_IMPORT = ("plateqp.accuracy", "plateqp.errors", "plateqp.linalg")
+#: Third-party packages that bind CHOLMOD: only plateqp.linalg may import them.
+CHOLMOD_BINDINGS = ("cvxopt", "sksparse")
+
+
+def module_name(path: Path) -> str:
+    rel = path.relative_to(ROOT.parent).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def sources() -> dict[str, Path]:
+    return {module_name(p): p for p in sorted(ROOT.rglob("*.py"))}
+
+
+def imports_of(name: str, path: Path) -> set[str]:
+    """Every module ``name`` imports (absolute names), at any depth of the file."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    out: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - (node.level - 1)]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            out.add(mod)
+            for a in node.names:  # `from . import x` may import the submodule x
+                out.add(f"{mod}.{a.name}")
+    return out
+
+
+def internal_graph() -> dict[str, set[str]]:
+    """plateqp module → the plateqp modules it imports (names resolved to existing modules)."""
+    mods = sources()
+    graph = {}
+    for name, path in mods.items():
+        deps = set()
+        for imp in imports_of(name, path):
+            if imp in mods:
+                deps.add(imp)
+        deps.discard(name)
+        graph[name] = deps
+    return graph
+
+
+def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """One import cycle, or None (depth-first search, three colours)."""
+    WHITE, GREY, BLACK = 0, 1, 2
+    colour = dict.fromkeys(graph, WHITE)
+    stack: list[str] = []
+
+    def visit(v: str) -> list[str] | None:
+        colour[v] = GREY
+        stack.append(v)
+        for w in sorted(graph[v]):
+            # a package's __init__ importing its own submodules is not a cycle through them
+            if v.startswith(w + ".") and w in graph:
+                continue
+            if colour[w] == GREY:
+                return stack[stack.index(w):] + [w]
+            if colour[w] == WHITE:
+                found = visit(w)
+                if found:
+                    return found
+        stack.pop()
+        colour[v] = BLACK
+        return None
+
+    for v in sorted(graph):
+        if colour[v] == WHITE:
+            found = visit(v)
+            if found:
+                return found
+    return None
+
+
+def parent_init_edges(graph: dict[str, set[str]]) -> dict[str, set[str]]:
+    """The graph without the edges from a submodule to the __init__ of its own package that
+    merely re-exports: importing ``plateqp.contact.kkt`` runs ``plateqp.contact``'s __init__
+    first anyway, so a cycle through it is the package's own re-exports, judged by its parts."""
+    out = {}
+    for v, deps in graph.items():
+        out[v] = {w for w in deps if not (v.startswith(w + ".") or w == "plateqp")}
+    return out
+
+
+# -- the checks ---------------------------------------------------------------------------------
+
+
+def test_the_checker_sees_a_cycle():
+    """The cycle finder finds a planted cycle (a check that cannot fail is no check)."""
+    g = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": set()}
+    assert find_cycle(g) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_relative_imports_are_resolved():
+    mods = sources()
+    imps = imports_of("plateqp.contact.pipeline", mods["plateqp.contact.pipeline"])
+    assert "plateqp.assembly" in imps and "plateqp.contact.kkt" in imps
+
+
+def test_no_import_cycle():
+    cycle = find_cycle(parent_init_edges(internal_graph()))
+    assert cycle is None, "import cycle: " + " -> ".join(cycle)
+
+
+def test_nothing_below_the_cli_imports_it():
+    graph = internal_graph()
+    bad = sorted(m for m, deps in graph.items() if "plateqp.cli" in deps and m != "plateqp.cli")
+    assert not bad, f"imports plateqp.cli from below it: {bad}"
+
+
+def test_backends_know_no_plates():
+    mods = sources()
+    bad = []
+    for name, path in mods.items():
+        if not name.startswith("plateqp.backends"):
+            continue
+        for imp in imports_of(name, path):
+            if imp.startswith("plateqp") and not imp.startswith("plateqp.backends") and not any(
+                    imp == ok or imp.startswith(ok + ".") for ok in BACKEND_MAY_IMPORT) and imp != "plateqp":
+                bad.append(f"{name} imports {imp}")
+    assert not bad, bad
+
+
+def test_cholmod_bindings_only_in_linalg():
+    mods = sources()
+    bad = [f"{name} imports {imp}" for name, path in mods.items() if not name.startswith("plateqp.linalg")
+           for imp in imports_of(name, path) if imp.split(".")[0] in CHOLMOD_BINDINGS]
+    assert not bad, bad
+
+
+@pytest.mark.parametrize("path", sorted(ROOT.rglob("*.py")), ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_source_file_is_too_long(path):
+    n = len(path.read_text(encoding="utf-8").splitlines())
+    assert n <= MAX_LINES, f"{path.relative_to(ROOT.parent)} has {n} lines (> {MAX_LINES}): split it"
