@@ -338,12 +338,8 @@ def _contacts(scene: Scene, model: Model) -> Contacts | None:
     if scene.foundation is not None:
         fnd = scene.foundation
         x0, x1, y0, y1 = fnd.region if fnd.region is not None else (0.0, grid.a, 0.0, grid.b)
-        cc = model.cells
-        cx = (cc % grid.nx + 0.5) * grid.hx
-        cy = (cc // grid.nx + 0.5) * grid.hy
-        inside = (cx >= x0) & (cx <= x1) & (cy >= y0) & (cy <= y1)
         area = np.zeros(grid.n_nodes)
-        np.add.at(area, grid.cell_nodes()[cc[inside]].ravel(), 0.25 * grid.hx * grid.hy)
+        np.add.at(area, grid.cell_nodes()[grid.cells_centred_in(x0, x1, y0, y1)].ravel(), 0.25 * grid.hx * grid.hy)
         nodes = np.flatnonzero(area > 0)
         wdof = nodes * nd
         nodes = nodes[free_pos[wdof] >= 0]  # a node whose w is prescribed gives its bed force to that support

@@ -105,6 +105,13 @@ class Grid:
         """True if (x, y) lies on a kept cell (boundaries included)."""
         return bool(self.locate(x, y)[0][0] >= 0)
 
+    def cells_centred_in(self, x0: float, x1: float, y0: float, y1: float) -> np.ndarray:
+        """Indices of the kept cells whose centre lies in [x0, x1] × [y0, y1] (bounds included)."""
+        cc = np.flatnonzero(self.cell_mask)
+        cx = (cc % self.nx + 0.5) * self.hx
+        cy = (cc // self.nx + 0.5) * self.hy
+        return cc[(cx >= x0) & (cx <= x1) & (cy >= y0) & (cy <= y1)]
+
     def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
         """True if the box [x0, x1] × [y0, y1] overlaps a kept cell with positive area."""
         i = np.arange(self.nx)

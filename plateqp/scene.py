@@ -19,6 +19,21 @@ from typing import Any, Callable
 
 from .errors import SceneError
 
+#: Magnitudes plateqp computes with safely: a non-zero physical number (length, modulus, load,
+#: gap, stiffness, prescribed displacement) must lie in this range, and so must the bending
+#: stiffness D and the load's deflection scale 0.01 F L²/D derived from them (checked in
+#: logarithms, so that an overflow is reported, not computed). The solve is nondimensional, so
+#: any consistent units inside this range give the same answer scaled (tests/test_scene.py);
+#: outside it products of the data overflow or underflow double precision: change units.
+SAFE_RANGE = (1e-100, 1e100)
+#: The derived quantities' range (wider: products of two or three safe numbers).
+SAFE_DERIVED = (1e-200, 1e200)
+#: No scene needs more cells than this; the memory a mesh needs is checked before assembly
+#: (:func:`plateqp.assembly.check_memory`), this only keeps validation itself small.
+MAX_CELLS = 10_000_000
+#: A scene file larger than this is not a scene (it is read no further).
+MAX_FILE_BYTES = 16 * 2**20
+
 EDGE_KINDS = ("free", "simple", "clamped")
 EDGE_NAMES = ("left", "right", "bottom", "top")  # x = 0, x = a, y = 0, y = b
 ELEMENT_KINDS = ("acm", "bfs")
@@ -203,16 +218,24 @@ class Scene:
         prefix = f"{self.source}: " if self.source else ""
         raise SceneError(f"{prefix}{where}: {what}")
 
-    def _num(self, where: str, v, *, positive=False, nonneg=False) -> float:
+    def _num(self, where: str, v, *, positive=False, nonneg=False, physical=False) -> float:
+        """A finite number (``physical``: 0 or of a magnitude in :data:`SAFE_RANGE`)."""
         if isinstance(v, bool) or not isinstance(v, (int, float)):
-            self._fail(where, f"must be a number (got {v!r})")
-        if not math.isfinite(v):
-            self._fail(where, f"must be finite (got {v!r})")
-        if positive and v <= 0:
+            self._fail(where, f"must be a number (got {_short(v)})")
+        try:
+            fv = float(v)
+        except OverflowError:  # an integer beyond double precision
+            fv = math.inf
+        if not math.isfinite(fv):
+            self._fail(where, f"must be finite (got {_short(v)})")
+        if positive and fv <= 0:
             self._fail(where, f"must be > 0 (got {v!r})")
-        if nonneg and v < 0:
+        if nonneg and fv < 0:
             self._fail(where, f"must be >= 0 (got {v!r})")
-        return float(v)
+        if physical and fv != 0.0 and not (SAFE_RANGE[0] <= abs(fv) <= SAFE_RANGE[1]):
+            self._fail(where, f"{v!r} is outside the magnitudes plateqp computes with safely "
+                       f"({SAFE_RANGE[0]:.0e} … {SAFE_RANGE[1]:.0e}); change units")
+        return fv
 
     def _inside(self, where: str, x, y, grid=None, covered: bool | None = None) -> None:
         """Fail unless (x, y) lies on the plate. ``grid``: the scene's grid, built once per
@@ -253,15 +276,24 @@ class Scene:
         """Check every field; raises SceneError naming the first bad one."""
         p = self.plate
         for k in ("a", "b", "h", "E"):
-            self._num(f"plate.{k}", getattr(p, k), positive=True)
+            self._num(f"plate.{k}", getattr(p, k), positive=True, physical=True)
         self._num("plate.nu", p.nu)
         if not (-1.0 < p.nu < 0.5):
             self._fail("plate.nu", f"must lie in (-1, 0.5) (got {p.nu})")
+        logD = math.log10(p.E) + 3 * math.log10(p.h) - math.log10(12.0 * (1.0 - p.nu**2))
+        if not (math.log10(SAFE_DERIVED[0]) <= logD <= math.log10(SAFE_DERIVED[1])):
+            self._fail("plate", f"the bending stiffness D = E h³/12(1 − ν²) = 1e{logD:.0f} is outside "
+                       f"{SAFE_DERIVED[0]:.0e} … {SAFE_DERIVED[1]:.0e}; change units")
         m = self.mesh
         for k in ("nx", "ny"):
             v = getattr(m, k)
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                self._fail(f"mesh.{k}", f"must be an integer >= 1 (got {v!r})")
+                self._fail(f"mesh.{k}", f"must be an integer >= 1 (got {_short(v)})")
+            if v > MAX_CELLS:
+                self._fail(f"mesh.{k}", f"{_short(v)} cells is more than any plate needs (at most {MAX_CELLS:.0e})")
+        if m.nx * m.ny > MAX_CELLS:
+            self._fail("mesh", f"{m.nx} x {m.ny} = {m.nx * m.ny:.2g} cells is more than any plate needs "
+                       f"(at most {MAX_CELLS:.0e}); the memory a mesh needs is checked before assembly")
         if m.element not in ELEMENT_KINDS:
             self._fail("mesh.element", f"unknown element {m.element!r}; choose one of {ELEMENT_KINDS}")
         for name, e in self.edges.items():
@@ -269,8 +301,8 @@ class Scene:
                 self._fail(f"edges.{name}", f"unknown edge; edges are {EDGE_NAMES}")
             if e.kind not in EDGE_KINDS:
                 self._fail(f"edges.{name}", f"unknown kind {e.kind!r}; choose one of {EDGE_KINDS}")
-            self._num(f"edges.{name}.w", e.w)
-            self._num(f"edges.{name}.slope", e.slope)
+            self._num(f"edges.{name}.w", e.w, physical=True)
+            self._num(f"edges.{name}.slope", e.slope, physical=True)
             if e.kind == "free" and (e.w != 0.0 or e.slope != 0.0):
                 self._fail(f"edges.{name}", "a free edge cannot carry a prescribed w or slope; make it simple or clamped")
             if e.kind == "simple" and e.slope != 0.0:
@@ -288,7 +320,7 @@ class Scene:
         for i, pin in enumerate(self.pins):
             self._num(f"pins.{i}.x", pin.x)
             self._num(f"pins.{i}.y", pin.y)
-            self._num(f"pins.{i}.w", pin.w)
+            self._num(f"pins.{i}.w", pin.w, physical=True)
             self._inside(f"pins.{i}", pin.x, pin.y, grid)
             if grid.node_at(pin.x, pin.y) is None:
                 hx, hy = grid.hx, grid.hy
@@ -299,12 +331,12 @@ class Scene:
             if not isinstance(ld, (UniformLoad, PatchLoad, PointLoad)):
                 self._fail(where, f"not a load: {ld!r}")
             if isinstance(ld, PointLoad):
-                self._num(f"{where}.P", ld.P)
+                self._num(f"{where}.P", ld.P, physical=True)
                 self._num(f"{where}.x", ld.x)
                 self._num(f"{where}.y", ld.y)
                 self._inside(where, ld.x, ld.y, grid)
             else:
-                self._num(f"{where}.q", ld.q)
+                self._num(f"{where}.q", ld.q, physical=True)
             if isinstance(ld, PatchLoad):
                 for k in ("x0", "x1", "y0", "y1"):
                     self._num(f"{where}.{k}", getattr(ld, k))
@@ -321,27 +353,32 @@ class Scene:
             where = f"supports.{i}"
             self._num(f"{where}.x", s.x)
             self._num(f"{where}.y", s.y)
-            self._num(f"{where}.gap", s.gap)
+            self._num(f"{where}.gap", s.gap, physical=True)
             self._inside(where, s.x, s.y, grid, None if covered is None else covered[i])
             if isinstance(s.stiffness, str):
                 if s.stiffness != "rigid":
                     self._fail(f"{where}.stiffness", f"must be \"rigid\" or a positive number (got {s.stiffness!r})")
             else:
-                self._num(f"{where}.stiffness", s.stiffness, positive=True)
+                self._num(f"{where}.stiffness", s.stiffness, positive=True, physical=True)
             key = (round(s.x / tol), round(s.y / tol))
             if key in seen:
                 self._fail(where, f"lies on the same point as supports.{seen[key]}; merge them into one support")
             seen[key] = i
         if self.foundation is not None:
             f = self.foundation
-            self._num("foundation.k", f.k, positive=True)
+            self._num("foundation.k", f.k, positive=True, physical=True)
             if f.region is not None:
-                if len(f.region) != 4:
-                    self._fail("foundation.region", "must be [x0, x1, y0, y1]")
+                if not isinstance(f.region, (list, tuple)) or len(f.region) != 4:
+                    self._fail("foundation.region", f"must be [x0, x1, y0, y1] (got {_short(f.region)})")
                 for j, v in enumerate(f.region):
                     self._num(f"foundation.region.{j}", v)
-                if not (f.region[0] < f.region[1] and f.region[2] < f.region[3]):
+                x0, x1, y0, y1 = f.region
+                if not (x0 < x1 and y0 < y1):
                     self._fail("foundation.region", "needs x0 < x1 and y0 < y1")
+                if not grid.cells_centred_in(x0, x1, y0, y1).any():
+                    self._fail("foundation.region", f"[{x0}, {x1}, {y0}, {y1}] holds the centre of no cell of "
+                               "the plate (it is off the plate, in an opening, or smaller than a cell): "
+                               "the bed would have no node")
             g = f.gap
             if isinstance(g, dict):
                 prof = g.get("profile")
@@ -357,9 +394,42 @@ class Scene:
                     if k not in allowed:
                         self._fail(f"foundation.gap.{k}", f"unknown key for profile {prof!r}; allowed {sorted(allowed)}")
                     if k != "profile":
-                        self._num(f"foundation.gap.{k}", v, positive=(k == "radius"))
+                        self._num(f"foundation.gap.{k}", v, positive=(k == "radius"), physical=True)
             elif not callable(g):
-                self._num("foundation.gap", g)
+                self._num("foundation.gap", g, physical=True)
+
+        self._check_scales()
+
+    def _check_scales(self) -> None:
+        """The load's deflection scale 0.01 F L²/D and each spring's flexibility relative to the
+        plate's, D/(c L²), must lie in :data:`SAFE_DERIVED` (computed in logarithms)."""
+        p = self.plate
+        lo, hi = math.log10(SAFE_DERIVED[0]), math.log10(SAFE_DERIVED[1])
+        logD = math.log10(p.E) + 3 * math.log10(p.h) - math.log10(12.0 * (1.0 - p.nu**2))
+        logL = math.log10(max(p.a, p.b))
+        for i, ld in enumerate(self.loads):
+            mag = abs(ld.P) if isinstance(ld, PointLoad) else abs(ld.q)
+            if mag == 0.0:
+                continue
+            if isinstance(ld, PatchLoad):
+                area = max(min(ld.x1, p.a) - max(ld.x0, 0.0), 1e-300) * max(min(ld.y1, p.b) - max(ld.y0, 0.0), 1e-300)
+                logF = math.log10(mag) + math.log10(area)
+            elif isinstance(ld, UniformLoad):
+                logF = math.log10(mag) + math.log10(p.a) + math.log10(p.b)
+            else:
+                logF = math.log10(mag)
+            logW = -2.0 + logF + 2 * logL - logD
+            if not lo <= logW <= hi:
+                self._fail(f"loads.{i}", f"deflects the plate by about 1e{logW:.0f} (0.01 F L²/D), outside "
+                           f"{SAFE_DERIVED[0]:.0e} … {SAFE_DERIVED[1]:.0e}; change units")
+        springs = [(f"supports.{i}.stiffness", s.stiffness) for i, s in enumerate(self.supports) if not s.rigid]
+        if self.foundation is not None:  # a node's spring is k × its area, about k h² on the finest mesh
+            springs.append(("foundation.k", self.foundation.k * (max(p.a, p.b) / max(self.mesh.nx, self.mesh.ny)) ** 2))
+        for where, c in springs:
+            logr = logD - math.log10(c) - 2 * logL
+            if not lo <= logr <= hi:
+                self._fail(where, f"is 1e{-logr:.0f} times the plate's own stiffness D/L², outside what "
+                           "double precision can weigh against it; make the support rigid, or remove it")
 
     # -- convenience ----------------------------------------------------------------------
     @property
@@ -370,14 +440,35 @@ class Scene:
     # -- TOML -----------------------------------------------------------------------------
     @classmethod
     def from_toml(cls, path: str | Path) -> Scene:
-        """Load a scene from a TOML file (unknown keys are errors)."""
+        """Load a scene from a TOML file (UTF-8, a byte-order mark allowed; unknown keys are errors).
+
+        Anything that is not a readable scene file (no file, a directory, unreadable, not UTF-8,
+        larger than :data:`MAX_FILE_BYTES`, not TOML, nested too deep) is a SceneError naming it.
+        """
+        if str(path) == "":
+            raise SceneError("the scene file name is an empty path")
         path = Path(path)
         try:
-            data = tomllib.loads(path.read_text())
+            with open(path, "rb") as fh:
+                raw = fh.read(MAX_FILE_BYTES + 1)
         except FileNotFoundError:
             raise SceneError(f"{path}: no such file") from None
+        except IsADirectoryError:
+            raise SceneError(f"{path}: is a directory, not a scene file") from None
+        except OSError as exn:
+            raise SceneError(f"{path}: cannot be read ({exn.strerror or exn})") from None
+        if len(raw) > MAX_FILE_BYTES:
+            raise SceneError(f"{path}: larger than {MAX_FILE_BYTES // 2**20} MiB: not a scene file")
+        try:
+            text = raw.decode("utf-8-sig")
+        except UnicodeDecodeError as exn:
+            raise SceneError(f"{path}: not UTF-8 text (byte {exn.start}); save the scene as UTF-8") from None
+        try:
+            data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exn:
-            raise SceneError(f"{path}: not valid TOML: {exn}") from exn
+            raise SceneError(f"{path}: not valid TOML: {exn}") from None
+        except RecursionError:
+            raise SceneError(f"{path}: not a scene: arrays or tables nested too deep") from None
         return cls.from_dict(data, source=str(path))
 
     @classmethod
@@ -404,7 +495,10 @@ class Scene:
         extra = set(data) - top
         if extra:
             fail(sorted(extra)[0], f"unknown key; allowed top-level keys: {sorted(top)}")
-        kw: dict[str, Any] = {"name": str(data.get("name", "scene"))}
+        name = data.get("name", "scene")
+        if not isinstance(name, str):
+            fail("name", f"must be a string (got {_short(name)})")
+        kw: dict[str, Any] = {"name": name}
         if "plate" in data:
             kw["plate"] = build(Plate, data["plate"], "plate")
         if "mesh" in data:
@@ -416,15 +510,15 @@ class Scene:
         for key, klass in (("openings", Opening), ("pins", Pin), ("supports", Support)):
             items = data.get(key, [])
             if not isinstance(items, list):
-                fail(key, "must be an array of tables ([[" + key + "]])")
+                fail(key, "must be an array of tables ([[" + key + "]], not [" + key + "])")
             kw[key] = [build(klass, d, f"{key}.{i}") for i, d in enumerate(items)]
         loads = []
         if not isinstance(data.get("loads", []), list):
             fail("loads", "must be an array of tables ([[loads]])")
         for i, d in enumerate(data.get("loads", [])):
             t = d.get("type") if isinstance(d, dict) else None
-            if t not in _LOADS:
-                fail(f"loads.{i}.type", f"must be one of {sorted(_LOADS)} (got {t!r})")
+            if not isinstance(t, str) or t not in _LOADS:
+                fail(f"loads.{i}.type", f"must be one of {sorted(_LOADS)} (got {_short(t)})")
             loads.append(build(_LOADS[t], d, f"loads.{i}"))
         kw["loads"] = loads
         if "foundation" in data:
@@ -472,3 +566,12 @@ def _edge_from(v, where: str, source: str | None) -> Edge:
         kind = v.get("kind", v.get("type", "free"))
         return Edge(kind=kind, w=v.get("w", 0.0), slope=v.get("slope", 0.0))
     raise SceneError(f"{prefix}{where}: must be a kind (\"free\", \"simple\", \"clamped\") or a table")
+
+
+def _short(v, n: int = 60) -> str:
+    """repr(v), cut to n characters (a hostile value must not flood the one-line message)."""
+    try:
+        r = repr(v)
+    except Exception:  # noqa: BLE001 - a repr that fails is still a bad value
+        r = f"<{type(v).__name__}>"
+    return r if len(r) <= n else r[: n - 1] + "…"

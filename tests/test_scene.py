@@ -106,6 +106,26 @@ BAD = [
                                                'radius = 0.3, depth = 0.01, width = 1.0 }\n'}, "foundation.gap.width"),
     ("foundation-profile-zero-radius", {"add": '[foundation]\nk = 1.0\ngap = { profile = "bump", x = 0.5, y = 0.5, '
                                                'radius = 0.0, depth = 0.01 }\n'}, "foundation.gap.radius"),
+    # hostile input (issue 10): each of these was a traceback, not a SceneError
+    ("load-type-array", {"sub": ('type = "uniform"', "type = []")}, "loads.0.type"),
+    ("load-type-table", {"sub": ('type = "uniform"', "type = { a = 1 }")}, "loads.0.type"),
+    ("foundation-region-number", {"add": "[foundation]\nk = 1.0\nregion = 5\n"}, "foundation.region"),
+    ("foundation-region-string", {"add": '[foundation]\nk = 1.0\nregion = "all"\n'}, "foundation.region"),
+    ("foundation-region-off-plate", {"add": "[foundation]\nk = 1.0\nregion = [5.0, 6.0, 0.0, 1.0]\n"},
+     "foundation.region"),
+    ("foundation-region-between-nodes", {"add": "[foundation]\nk = 1.0\nregion = [0.01, 0.02, 0.01, 0.02]\n"},
+     "foundation.region"),
+    ("huge-integer-mesh", {"sub": ("nx = 8", "nx = 100000000000000000000000")}, "mesh.nx"),
+    ("thick-beyond-range", {"sub": ("h = 0.02", "h = 1e120")}, "plate.h"),
+    ("thin-beyond-range", {"sub": ("h = 0.02", "h = 1e-120")}, "plate.h"),
+    ("load-beyond-range", {"sub": ("q = 1.0", "q = 1e300")}, "loads.0.q"),
+    ("load-below-range", {"sub": ("q = 1.0", "q = 1e-300")}, "loads.0.q"),
+    ("gap-beyond-range", {"add": "[[supports]]\nx = 1.0\ny = 0.5\ngap = 1e300\n"}, "supports.0.gap"),
+    ("stiffness-denormal", {"add": "[[supports]]\nx = 1.0\ny = 0.5\nstiffness = 5e-324\n"},
+     "supports.0.stiffness"),
+    ("stiffness-string", {"add": '[[supports]]\nx = 1.0\ny = 0.5\nstiffness = "soft"\n'}, "supports.0.stiffness"),
+    ("name-not-a-string", {"sub": ('name = "base"', "name = [1, 2]")}, "name"),
+    ("supports-a-table", {"add": "[supports]\nx = 1.0\n"}, "supports"),
 ]
 
 
@@ -162,6 +182,69 @@ def test_invalid_scene_in_python_names_field():
         pq.Scene(mesh=pq.MeshSpec(nx=0))
 
 
+def test_bending_stiffness_out_of_range_names_the_plate(tmp_path):
+    """Each number in range, their product not: D = E h³ / 12(1 − ν²) overflows the safe range."""
+    path = write(tmp_path, BASE.replace("E = 3.0e4", "E = 1e99").replace("h = 0.02", "h = 1e40"))
+    with pytest.raises(pq.SceneError, match=r"plate: .*bending stiffness"):
+        pq.Scene.from_toml(path)
+
+
+@pytest.mark.parametrize("value", ["1e-90", "1e90"])
+def test_extreme_but_safe_magnitudes_solve(value):
+    """Inside the safe range the nondimensional solve works at any scale: a load of 1e±90 gives
+    deflections and reactions scaled by exactly that factor (statics: R sums to the load)."""
+    q = float(value)
+
+    def scene(load):
+        return pq.Scene(plate=pq.Plate(), mesh=pq.MeshSpec(4, 4), loads=[pq.UniformLoad(load)],
+                        supports=[pq.Support(x, y) for x in (0.0, 1.0) for y in (0.0, 1.0)],
+                        pins=[pq.Pin(0.5, 0.5)])
+
+    ref = pq.solve(scene(1.0), backend="lemke")
+    res = pq.solve(scene(q), backend="lemke")
+    assert res.status == pq.Status.OPTIMAL
+    import numpy as np
+
+    np.testing.assert_allclose(res.reactions / q, ref.reactions, rtol=1e-9)
+    np.testing.assert_allclose(res.u / q, ref.u, rtol=1e-9, atol=1e-12 * np.abs(ref.u).max())
+
+
+def test_hostile_files(tmp_path):
+    """A directory, an empty path, bytes that are not UTF-8, deeply nested arrays and a file too
+    large to be a scene are SceneErrors naming the file; a UTF-8 byte-order mark is accepted."""
+    with pytest.raises(pq.SceneError, match="is a directory"):
+        pq.Scene.from_toml(tmp_path)
+    with pytest.raises(pq.SceneError, match="empty path"):
+        pq.Scene.from_toml("")
+    raw = tmp_path / "latin1.toml"
+    raw.write_bytes(BASE.replace("base", "b\xe4se").encode("latin-1"))
+    with pytest.raises(pq.SceneError, match=r"latin1\.toml: .*UTF-8"):
+        pq.Scene.from_toml(raw)
+    nested = tmp_path / "nested.toml"
+    nested.write_text("name = " + "[" * 100_000 + "]" * 100_000 + "\n")
+    with pytest.raises(pq.SceneError, match=r"nested\.toml"):
+        pq.Scene.from_toml(nested)
+    big = tmp_path / "big.toml"
+    with open(big, "w") as fh:
+        fh.write(BASE)
+        fh.write("# padding\n" * 2_000_000)
+    with pytest.raises(pq.SceneError, match=r"big\.toml: .*larger than"):
+        pq.Scene.from_toml(big)
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + BASE.encode())
+    assert pq.Scene.from_toml(bom).name == "base"
+
+
+def test_endless_file_is_refused(tmp_path):
+    """/dev/zero (a file with no end) is read only up to the size limit, then refused."""
+    import os
+
+    if not os.path.exists("/dev/zero"):
+        pytest.skip("no /dev/zero here")
+    with pytest.raises(pq.SceneError, match="larger than"):
+        pq.Scene.from_toml("/dev/zero")
+
+
 def test_missing_and_malformed_files(tmp_path):
     missing = tmp_path / "nope.toml"
     with pytest.raises(pq.SceneError, match="nope.toml"):
@@ -196,7 +279,7 @@ def foundation_variants():
     return [pq.Foundation(k=5.0), pq.Foundation(k=5.0, gap=-0.003),
             pq.Foundation(k=5.0, gap={"profile": "linear", "g0": 0.01, "gx": -0.001, "gy": 0.002}),
             pq.Foundation(k=5.0, gap={"profile": "uniform", "g0": 0.004}),
-            pq.Foundation(k=5.0, region=[1.0, 2.0, 0.5, 1.0],
+            pq.Foundation(k=5.0, region=[0.5, 1.0, 0.5, 1.0],  # on the default 1 x 1 plate
                           gap={"profile": "bump", "x": 2.0, "y": 1.0, "radius": 0.5, "depth": 0.02})]
 
 
