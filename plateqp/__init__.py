@@ -18,6 +18,7 @@ from .errors import (
     PlateQPWarning,
     ExportError,
     ProblemError,
+    ResourceError,
     SceneError,
     SolverError,
 )
@@ -42,7 +43,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Accuracy", "Edge", "ExportError", "Foundation", "KKTReport", "MechanismError", "MeshSpec", "NoEquilibriumError", "Opening",
-    "PatchLoad", "Pin", "Plate", "PlateQPError", "PlateQPWarning", "PointLoad", "ProblemError", "Result",
+    "PatchLoad", "Pin", "Plate", "PlateQPError", "PlateQPWarning", "PointLoad", "ProblemError", "ResourceError", "Result",
     "Scene", "SceneError", "SolverError", "Status", "Support", "UniformLoad", "available_backends",
     "get_backend", "registry", "solve", "solve_bilateral",
 ]

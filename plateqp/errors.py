@@ -16,6 +16,11 @@ class SceneError(PlateQPError, ValueError):
     """A scene is invalid: the message names the field (and the file, if any)."""
 
 
+class ResourceError(SceneError):
+    """A scene would need more memory (or work) than allowed: the message gives the estimate and
+    the limit, and how to raise it."""
+
+
 class MechanismError(PlateQPError):
     """The plate is a mechanism: its supports cannot prevent a rigid motion."""
 
