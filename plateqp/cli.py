@@ -2,13 +2,22 @@
 
 Errors go to stderr as one line (what is wrong and where) with exit code 2 for bad input,
 3 for no equilibrium, 4 for a solver failure, 5 for an answer that missed the asked accuracy
-(or a ``--target`` not reached).
+(or a ``--target`` not reached), 130 when interrupted; 1 only for an internal error (a bug:
+the line says so; ``PLATEQP_DEBUG=1`` shows the traceback).
+
+While a command works, anything a solver prints on standard output (HiGHS's banner, OSQP's
+"Polishing not needed") is sent to standard error, so that ``--json`` output is JSON alone.
+Files are written only inside ``--out``, under names made safe from the scene's name, never
+over an existing file unless ``--force`` is given, and ``--out`` is checked before any work.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import os
+import re
 import sys
 import warnings
 from pathlib import Path
@@ -16,11 +25,11 @@ from pathlib import Path
 import numpy as np
 
 from . import scenes
-from .backends import registry
+from .backends import get_backend, registry
 from .accuracy import Status, accuracy_tol
 from .contact import formulations_for
 from .solving import solve
-from .errors import NoEquilibriumError, PlateQPError, SceneError, SolverError
+from .errors import NoEquilibriumError, PlateQPError, ProblemError, SceneError, SolverError
 from .scene import Scene
 
 
@@ -52,6 +61,90 @@ def _target(text: str) -> float:
     return v
 
 
+def _options(text: str | None) -> dict | None:
+    """--options: a JSON object, or a one-line error naming what is wrong with it."""
+    if not text:
+        return None
+    try:
+        opts = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exn:
+        raise ProblemError(f"--options: not valid JSON ({getattr(exn, 'msg', 'nested too deep')})") from None
+    if not isinstance(opts, dict):
+        raise ProblemError(f"--options: must be a JSON object such as '{{\"max_iter\": 100}}' (got {type(opts).__name__})")
+    return opts
+
+
+def _backend_name(name: str) -> str:
+    """An unknown backend is bad input (exit 2), found before any work."""
+    if name != "auto":
+        try:
+            get_backend(name)
+        except SolverError as exn:  # unknown or not installed: what was asked is not there
+            raise ProblemError(f"--backend: {exn}") from None
+    return name
+
+
+#: Characters allowed in a file name made from a scene's name.
+_SAFE = re.compile(r"[^A-Za-z0-9._-]+")
+
+
+def safe_filename(name: str) -> str:
+    """A scene name as a plain file name: no directories, no leading dot, at most 100 characters."""
+    out = _SAFE.sub("_", str(name)).lstrip(".")[:100]
+    return out or "scene"
+
+
+def _out_dir(text: str, files: list[str], force: bool) -> Path:
+    """Check ``--out`` before any work: a folder (made if missing) that is writable and holds none
+    of ``files`` (unless ``force``)."""
+    out = Path(text)
+    if out.exists() and not out.is_dir():
+        raise ProblemError(f"--out {out}: exists and is not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exn:
+        raise ProblemError(f"--out {out}: cannot be made ({exn.strerror or exn})") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise ProblemError(f"--out {out}: is not writable")
+    there = [f for f in files if (out / f).exists()]
+    if there and not force:
+        raise ProblemError(f"--out {out}: {there[0]} exists; use --force to overwrite")
+    return out
+
+
+@contextlib.contextmanager
+def _stdout_to_stderr():
+    """Send everything written to standard output (Python's and the C libraries') to standard
+    error while the block runs; the command's own output is printed after it."""
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:  # no file descriptor 1 (embedded): Python-level redirection only
+        saved = None
+    try:
+        if saved is not None:
+            os.dup2(2, 1)
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
+    finally:
+        sys.stdout.flush()
+        if saved is not None:
+            try:
+                sys.__stdout__.flush()
+            except (OSError, ValueError, AttributeError):
+                pass
+            os.dup2(saved, 1)
+            os.close(saved)
+
+
+def _set_memory_limit(text: str | None) -> None:
+    if text:
+        from .assembly import MEMORY_ENV, parse_bytes
+
+        parse_bytes(text, "--max-memory")
+        os.environ[MEMORY_ENV] = text  # worker processes inherit it
+
+
 def _summary(result, probes=()) -> str:
     w, x, y = result.w_max()
     lines = [f"scene {result.scene.name!r}: {result.formulation} / {result.backend} / {result.accuracy}"
@@ -77,10 +170,14 @@ def _summary(result, probes=()) -> str:
 
 
 def cmd_solve(args) -> int:
+    _set_memory_limit(args.max_memory)
     scene = _scene_or_builtin(args.scene)
-    opts = json.loads(args.options) if args.options else None
+    opts = _options(args.options)
+    _backend_name(args.backend)
+    stem = safe_filename(scene.name)
+    out = _out_dir(args.out, [f"{stem}.json", f"{stem}-w.npy"], args.force) if args.out else None
     reached = True
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), _stdout_to_stderr():
         warnings.simplefilter("ignore")  # the status says it; the warning would repeat it on stderr
         if args.target is not None:
             from .target import solve_to_target
@@ -111,11 +208,9 @@ def cmd_solve(args) -> int:
         if args.target is not None:
             print(tr)
         print(_summary(result, args.probe))
-    if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / f"{scene.name}.json").write_text(json.dumps(result.to_dict(args.probe), indent=1))
-        np.save(out / f"{scene.name}-w.npy", result.w_nodes())
+    if out is not None:
+        (out / f"{stem}.json").write_text(json.dumps(result.to_dict(args.probe), indent=1))
+        np.save(out / f"{stem}-w.npy", result.w_nodes())
     return 0 if result.status in (Status.OPTIMAL,) and reached else 5
 
 
@@ -153,6 +248,8 @@ def _sweep_values(args) -> list:
                 out.append(int(v) if v.lstrip("+-").isdigit() else float(v))
             except ValueError:
                 raise PlateQPError(f"--values: not a number or 'rigid': {v!r}") from None
+        if len(out) > args.max_values:
+            raise PlateQPError(f"--values: {len(out)} values is more than --max-values {args.max_values}")
         return out
     parts = args.range.split(":")
     try:
@@ -163,6 +260,9 @@ def _sweep_values(args) -> list:
         raise PlateQPError(f"--range wants A:B:N or A:B:N:log (got {args.range!r})") from None
     if n < 1:
         raise PlateQPError(f"--range: N must be >= 1 (got {n})")
+    if n > args.max_values:
+        raise PlateQPError(f"--range: {n} values is more than --max-values {args.max_values}; "
+                           "raise --max-values if you mean it")
     if len(parts) == 4 and parts[3] == "log":
         if a <= 0 or b <= 0:
             raise PlateQPError(f"--range {args.range}: a log range needs A, B > 0")
@@ -173,13 +273,16 @@ def _sweep_values(args) -> list:
 def cmd_sweep(args) -> int:
     from .studies import sweep
 
+    _set_memory_limit(args.max_memory)
     scene = _scene_or_builtin(args.scene)
     values = _sweep_values(args)
-    opts = json.loads(args.options) if args.options else None
-    res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
-                accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
-                max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
-                refine_breakpoints=not args.no_refine, rtol=args.rtol, warm_start=not args.no_warm_start)
+    opts = _options(args.options)
+    _backend_name(args.backend)
+    with _stdout_to_stderr():
+        res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
+                    accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
+                    max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                    refine_breakpoints=not args.no_refine, rtol=args.rtol, warm_start=not args.no_warm_start)
     if args.json:
         print(json.dumps(res.to_dict(), indent=1))
     else:
@@ -251,7 +354,10 @@ def main(argv=None) -> int:
     s.add_argument("--probe", type=_probe, action="append", default=[], metavar="X,Y")
     s.add_argument("--options", help="backend options as a JSON object, passed through untouched")
     s.add_argument("--json", action="store_true")
-    s.add_argument("--out")
+    s.add_argument("--out", metavar="DIR", help="write <name>.json and <name>-w.npy (nodal w) into DIR")
+    s.add_argument("--force", action="store_true", help="--out: overwrite files that exist")
+    s.add_argument("--max-memory", metavar="BYTES",
+                   help="refuse meshes estimated to need more (e.g. 8G; default 80%% of this machine's memory)")
     w = sub.add_parser("sweep", help="solve a scene for a range of one parameter; find where the contact set changes")
     w.add_argument("scene")
     w.add_argument("--param", required=True, metavar="PATH", help="e.g. supports.*.stiffness, supports.3.gap, loads.0.P")
@@ -268,6 +374,8 @@ def main(argv=None) -> int:
     w.add_argument("--workers", type=int, default=2, help="local worker processes (1: serial)")
     w.add_argument("--no-warm-start", action="store_true",
                    help="start each value's solve cold (warm starts: bpp and pdas, from the previous contact set)")
+    w.add_argument("--max-values", type=int, default=10_000, metavar="N", help="most values a sweep takes")
+    w.add_argument("--max-memory", metavar="BYTES", help="refuse meshes estimated to need more (e.g. 8G)")
     w.add_argument("--json", action="store_true")
     x = sub.add_parser("export", help="write the contact problem as a QPS file or a qpbenchmark test set")
     x.add_argument("scene", help="a scene file, or the name of a built-in scene")
@@ -281,9 +389,13 @@ def main(argv=None) -> int:
     b = sub.add_parser("backends", help="list the backends and the formulations each takes")
     b.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
+    saved_limit = os.environ.get("PLATEQP_MAX_MEMORY")  # --max-memory holds for this command only
     try:
         return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends,
                 "export": cmd_export}[args.cmd](args)
+    except KeyboardInterrupt:
+        print("plateqp: interrupted", file=sys.stderr)
+        return 130
     except NoEquilibriumError as exn:
         print(f"plateqp: no equilibrium: {exn}", file=sys.stderr)
         return 3
@@ -293,6 +405,20 @@ def main(argv=None) -> int:
     except PlateQPError as exn:
         print(f"plateqp: {exn}", file=sys.stderr)
         return 2
+    except MemoryError:
+        print("plateqp: out of memory: use a coarser mesh, or fewer contact points", file=sys.stderr)
+        return 2
+    except Exception as exn:  # noqa: BLE001 - a bug: one line, not a traceback (PLATEQP_DEBUG=1 shows it)
+        if os.environ.get("PLATEQP_DEBUG"):
+            raise
+        print(f"plateqp: internal error (a bug in plateqp, please report it with the command): "
+              f"{type(exn).__name__}: {str(exn).splitlines()[0] if str(exn) else ''}", file=sys.stderr)
+        return 1
+    finally:
+        if saved_limit is None:
+            os.environ.pop("PLATEQP_MAX_MEMORY", None)
+        else:
+            os.environ["PLATEQP_MAX_MEMORY"] = saved_limit
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -78,7 +79,7 @@ def test_errors_are_one_line(capsys, tmp_path, text, needle, code):
 
 def test_unknown_backend_exit_code(capsys):
     code, _, err = run_cli(capsys, "solve", str(scenes.path("heave")), "--backend", "nonesuch")
-    assert code == 4 and "lemke" in err
+    assert code == 2 and "lemke" in err and err.count("\n") == 1  # bad input, one line naming what is there
 
 
 def test_demo_writes_reports(capsys, tmp_path):
@@ -93,3 +94,125 @@ def test_lemke_trace_through_solve():
     res = pq.solve(sc, backend="lemke", formulation="condensed", options={"trace": True})
     trace = res.extras["trace"]
     assert len(trace) == res.iterations and trace[0]["entering"][0] == "z0"
+
+
+# -- hostile input (issue 10): one line on stderr, the right exit code, nothing written astray ------
+
+SMALL = """\
+name = {name}
+[plate]
+a = 1.0
+b = 1.0
+h = 0.02
+E = 1.0e7
+nu = 0.3
+[mesh]
+nx = 4
+ny = 4
+[edges]
+left = "simple"
+[[loads]]
+type = "uniform"
+q = 1.0
+[[supports]]
+x = 1.0
+y = 0.0
+gap = {gap}
+[[supports]]
+x = 1.0
+y = 1.0
+gap = {gap}
+"""
+
+
+def small(tmp_path, name='"small"', gap=0.0, file="s.toml"):
+    path = tmp_path / file
+    path.write_text(SMALL.format(name=name, gap=gap))
+    return path
+
+
+def one_line_error(code, err, expect_code=2):
+    assert code == expect_code, err
+    assert err.count("\n") == 1 and err.startswith("plateqp: ") and "Traceback" not in err, err
+
+
+@pytest.mark.parametrize("name", ['"../../ESCAPED"', '"/tmp/plateqp-abs-ESCAPED"', '"a/b\\\\c"', '".hidden"'])
+def test_scene_name_never_leaves_out(capsys, tmp_path, name):
+    scene = small(tmp_path, name=name)
+    out = tmp_path / "deep" / "out"
+    code, _, err = run_cli(capsys, "solve", str(scene), "--out", str(out))
+    assert code == 0, err
+    written = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file())
+    assert all(p.parts[:2] == ("deep", "out") or p.name == "s.toml" for p in written), written
+    assert len(list(out.iterdir())) == 2 and not any(p.name.startswith(".") for p in out.iterdir())
+    assert not (tmp_path / "ESCAPED.json").exists() and not Path("/tmp/plateqp-abs-ESCAPED.json").exists()
+
+
+def test_out_is_checked_first_and_never_overwritten(capsys, tmp_path):
+    scene = small(tmp_path)
+    out = tmp_path / "out"
+    assert run_cli(capsys, "solve", str(scene), "--out", str(out))[0] == 0
+    before = (out / "small.json").read_bytes()
+    code, _, err = run_cli(capsys, "solve", str(scene), "--out", str(out), "--accuracy", "high")
+    one_line_error(code, err)
+    assert "small.json exists" in err and "--force" in err and (out / "small.json").read_bytes() == before
+    code, _, err = run_cli(capsys, "solve", str(scene), "--out", str(out), "--accuracy", "high", "--force")
+    assert code == 0 and json.loads((out / "small.json").read_text())["accuracy"] == "high"
+    code, _, err = run_cli(capsys, "solve", str(scene), "--out", str(scene))  # a file, not a folder
+    one_line_error(code, err)
+    assert "not a folder" in err
+    code, _, err = run_cli(capsys, "solve", str(scene), "--out", str(scene / "sub"))  # under a file
+    one_line_error(code, err)
+
+
+@pytest.mark.parametrize("opts", ["{bad", "[1,2]", "1", '"x"'])
+def test_bad_options_json(capsys, tmp_path, opts):
+    code, _, err = run_cli(capsys, "solve", str(small(tmp_path)), "--options", opts)
+    one_line_error(code, err)
+    assert "--options" in err
+
+
+@pytest.mark.parametrize("path", ["", ".", "/dev/zero"])
+def test_scene_path_that_is_not_a_scene(capsys, path):
+    code, _, err = run_cli(capsys, "solve", path)
+    one_line_error(code, err)
+
+
+def test_unbounded_sweep_is_refused(capsys, tmp_path):
+    code, _, err = run_cli(capsys, "sweep", str(small(tmp_path)), "--param", "supports.0.gap", "--range", "0:1:1000000")
+    one_line_error(code, err)
+    assert "--max-values" in err
+
+
+def test_memory_limit_flag(capsys, tmp_path):
+    code, _, err = run_cli(capsys, "solve", str(small(tmp_path)), "--max-memory", "1K")
+    one_line_error(code, err)
+    assert "above the limit" in err
+    code, _, err = run_cli(capsys, "solve", str(small(tmp_path)), "--max-memory", "lots")
+    one_line_error(code, err)
+
+
+def run_subprocess(*argv):
+    """The command in a fresh process, so that what C libraries print on file descriptor 1 is seen."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path as P
+
+    env = dict(os.environ, PYTHONPATH=str(P(__file__).resolve().parents[1]))
+    r = subprocess.run([sys.executable, "-m", "plateqp.cli", *argv], capture_output=True, text=True, env=env,
+                       timeout=300)
+    return r.returncode, r.stdout, r.stderr
+
+
+@pytest.mark.parametrize("backend, gap", [("qpsolvers:highs", 0.0), ("cvxpy:HIGHS", 0.0), ("osqp", 1.0)])
+def test_json_alone_on_stdout_whatever_the_solver_prints(tmp_path, backend, gap):
+    """HiGHS prints its banner on stdout; OSQP prints "Polishing not needed" when nothing touches
+    (gap 1.0: every support far below the plate)."""
+    if backend not in pq.available_backends():
+        pytest.skip(f"{backend} is not installed")
+    code, out, err = run_subprocess("solve", str(small(tmp_path, gap=gap)), "--backend", backend,
+                                    "--formulation", "primal", "--json")
+    assert code in (0, 5), err
+    d = json.loads(out)
+    assert d["backend"] == backend
