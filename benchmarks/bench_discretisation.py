@@ -9,7 +9,7 @@ largest; the bed: its largest pressure). The exact answer's error is the mesh's 
 iterative answer's error falls with the tolerance until it meets it, and no further.
 
 Also records, per mesh, the tolerance ``accuracy="auto"`` would choose (a tenth of the
-Richardson estimate from the two coarser meshes, plateqp.target).
+Richardson estimate from the two coarser meshes, plateqp.estimate).
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_discretisation.py            # all families
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_discretisation.py --families grid_rigid --max-mesh 64
@@ -39,7 +39,7 @@ COARSEST = 8
 
 
 def _quantities(res):
-    from plateqp.target import Quantities
+    from plateqp.estimate import Quantities
 
     q = Quantities.of(res)
     return {"w": q.w_nodes, "w_max": q.w_max, "R": q.reactions, "p": q.p_max}
@@ -87,7 +87,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default=str(HERE / "results" / "discretisation.csv"))
     args = ap.parse_args(argv)
     import plateqp as pq
-    from plateqp.target import auto_tolerance
+    from plateqp.studies import auto_tolerance
     from plateqp.families import family
 
     meshes = [n for n in (8, 16, 32, 64, 128) if n <= args.max_mesh]

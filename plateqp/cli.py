@@ -180,7 +180,7 @@ def cmd_solve(args) -> int:
     with warnings.catch_warnings(), _stdout_to_stderr():
         warnings.simplefilter("ignore")  # the status says it; the warning would repeat it on stderr
         if args.target is not None:
-            from .target import solve_to_target
+            from .studies import solve_to_target
 
             if opts:
                 raise PlateQPError("--target chooses the backend's tolerance itself: drop --options")

@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from . import post
 from .accuracy import Status
-from .elements import bending_matrix
 
 
 @dataclass
@@ -102,27 +102,16 @@ class Result:
         return self._eval(x, y, 2, 0), self._eval(x, y, 0, 2), self._eval(x, y, 1, 1)
 
     def moments(self, x, y):
-        """(Mx, My, Mxy) per unit length at points: M = −D_b κ."""
-        p = self.scene.plate
-        kxx, kyy, kxy = (np.asarray(v) for v in self.curvatures(x, y))
-        Db = bending_matrix(p.D, p.nu)
-        Mx = -(Db[0, 0] * kxx + Db[0, 1] * kyy)
-        My = -(Db[1, 0] * kxx + Db[1, 1] * kyy)
-        Mxy = -Db[2, 2] * 2.0 * kxy
-        return _unwrap(Mx), _unwrap(My), _unwrap(Mxy)
+        """(Mx, My, Mxy) per unit length at points: M = −D_b κ (:func:`plateqp.post.moments`)."""
+        return tuple(_unwrap(m) for m in post.moments(self.scene.plate, *self.curvatures(x, y)))
 
     def stresses(self, x, y):
         """(σx, σy, τxy) on the bottom face: 6 M / h²."""
-        c = 6.0 / self.scene.plate.h**2
-        return tuple(_unwrap(c * np.asarray(m)) for m in self.moments(x, y))
+        return tuple(_unwrap(s) for s in post.stresses(self.scene.plate, *self.curvatures(x, y)))
 
     def principal_stresses(self, x, y):
         """(σ1, σ2, θ1) on the bottom face: σ1 ≥ σ2 and the angle of σ1 from x (radians)."""
-        sx, sy, txy = (np.asarray(v) for v in self.stresses(x, y))
-        c = 0.5 * (sx + sy)
-        r = np.hypot(0.5 * (sx - sy), txy)
-        theta = 0.5 * np.arctan2(2.0 * txy, sx - sy)
-        return _unwrap(c + r), _unwrap(c - r), _unwrap(theta)
+        return tuple(_unwrap(s) for s in post.principal(*self.stresses(x, y)))
 
     def section(self, p0, p1, n: int = 101, quantity: str = "w"):
         """Values along the segment p0 → p1: returns (s, values) with s the distance from p0.
@@ -153,33 +142,14 @@ class Result:
         return table[quantity]()
 
     def nodal(self, quantity: str = "w") -> np.ndarray:
-        """(ny+1, nx+1) smoothed nodal values (average over the kept cells at each node; NaN off the plate)."""
-        g = self.model.grid
-        cells = self.model.cells
-        corners = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-        acc = np.zeros(g.n_nodes)
-        cnt = np.zeros(g.n_nodes)
-        cn = g.cell_nodes()[cells]
-        x0 = (cells % g.nx) * g.hx
-        y0 = (cells // g.nx) * g.hy
-        for k, (cx, cy) in enumerate(corners):
-            # evaluate just inside the cell so each cell contributes its own value
-            xi = 1e-9 + (1 - 2e-9) * cx
-            eta = 1e-9 + (1 - 2e-9) * cy
-            v = np.asarray(self.at(x0 + xi * g.hx, y0 + eta * g.hy, quantity)).ravel()
-            np.add.at(acc, cn[:, k], v)
-            np.add.at(cnt, cn[:, k], 1.0)
-        out = np.where(cnt > 0, acc / np.where(cnt > 0, cnt, 1), np.nan)
-        return out.reshape(g.ny + 1, g.nx + 1)
+        """(ny+1, nx+1) smoothed nodal values (average over the kept cells at each node; NaN off
+        the plate): :class:`plateqp.post.NodalOperator`. ``quantity`` as for :meth:`section`."""
+        return post.NodalOperator(self.model)(self.u, self.scene.plate, quantity)
 
     # -- summaries --------------------------------------------------------------------------
     def w_nodes(self) -> np.ndarray:
         """w at every plate node (NaN off the plate), shape (ny+1, nx+1)."""
-        g = self.model.grid
-        nd = self.model.element.ndof_node
-        w = self.u[0::nd][: g.n_nodes].astype(float).copy()
-        w[~g.node_mask()] = np.nan
-        return w.reshape(g.ny + 1, g.nx + 1)
+        return post.nodal_w(self.model, self.u)
 
     def w_max(self) -> tuple[float, float, float]:
         """(w, x, y) of the node with the largest |w|."""

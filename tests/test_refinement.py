@@ -1,4 +1,5 @@
-"""Discretisation error against solver error: ``accuracy="auto"`` and ``solve_to_target``.
+"""Mesh refinement (plateqp.studies.refinement): the convergence table against Timoshenko, and
+discretisation error against solver error: ``accuracy="auto"`` and ``solve_to_target``.
 
 External reference: Navier's double series for a simply supported square plate, under a
 uniform load and under a central point load; by superposition the reaction of a rigid
@@ -17,8 +18,10 @@ import pytest
 
 import plateqp as pq
 from plateqp.errors import ProblemError
-from plateqp.target import auto_tolerance, solve_to_target
+from plateqp.studies import auto_tolerance, convergence, solve_to_target
+from study_scenes import fig5
 
+SLAB_W = 0.0040624  # Timoshenko: SS square, uniform load, centre w × q a⁴/D
 A, Q, NU = 1.0, 50.0, 0.3
 PLATE = pq.Plate(a=A, b=A, h=0.02, E=1.0e7, nu=NU)
 D = PLATE.D
@@ -150,3 +153,36 @@ def test_cli_target_and_accuracy(tmp_path, capsys):
         assert exc.value.code == 2
     assert main(["solve", str(path), "--target", "1e-3", "--accuracy", "high"]) == 2
     assert "drop --accuracy" in capsys.readouterr().err
+
+
+# -- convergence by mesh halving ----------------------------------------------------------------
+
+def test_convergence_slab_against_timoshenko():
+    sc = pq.Scene(name="slab", plate=pq.Plate(a=1.0, b=1.0, h=0.01, E=2.1e11, nu=0.3), mesh=pq.MeshSpec(8, 8),
+                  edges={k: pq.Edge("simple") for k in ("left", "right", "bottom", "top")},
+                  loads=[pq.UniformLoad(q=1000.0)])
+    tab = convergence(sc, meshes=(2, 4, 8, 16, 32), quantities=("w_max", "w:0.5,0.5"), target=0.01)
+    ref = SLAB_W * 1000.0 / sc.plate.D
+    w = tab.values["w:0.5,0.5"]
+    assert w[-1] == pytest.approx(ref, rel=0.01)  # the finest mesh within 1 %
+    np.testing.assert_allclose(tab.values["w_max"], w)  # the maximum is at the centre
+    d = tab.diff["w_max"]
+    assert np.all(np.diff(d[:-1]) < 0) and np.isnan(d[-1])  # the changes shrink on halving
+    assert d[:-1] == pytest.approx(np.abs(np.diff(w)) / np.abs(w[1:]))
+    err = np.abs(w - ref)
+    assert np.all(np.diff(err) < 0)
+    # the paper's finding for deflections: halving 8x8 still changes w by 1.2 %, halving 16x16 by 0.3 %
+    assert tab.converged_at["w_max"] == (16, 16)
+    assert [r["nx"] for r in tab.rows] == [2, 4, 8, 16, 32] and "w_max diff" in tab.rows[0]
+    assert "converged at" in str(tab)
+
+
+def test_convergence_reactions_on_a_contact_scene():
+    sc = fig5()
+    sc.loads[0] = pq.PointLoad(P=20000.0, x=200.0, y=200.0)
+    tab = convergence(sc, meshes=(4, 8, 16), quantities=("w_max", "reactions.12", "reactions.0"), target=0.01)
+    assert all(e is None for e in tab.errors)
+    # the paper's finding: reactions converge already on the coarsest meshes
+    assert tab.converged_at["reactions.12"] == (4, 4)
+    # a lifted support's reaction is zero up to rounding: compared with the largest reaction, not with noise
+    assert tab.converged_at["reactions.0"] == (4, 4)

@@ -1,0 +1,182 @@
+"""Scene paths: read or change one field of a scene named with dots.
+
+A PATH names a scene field with dots: ``plate.h``, ``mesh.nx``, ``loads.0.P``,
+``supports.3.gap``, ``supports.*.stiffness`` (``*``: every item of a list), ``foundation.k``,
+``edges.left`` (``"free"``, ``"simple"``, ``"clamped"``). :func:`get_param` reads one,
+:func:`set_param` returns a validated deep copy with it changed. A support stiffness accepts
+``"rigid"`` (also ``math.inf`` or ``"inf"``, stored as ``"rigid"``): the paper's stiffness study
+starts from c = ∞. A bad path or value is a :class:`~plateqp.errors.SceneError` that names the
+path and what exists there.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import fields, is_dataclass
+
+import numpy as np
+
+from .errors import SceneError
+from .scene import EDGE_NAMES, Edge, Scene
+
+_TOP = ("name", "plate", "mesh", "edges", "openings", "pins", "loads", "supports", "foundation")
+
+
+def _path_parts(path: str) -> list[str]:
+    if not isinstance(path, str) or not path or any(p == "" for p in path.split(".")):
+        raise SceneError(f"bad path {path!r}: write dotted names such as 'supports.3.gap' or 'plate.h'")
+    return path.split(".")
+
+
+def _names(obj) -> list[str]:
+    if isinstance(obj, Scene):
+        return list(_TOP)
+    if is_dataclass(obj):
+        return [f.name for f in fields(obj) if f.init]
+    return []
+
+
+def _walk(obj, parts: list[str], where: str, create: bool):
+    """Yield (container, key, where) for every leaf the path names (``*`` expands lists)."""
+    if not parts:
+        raise SceneError(f"{where}: names a whole section; name a field of it")
+    key, rest = parts[0], parts[1:]
+    here = f"{where}.{key}" if where else key
+    if isinstance(obj, list):
+        if key == "*":
+            keys = range(len(obj))
+            if not keys:
+                raise SceneError(f"{here}: {where} is empty")
+        else:
+            try:
+                k = int(key)
+            except ValueError:
+                raise SceneError(f"{here}: {where} is a list; use an index 0..{len(obj) - 1} or '*'") from None
+            if not 0 <= k < len(obj):
+                raise SceneError(f"{here}: index out of range; the scene has {len(obj)} {where} "
+                                 f"(indices 0..{len(obj) - 1})" if obj else f"{here}: the scene has no {where}")
+            keys = [k]
+        for k in keys:
+            sub = f"{where}.{k}"
+            if rest:
+                yield from _walk(obj[k], rest, sub, create)
+            else:
+                yield obj, k, sub
+        return
+    if isinstance(obj, dict):  # edges
+        if key not in EDGE_NAMES:
+            raise SceneError(f"{here}: unknown edge; edges are {', '.join(EDGE_NAMES)}")
+        if key not in obj and create:
+            obj[key] = Edge("free")
+        if rest:
+            yield from _walk(obj.get(key, Edge("free")), rest, here, create)
+        else:
+            yield obj, key, here
+        return
+    names = _names(obj)
+    if key == "*" or key not in names:
+        what = where or "the scene"
+        raise SceneError(f"{here}: no such field in {what}; fields: {', '.join(names)}")
+    if rest:
+        sub = getattr(obj, key)
+        if sub is None:
+            raise SceneError(f"{here}: the scene has no {key}; add a [{key}] section first")
+        if isinstance(sub, (str, int, float)) and not isinstance(sub, bool):
+            raise SceneError(f"{here}.{rest[0]}: {here} is a value ({sub!r}), not a section")
+        if isinstance(sub, dict) and key != "edges":  # e.g. foundation.gap as a profile
+            if len(rest) != 1:
+                raise SceneError(f"{here}.{'.'.join(rest)}: too deep")
+            if rest[0] not in sub:
+                raise SceneError(f"{here}.{rest[0]}: no such key; keys: {', '.join(sub)}")
+            yield sub, rest[0], f"{here}.{rest[0]}"
+            return
+        yield from _walk(sub, rest, here, create)
+    else:
+        yield obj, key, here
+
+
+def _read(container, key):
+    if isinstance(container, (list, dict)):
+        v = container[key] if not isinstance(container, dict) or key in container else Edge("free")
+    else:
+        v = getattr(container, key)
+    return v.kind if isinstance(v, Edge) and v.w == 0.0 and v.slope == 0.0 else v
+
+
+def get_param(scene: Scene, path: str):
+    """The value a PATH names (a list of values for a path with ``*``).
+
+    >>> get_param(scene, "supports.*.gap")     # one value per support
+    >>> get_param(scene, "plate.h")
+    """
+    parts = _path_parts(path)
+    leaves = list(_walk(scene, parts, "", create=False))
+    vals = [_read(c, k) for c, k, _ in leaves]
+    return vals if "*" in parts else vals[0]
+
+
+def _coerce(where: str, old, value):
+    """The value as the field wants it ("rigid"/inf for stiffness, int for mesh sizes, Edge for edges)."""
+    leaf = where.rsplit(".", 1)[-1]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if leaf == "stiffness":
+        if isinstance(value, str) and value.strip().lower() in ("rigid", "inf", "infinity"):
+            return "rigid"
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isinf(value) and value > 0:
+            return "rigid"
+    edge_itself = where.startswith("edges.") and where.count(".") == 1
+    if isinstance(value, str) and leaf not in ("name", "element", "kind", "profile") and not edge_itself:
+        try:
+            value = float(value)
+        except ValueError:
+            raise SceneError(f"{where}: not a number: {value!r}") from None
+    if edge_itself:
+        if isinstance(value, Edge):
+            return copy.deepcopy(value)
+        if isinstance(value, str):
+            return Edge(kind=value)
+        if isinstance(value, dict):
+            return Edge(kind=value.get("kind", "free"), w=value.get("w", 0.0), slope=value.get("slope", 0.0))
+        raise SceneError(f"{where}: must be an edge kind (free, simple, clamped)")
+    if isinstance(old, int) and not isinstance(old, bool) and isinstance(value, float):
+        if value.is_integer():
+            return int(value)
+        raise SceneError(f"{where}: must be an integer (got {value!r})")
+    return value
+
+
+def set_param(scene: Scene, path: str, value) -> Scene:
+    """A validated deep copy of ``scene`` with the field PATH set to ``value``.
+
+    With ``*`` in the path every item gets ``value``, or, if ``value`` is a sequence as long
+    as the items, one entry each (``set_param(scene, "supports.*.gap", gaps)``).
+    Raises SceneError naming the path for a bad path or value.
+    """
+    parts = _path_parts(path)
+    new = copy.deepcopy(scene)
+    leaves = list(_walk(new, parts, "", create=True))
+    per_item = ("*" in parts and not isinstance(value, (str, dict)) and np.ndim(value) == 1
+                and len(value) == len(leaves) and len(leaves) > 0)
+    for j, (c, k, where) in enumerate(leaves):
+        v = _coerce(where, _read(c, k) if not isinstance(c, dict) or k in c else None,
+                    value[j] if per_item else value)
+        if isinstance(c, (list, dict)):
+            c[k] = v
+        else:
+            if k == "type":
+                raise SceneError(f"{where}: the load type cannot be changed by a path; edit the scene")
+            setattr(c, k, v)
+    new.validate()
+    return new
+
+
+def as_number(value) -> float:
+    """A parameter value as a number ("rigid" is +inf)."""
+    if isinstance(value, str):
+        return math.inf if value.strip().lower() in ("rigid", "inf", "infinity") else float(value)
+    return float(value)
+
+
+__all__ = ["as_number", "get_param", "set_param"]

@@ -1,0 +1,152 @@
+"""Where the values of a sweep are solved: this process, local worker processes, any
+:class:`concurrent.futures.Executor` or a Dask ``distributed.Client``; and a progress bar.
+
+Every runner has the same two calls: ``submit(fn, *args)`` and ``as_completed(tasks)``, which
+yields (task, future) pairs as they finish (in order for :class:`Serial`, which runs each task
+when its result is asked for). Local worker processes start from a fresh interpreter
+(forkserver/spawn), never by forking a process whose numerical libraries have run threads.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import pickle
+import sys
+import warnings
+
+from ..errors import PlateQPWarning, ProblemError
+
+#: ``executor=None`` runs fewer values than this in the calling process.
+SERIAL_BELOW = 8
+
+
+class Serial:
+    """Runs each task when its result is asked for, so progress advances as it goes."""
+
+    kind = "serial"
+    workers = 1
+
+    class _Task:
+        def __init__(self, fn, args):
+            self.fn, self.args = fn, args
+
+    def submit(self, fn, *args):
+        return self._Task(fn, args)
+
+    def as_completed(self, tasks):
+        for t in tasks:
+            fut: cf.Future = cf.Future()
+            try:
+                fut.set_result(t.fn(*t.args))
+            except Exception as exn:  # pragma: no cover - tasks catch their own errors
+                fut.set_exception(exn)
+            yield t, fut
+
+    def close(self):
+        pass
+
+
+class Futures:
+    """A concurrent.futures executor (ours or the user's) or a Dask distributed Client."""
+
+    def __init__(self, executor, own: bool, dask: bool, workers: int):
+        self.ex, self.own, self.dask, self.workers = executor, own, dask, workers
+        self.kind = "dask" if dask else "futures"
+
+    def submit(self, fn, *args):
+        if self.dask:
+            return self.ex.submit(fn, *args, pure=False)
+        return self.ex.submit(fn, *args)
+
+    def as_completed(self, futs):
+        if self.dask:
+            from distributed import as_completed
+
+            for f in as_completed(list(futs)):
+                yield f, f
+        else:
+            for f in cf.as_completed(list(futs)):
+                yield f, f
+
+    def close(self):
+        if self.own:
+            self.ex.shutdown(wait=True)
+
+
+def mp_context():
+    """Worker processes start from a clean server process ("forkserver"; "spawn" where there is
+    none), never by forking this one: a fork after SuiteSparse/OpenMP or BLAS threads have run
+    here deadlocks the workers (seen: both blocked on a futex after a 32x32 serial sweep)."""
+    import multiprocessing as mp
+
+    return mp.get_context("forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn")
+
+
+def is_dask(executor) -> bool:
+    return type(executor).__module__.split(".")[0] == "distributed" and hasattr(executor, "submit")
+
+
+def make_runner(executor, n: int, max_workers: int, payload):
+    """The runner for ``executor`` (see :func:`plateqp.studies.sweep.sweep`) and ``n`` tasks;
+    ``payload``, what every task is sent, must pickle for local processes (else: this process)."""
+    if executor == "serial" or (executor is None and n < SERIAL_BELOW) or max_workers <= 1 and executor is None:
+        return Serial()
+    if executor is None or executor in ("process", "processes"):
+        try:
+            pickle.dumps(payload)
+        except Exception:
+            warnings.warn("the scene cannot be pickled (a Python callable in it?): sweeping in this process",
+                          PlateQPWarning, stacklevel=3)
+            return Serial()
+        return Futures(cf.ProcessPoolExecutor(max_workers=max_workers, mp_context=mp_context()), True, False,
+                        max_workers)
+    if is_dask(executor):
+        try:
+            workers = max(1, sum(executor.nthreads().values()))
+        except Exception:
+            workers = max_workers
+        return Futures(executor, False, True, workers)
+    if isinstance(executor, cf.Executor):
+        return Futures(executor, False, False, getattr(executor, "_max_workers", max_workers) or max_workers)
+    raise ProblemError(f"executor must be None, 'serial', 'process', a concurrent.futures.Executor or a "
+                       f"dask distributed Client (got {executor!r})")
+
+
+class Progress:
+    """tqdm on stderr if installed, else one counter line that rewrites itself."""
+
+    def __init__(self, total: int, desc: str, enabled: bool):
+        self.total, self.desc, self.enabled, self.n = total, desc, enabled and total > 0, 0
+        self.bar = None
+        if self.enabled:
+            try:
+                from tqdm import tqdm
+
+                self.bar = tqdm(total=total, desc=desc, file=sys.stderr, leave=False)
+            except ImportError:
+                self._line()
+
+    def _line(self):
+        sys.stderr.write(f"\r{self.desc}: {self.n}/{self.total}")
+        sys.stderr.flush()
+
+    def update(self, k: int = 1):
+        self.n += k
+        if not self.enabled:
+            return
+        if self.bar is not None:
+            self.bar.update(k)
+        else:
+            self._line()
+
+    def close(self):
+        if not self.enabled:
+            return
+        if self.bar is not None:
+            self.bar.close()
+        else:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+__all__ = ["SERIAL_BELOW", "Futures", "Progress", "Serial", "is_dask", "make_runner", "mp_context"]

@@ -1,0 +1,66 @@
+"""Model re-use: a scene that differs from a model's only in gaps, support stiffnesses, the
+bed's modulus and gap field, or loads shares its stiffness matrix and contact operator.
+
+A sweep (:mod:`plateqp.studies.sweep`) and the stiffness design
+(:func:`plateqp.studies.design.most_uniform_stiffness`) build one model and adapt it to each
+value; the condensation of a contact problem that shares K and B is then computed once too.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..assembly import Model
+from ..scene import Scene
+
+
+def same_structure(a: Scene, b: Scene) -> bool:
+    """True if the two scenes have the same K and contact operator B (only gaps, stiffnesses,
+    bed modulus and gap field, or loads differ)."""
+    if (a.plate, a.mesh, a.edges, a.openings, a.pins) != (b.plate, b.mesh, b.edges, b.openings, b.pins):
+        return False
+    if [(s.x, s.y) for s in a.supports] != [(s.x, s.y) for s in b.supports]:
+        return False
+    if (a.foundation is None) != (b.foundation is None):
+        return False
+    return a.foundation is None or a.foundation.region == b.foundation.region
+
+
+def adapt_model(base: Model, scene: Scene) -> Model | None:
+    """A copy of ``base`` for ``scene`` without re-assembly, or None if K or B would change.
+
+    Gaps, support stiffnesses, the bed's modulus and gap field and the loads are changed in
+    copies of the arrays; the stiffness matrix and contact operator B are shared. The gaps are
+    the scene's, shifted by the prescribed dofs as in ``base``
+    (:meth:`plateqp.assembly.ContactOperator.with_gaps`).
+    """
+    old = base.scene
+    if not same_structure(old, scene):
+        return None
+    model = dataclasses.replace(base, scene=scene)
+    if old.loads != scene.loads:
+        from ..assembly import _loads  # the load vector alone (no stiffness assembly)
+
+        f_full = _loads(scene, base.grid, base.element, base.cells, base.cell_dofs, base.n_full)
+        model.f_full = f_full
+        model.f = f_full[base.free] - base.K_full[base.free][:, base.fixed] @ base.values
+    c = base.contacts
+    if c is not None:
+        gaps, rho = c.scene_gaps.copy(), c.rho.copy()
+        sup = c.source == "support"
+        if np.any(sup):
+            i = c.index[sup]
+            gaps[sup] = [scene.supports[k].gap for k in i]
+            rho[sup] = [0.0 if scene.supports[k].rigid else 1.0 / scene.supports[k].stiffness for k in i]
+        bed = c.source == "bed"
+        if np.any(bed):
+            fo, fn = old.foundation, scene.foundation
+            gaps[bed] = fn.gap_at(c.xy[bed, 0], c.xy[bed, 1])
+            rho[bed] = c.rho[bed] * (fo.k / fn.k)  # 1 / (k × the node's area)
+        model.contacts = c.with_gaps(gaps, rho)
+    return model
+
+
+__all__ = ["adapt_model", "same_structure"]

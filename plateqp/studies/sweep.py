@@ -1,0 +1,227 @@
+"""Sweeps of one scene parameter, with the breakpoints where the working scheme changes.
+
+One row per value: reactions, contact set, w_max, max σ1, KKT report, status, times (the
+fields of ``plateqp solve --json`` plus ``value``). Between two successive values whose contact
+sets differ, the change is located by bisection (:mod:`plateqp.studies.breakpoints`). Re-use:
+the model (stiffness matrix, contact operator) is built once per worker and only the gaps,
+support flexibilities or loads are changed in a copy when the parameter does not change K
+(:func:`plateqp.studies.reuse.adapt_model`); the max nodal σ1 of each row is then computed
+with operators built once per mesh (:class:`plateqp.post.NodalOperator`). Warm starts
+(``options={"active": ...}``: the previous solve's own final state, ``Result.extras["active"]``,
+else its contact set) go only to backends that take them (:data:`WARM_START_BACKENDS`), with
+re-use on; ``warm_start=False`` turns them off alone. Where the values are solved:
+:mod:`plateqp.studies.parallel`.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import uuid
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ProblemError
+from ..paths import as_number, get_param, set_param
+from ..scene import Scene
+from .breakpoints import Bisection, contact_set, refine_bracket
+from .parallel import SERIAL_BELOW, Progress, make_runner
+from .worker import WARM_START_BACKENDS, Context, forget, next_start, run_chunk, solve_value
+
+
+@dataclass
+class SweepResult:
+    """The rows of a sweep (one per value) and the breakpoints between them.
+
+    ``rows``: dicts with the fields of ``plateqp solve --json`` plus ``value``, ``s1_max``,
+    ``kkt_worst`` and ``error`` (None, or the failure of that value: its status is then
+    "infeasible" for no equilibrium, else "error"). A row's ``times`` (seconds) has, besides
+    ``build`` (scene copy and model, adapted or built), ``solve`` (the backend) and ``total``,
+    the parts ``scene`` (copy and validation of the scene), ``formulate`` (scaling, statics
+    check, formulation), ``recover`` (fields and KKT report) and ``post`` (the row itself:
+    w_max, s1_max, lists). ``breakpoints``: dicts
+    ``{between: [v1, v2], at, bracket: [lo, hi], before, after}``, where the contact set
+    (indices of the contact points in contact) changes from ``before`` to ``after`` at
+    ``at`` (the middle of the final bracket; None if it could not be refined). ``times``:
+    seconds for "values", "breakpoints" and "total"; "bisection_solves" (solves the bisection
+    took) and "bisection_iterations" (the backend's iterations in them); "executor".
+    """
+
+    path: str
+    values: list
+    rows: list[dict]
+    breakpoints: list[dict]
+    times: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """The JSON shape of ``plateqp sweep --json``: {rows, breakpoints}."""
+        return {"rows": self.rows, "breakpoints": self.breakpoints}
+
+    @property
+    def reactions(self) -> np.ndarray:
+        """(n_values, m) reactions; NaN rows for failed values."""
+        m = max((len(r["reactions"]) for r in self.rows if r["reactions"] is not None), default=0)
+        return np.array([r["reactions"] if r["reactions"] is not None else [np.nan] * m for r in self.rows])
+
+    @property
+    def active(self) -> list:
+        """Contact set (bool list) per value; None for failed values."""
+        return [r["active"] for r in self.rows]
+
+    def __str__(self) -> str:
+        head = (f"{'value':>12s} {'status':>10s} {'contact':>8s} {'sum R':>12s} {'w_max':>12s}"
+                f" {'max s1':>12s} {'KKT worst':>9s} {'time s':>8s}")
+        lines = [f"sweep of {self.path}: {len(self.rows)} values", head]
+        for r in self.rows:
+            v = r["value"]
+            vs = v if isinstance(v, str) else f"{v:.6g}"
+            if r["error"]:
+                lines.append(f"{vs:>12s} {r['status']:>10s}   {r['error']}")
+                continue
+            lines.append(f"{vs:>12s} {r['status']:>10s} {sum(r['active']):>4d}/{len(r['active']):<3d}"
+                         f" {sum(r['reactions']):12.6g} {r['w_max']:12.6g} {r['s1_max']:12.6g}"
+                         f" {r['kkt_worst'] if r['kkt_worst'] is not None else float('nan'):9.1e}"
+                         f" {r['times']['total']:8.3f}")
+        if self.breakpoints:
+            lines.append("changes of the contact set (working scheme):")
+            for b in self.breakpoints:
+                on = sorted(set(b["after"]) - set(b["before"]))
+                off = sorted(set(b["before"]) - set(b["after"]))
+                where = f"at {b['at']:.6g}" if b["at"] is not None else f"in {b['bracket']}"
+                lines.append(f"  between {b['between'][0]} and {b['between'][1]}: {where};"
+                             f" comes into contact {on or '-'}, lifts off {off or '-'}"
+                             + (f" ({b['note']})" if b.get("note") else ""))
+        else:
+            lines.append("the contact set is the same for every value")
+        return "\n".join(lines)
+
+
+def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", formulation: str = "auto",
+          accuracy: str = "default", executor=None, progress: bool = True, refine_breakpoints: bool = True,
+          rtol: float = 1e-3, options: dict | None = None, reuse: bool = True, max_workers: int = 2,
+          bisection: str = "auto", warm_start: bool = True) -> SweepResult:
+    """Solve ``scene`` for each value of the field PATH; find where the contact set changes.
+
+    Parameters
+    ----------
+    scene, path : the scene and the field to vary (see :func:`set_param`)
+    values : the values, in sweep order ("rigid" allowed for a stiffness)
+    backend, formulation, accuracy, options : as for :func:`plateqp.solve`
+    executor : None (local processes, ``max_workers`` of them, or this process for fewer
+        than :data:`SERIAL_BELOW` values), "serial", "process", any
+        :class:`concurrent.futures.Executor`, or a Dask ``distributed.Client``. Local
+        processes start from a fresh interpreter (forkserver/spawn), so a script that sweeps
+        with them needs the usual ``if __name__ == "__main__":`` guard.
+    progress : a progress bar on stderr (tqdm if installed, else a counter line)
+    refine_breakpoints : bisect each change of the contact set between successive values
+        until its bracket is within ``rtol`` relative
+    reuse : build the model once and change only gaps, stiffnesses or loads in a copy (the
+        condensation is then computed once too); False rebuilds and solves everything from
+        scratch for each value, without warm starts (the reference for timing the re-use)
+    warm_start : with ``reuse``, start each solve of a backend that takes a warm start
+        (:data:`WARM_START_BACKENDS`) from the final state of the solve before it (in a
+        chunk of values, or in a bisection from the bracket's end it continues); False
+        re-uses the model but starts every solve cold (to measure what warm starts save).
+        Other backends ignore it. Each row's ``iterations`` counts the backend's steps.
+    bisection : "auto" (geometric when every value is positive and they span a decade or
+        more, else linear), "geometric" or "linear"
+
+    Returns
+    -------
+    SweepResult. A value whose solve fails is recorded as a row with its status and error;
+    the sweep goes on. A change between a failed value and its neighbours is not bisected.
+    """
+    values = [v.item() if isinstance(v, np.generic) else v for v in values]
+    if not values:
+        raise ProblemError("sweep: no values given")
+    if bisection not in ("auto", "geometric", "linear"):
+        raise ProblemError(f"bisection must be 'auto', 'geometric' or 'linear' (got {bisection!r})")
+    if not isinstance(warm_start, (bool, np.bool_)):
+        raise ProblemError(f"warm_start must be True or False (got {warm_start!r})")
+    current = get_param(scene, path)  # a bad path fails here, naming what exists
+    set_param(scene, path, values[0])  # and a bad value
+    first = current[0] if isinstance(current, list) else current
+    is_int = isinstance(first, int) and not isinstance(first, bool)  # mesh.nx: bisect on integers
+    finite = [x for x in (as_number(v) for v in values) if math.isfinite(x)]
+    geometric = {"geometric": True, "linear": False}.get(
+        bisection, bool(finite) and min(finite) > 0 and max(finite) >= 10.0 * min(finite))
+    if geometric and not (finite and min(finite) > 0):
+        raise ProblemError("geometric bisection needs positive values")
+    bis = Bisection(geometric, rtol, 1e-3 * max((abs(x) for x in finite), default=1.0), is_int)
+
+    t0 = time.perf_counter()
+    ctx = Context(uuid.uuid4().hex, scene, path, backend, formulation, accuracy, options, reuse,
+                   bool(warm_start))
+    runner = make_runner(executor, len(values), max_workers, ctx)
+    n = len(values)
+    rows: list[dict | None] = [None] * n
+    actives: list = [None] * n
+    found: dict[int, list[dict]] = {}
+    solves = bisection_steps = 0
+    try:
+        bar = Progress(n, f"sweep {path}", progress)
+        try:
+            if runner.kind == "serial":
+                # a plain loop, warm-starting each value from the one before
+                state = None
+                for i in range(n):
+                    row, act, new = solve_value(ctx, values[i], next_start(ctx, state))
+                    rows[i], actives[i] = row, act
+                    state = new or state
+                    bar.update()
+            else:
+                size = max(1, math.ceil(n / (4 * runner.workers)))
+                chunks = [[(i, values[i]) for i in range(j, min(n, j + size))] for j in range(0, n, size)]
+                futs = {runner.submit(run_chunk, ctx, ch): ch for ch in chunks}
+                for key, fut in runner.as_completed(futs):
+                    ch = futs[key]
+                    try:
+                        done = fut.result()
+                    except Exception:  # a worker died or could not run it: do this chunk here
+                        done = run_chunk(ctx, ch)
+                    for i, row in done:
+                        rows[i] = row
+                        actives[i] = tuple(row["active"]) if row["active"] is not None else None
+                    bar.update(len(ch))
+        finally:
+            bar.close()
+        t1 = time.perf_counter()
+
+        # breakpoints between successive values whose contact sets differ
+        pairs = [i for i in range(n - 1)
+                 if actives[i] is not None and actives[i + 1] is not None and actives[i] != actives[i + 1]]
+        if refine_breakpoints and pairs:
+            bar = Progress(len(pairs), "refining breakpoints", progress)
+            try:
+                args = {i: (ctx, bis, values[i], actives[i], values[i + 1], actives[i + 1]) for i in pairs}
+                futs = {runner.submit(refine_bracket, *args[i]): i for i in pairs}
+                for key, fut in runner.as_completed(futs):
+                    i = futs[key]
+                    try:
+                        found[i], (k, steps) = fut.result()
+                    except Exception:  # a worker died: refine this one here
+                        found[i], (k, steps) = refine_bracket(*args[i])
+                    solves += k
+                    bisection_steps += steps
+                    bar.update()
+            finally:
+                bar.close()
+        else:
+            for i in pairs:
+                found[i] = [{"between": [values[i], values[i + 1]], "at": None,
+                             "bracket": [values[i], values[i + 1]],
+                             "before": contact_set(actives[i]), "after": contact_set(actives[i + 1])}]
+    finally:
+        runner.close()
+        forget(ctx.token)
+    breakpoints = [b for i in sorted(found) for b in found[i]]
+    t2 = time.perf_counter()
+    return SweepResult(path, values, rows, breakpoints,
+                       times={"values": t1 - t0, "breakpoints": t2 - t1, "total": t2 - t0,
+                              "bisection_solves": solves, "bisection_iterations": bisection_steps,
+                              "executor": runner.kind})
+
+
+__all__ = ["SERIAL_BELOW", "SweepResult", "WARM_START_BACKENDS", "sweep"]

@@ -1,0 +1,64 @@
+"""Scene paths (plateqp.paths): get and set a scene field named with dots; bad paths and values
+say what exists."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import plateqp as pq
+import plateqp.studies
+from plateqp.paths import as_number, get_param, set_param
+from study_scenes import STIFF, fig5
+
+
+def test_the_studies_package_keeps_the_names():
+    assert plateqp.studies.get_param is get_param and plateqp.studies.set_param is set_param
+
+
+def test_get_and_set_paths():
+    sc = fig5()
+    assert get_param(sc, "plate.h") == 20.0
+    assert get_param(sc, "supports.0.gap") == -0.02
+    assert get_param(sc, "supports.*.gap")[:3] == [-0.02, -0.02, 0.0]
+    assert get_param(sc, "loads.0.P") == 20000.0
+    assert get_param(sc, "edges.left") == "free"  # an edge not named is free
+
+    s2 = set_param(sc, STIFF, 1e4)
+    assert get_param(s2, STIFF) == [1e4] * 25 and get_param(sc, STIFF) == ["rigid"] * 25  # a copy
+    assert get_param(set_param(s2, "supports.3.stiffness", float("inf")), "supports.3.stiffness") == "rigid"
+    assert get_param(set_param(s2, STIFF, "rigid"), STIFF) == ["rigid"] * 25
+    nx = get_param(set_param(sc, "mesh.nx", 16.0), "mesh.nx")
+    assert nx == 16 and isinstance(nx, int)
+    gaps = np.linspace(-0.01, 0.01, 25)
+    assert get_param(set_param(sc, "supports.*.gap", gaps), "supports.*.gap") == pytest.approx(gaps)
+    s3 = set_param(sc, "edges.left", "clamped")
+    assert s3.edges["left"].kind == "clamped" and "left" not in sc.edges
+    s4 = pq.Scene(foundation=pq.Foundation(k=100.0), loads=[pq.UniformLoad(q=1.0)])
+    assert get_param(set_param(s4, "foundation.k", 50), "foundation.k") == 50
+
+
+@pytest.mark.parametrize("path, value, words", [
+    ("supports.25.gap", 0.0, ["supports.25", "25 supports", "0..24"]),
+    ("supports.3.gapp", 0.0, ["supports.3.gapp", "x, y, gap, stiffness"]),
+    ("plat.h", 1.0, ["plat", "plate", "mesh", "supports"]),
+    ("supports.x.gap", 0.0, ["supports.x", "index", "'*'"]),
+    ("foundation.k", 1.0, ["foundation", "no foundation"]),
+    ("plate.h.x", 1.0, ["plate.h", "value"]),
+    ("supports.3.stiffness", -5.0, ["supports.3.stiffness", "> 0"]),
+    ("supports.3.stiffness", "soft", ["supports.3.stiffness", "soft"]),
+    ("mesh.nx", 2.5, ["mesh.nx", "integer"]),
+    ("edges.middle", "simple", ["edges.middle", "left, right, bottom, top"]),
+    ("supports..gap", 0.0, ["bad path"]),
+])
+def test_bad_paths_and_values_say_what_exists(path, value, words):
+    with pytest.raises(pq.SceneError) as exn:
+        set_param(fig5(), path, value)
+    for w in words:
+        assert w in str(exn.value)
+
+
+@pytest.mark.parametrize("value, number", [("rigid", np.inf), ("inf", np.inf), (" Infinity ", np.inf), ("2.5", 2.5),
+                                           (3, 3.0), (np.float32(0.5), 0.5)])
+def test_as_number(value, number):
+    assert as_number(value) == number
