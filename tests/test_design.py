@@ -79,3 +79,46 @@ def test_most_uniform_stiffness_against_a_scan():
     assert R.std() / R.mean() == pytest.approx(best.cv, rel=1e-9)
     # without the column the plate floats on equal springs: softer is always more uniform
     assert most_uniform_stiffness(contour(), (10.0, 1e6), scan=9).at_bound
+
+
+def test_regulate_gaps_needs_no_cvxpy(monkeypatch):
+    """The projection onto equilibrium is solved in-house (Lemke), so it runs without cvxpy."""
+    monkeypatch.setitem(__import__("sys").modules, "cvxpy", None)  # `import cvxpy` now fails
+    sc = contour(stiffness=1e4, loads=[pq.UniformLoad(q=10.0), pq.PointLoad(P=5.0, x=0.75, y=0.5)])
+    reg = regulate_gaps(sc, 15.0 / 16, backend="lemke")
+    assert not reg.reachable
+    assert reg.reactions.sum() == pytest.approx(15.0, rel=1e-9)
+    _check_regulated(reg, np.arange(16), reg.reactions)
+
+
+def test_regulate_gaps_cannot_balance_an_uplift():
+    sc = contour(loads=[pq.UniformLoad(q=-10.0)])  # the load lifts the floating plate off
+    with pytest.raises(pq.NoEquilibriumError, match="no reactions R ≥ 0 of these supports balance the load"):
+        regulate_gaps(sc, 1.0)
+
+
+@pytest.mark.parametrize("seed, n_other", [(0, 0), (1, 0), (2, 3), (3, 5)])
+def test_project_reactions_meets_its_optimality_conditions(seed, n_other):
+    """The projection's KKT conditions, checked as a certificate (the problem is convex):
+    R ≥ 0, A R = b, and multipliers y with λ = P (R − R*) − Aᵀ y ≥ 0, zero where R > 0."""
+    from plateqp.studies.design import project_reactions
+
+    rng = np.random.default_rng(seed)
+    r, k = 8, 3
+    n = r + n_other
+    A = rng.normal(size=(k, n))
+    A[0] = np.abs(A[0]) + 0.1  # a force balance: every reaction pushes the same way
+    b = A @ rng.uniform(0.0, 2.0, n)  # feasible
+    target = rng.uniform(0.0, 2.0, r) * (rng.uniform(size=r) > 0.3)
+    target *= 2.0 * b[0] / (A[0, :r] @ target)  # twice the force the supports may carry: unreachable
+    R = project_reactions(A, b, target, n_other)
+    scale = np.abs(R).max()
+    assert R.min() >= 0
+    np.testing.assert_allclose(A @ R, b, rtol=0, atol=1e-10 * np.abs(b).max())
+    grad = np.concatenate([R[:r] - target, np.zeros(n_other)])
+    pos = R > 1e-10 * scale
+    y, *_ = np.linalg.lstsq(A[:, pos].T, grad[pos], rcond=None)
+    lam = grad - A.T @ y
+    np.testing.assert_allclose(lam[pos], 0.0, atol=1e-9 * max(1.0, np.abs(grad).max()))
+    assert lam[~pos].min(initial=0.0) >= -1e-9 * max(1.0, np.abs(grad).max())
+    assert (A[0, :r] @ R[:r]) <= b[0] * (1 + 1e-12) and not np.allclose(R[:r], target)  # a real projection
