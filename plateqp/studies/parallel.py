@@ -99,7 +99,7 @@ def make_runner(executor, n: int, max_workers: int, payload):
                           PlateQPWarning, stacklevel=3)
             return Serial()
         return Futures(cf.ProcessPoolExecutor(max_workers=max_workers, mp_context=mp_context()), True, False,
-                        max_workers)
+                       max_workers)
     if is_dask(executor):
         try:
             workers = max(1, sum(executor.nthreads().values()))
