@@ -270,7 +270,15 @@ class Scene:
             ys.append(y)
         if not xs:
             return []
-        return (grid.locate(xs, ys)[0] >= 0).tolist()
+        import numpy as np
+
+        xs, ys = np.array(xs, dtype=float), np.array(ys, dtype=float)
+        # far off the plate: not covered, and not handed to locate (cell indices would overflow)
+        near = (np.abs(xs) <= 4 * grid.a) & (np.abs(ys) <= 4 * grid.b)
+        out = np.zeros(xs.shape, dtype=bool)
+        if near.any():
+            out[near] = grid.locate(xs[near], ys[near])[0] >= 0
+        return out.tolist()
 
     def validate(self) -> None:
         """Check every field; raises SceneError naming the first bad one."""

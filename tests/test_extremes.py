@@ -168,13 +168,17 @@ def test_soft_supports_tend_to_no_support(backend, formulation):
 
 @pytest.mark.parametrize("backend,formulation", IN_HOUSE)
 def test_soft_and_rigid_supports_in_one_scene(backend, formulation):
-    """Flexibilities from 0 to 1e8 a²/D side by side: every in-house solver is exact."""
+    """Flexibilities from 0 to 1e8 a²/D side by side: every exact in-house solver is exact.
+
+    PGS (iterative) gets the reactions but leaves the soft springs' gaps open by 2.5e-3 of the
+    deflection scale where they touch; the KKT check's natural residual in deflection units
+    (issue 10) flags that INACCURATE, which is the truth about its reported gaps."""
     sc = grid_scene()
     for i, s in enumerate(sc.supports):
         s.stiffness = "rigid" if i % 2 else 1e-8 * sc.plate.D
     ref = run(sc, "pdas", "primal").reactions
     res = run(sc, backend, formulation)
-    assert res.status == pq.Status.OPTIMAL
+    assert res.status == pq.Status.OPTIMAL or (backend == "pgs" and res.status == pq.Status.INACCURATE)
     np.testing.assert_allclose(res.reactions, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
 
 

@@ -98,8 +98,8 @@ class Scaled:
 
 def contact_spacing(model: Model) -> np.ndarray:
     """Distance from each contact point to the nearest other point that holds the plate: another
-    contact point, or a node whose deflection is prescribed (edges, pins); the plate's size
-    where there is none."""
+    contact point, a node whose deflection is prescribed (pins, edges), or a held edge's line;
+    the plate's size where there is none."""
     from scipy.spatial import cKDTree
 
     c = model.contacts
@@ -110,7 +110,14 @@ def contact_spacing(model: Model) -> np.ndarray:
     if pts.shape[0] < 2:
         return np.full(c.m, max(p.a, p.b))
     d, _ = cKDTree(pts).query(c.xy, k=2)
-    return np.where(d[:, 1] > 0, d[:, 1], max(p.a, p.b))
+    s = np.where(d[:, 1] > 0, d[:, 1], max(p.a, p.b))
+    # an edge held along its length holds the plate between its nodes too: nearer than its nodes
+    x, y = c.xy[:, 0], c.xy[:, 1]
+    for name, dist in (("left", x), ("right", p.a - x), ("bottom", y), ("top", p.b - y)):
+        e = model.scene.edges.get(name)
+        if e is not None and e.kind != "free":
+            s = np.where(dist > 0, np.minimum(s, dist), s)
+    return s
 
 
 def deflection_scale(model: Model, floating: bool) -> tuple[float, float]:
