@@ -288,10 +288,6 @@ class Scene:
         self._num("plate.nu", p.nu)
         if not (-1.0 < p.nu < 0.5):
             self._fail("plate.nu", f"must lie in (-1, 0.5) (got {p.nu})")
-        logD = math.log10(p.E) + 3 * math.log10(p.h) - math.log10(12.0 * (1.0 - p.nu**2))
-        if not (math.log10(SAFE_DERIVED[0]) <= logD <= math.log10(SAFE_DERIVED[1])):
-            self._fail("plate", f"the bending stiffness D = E h³/12(1 − ν²) = 1e{logD:.0f} is outside "
-                       f"{SAFE_DERIVED[0]:.0e} … {SAFE_DERIVED[1]:.0e}; change units")
         m = self.mesh
         for k in ("nx", "ny"):
             v = getattr(m, k)
@@ -409,11 +405,15 @@ class Scene:
         self._check_scales()
 
     def _check_scales(self) -> None:
-        """The load's deflection scale 0.01 F L²/D and each spring's flexibility relative to the
-        plate's, D/(c L²), must lie in :data:`SAFE_DERIVED` (computed in logarithms)."""
+        """The bending stiffness D, the load's deflection scale 0.01 F L²/D and each spring's
+        flexibility relative to the plate's, D/(c L²), must lie in :data:`SAFE_DERIVED`
+        (computed in logarithms)."""
         p = self.plate
         lo, hi = math.log10(SAFE_DERIVED[0]), math.log10(SAFE_DERIVED[1])
         logD = math.log10(p.E) + 3 * math.log10(p.h) - math.log10(12.0 * (1.0 - p.nu**2))
+        if not lo <= logD <= hi:
+            self._fail("plate", f"the bending stiffness D = E h³/12(1 − ν²) = 1e{logD:.0f} is outside "
+                       f"{SAFE_DERIVED[0]:.0e} … {SAFE_DERIVED[1]:.0e}; change units")
         logL = math.log10(max(p.a, p.b))
         for i, ld in enumerate(self.loads):
             mag = abs(ld.P) if isinstance(ld, PointLoad) else abs(ld.q)
