@@ -312,10 +312,17 @@ def test_nearly_coincident_rigid_supports_are_refused(backend, formulation):
 
 @pytest.mark.parametrize("backend,formulation", PAIRS)
 def test_close_rigid_supports_are_solved(backend, formulation):
-    """1e-3 of a cell apart: well enough determined; exact solvers agree, nobody claims wrong."""
+    """1e-3 of a cell apart: well enough determined; exact solvers agree, nobody claims wrong.
+
+    The reference is Lemke on the dual with the pair's split taken from the scene's symmetry
+    (equal shares): the dual's matrix holds the two nearly equal rows of B K⁻¹ Bᵀ, so its own
+    split carries rounding of about ε·cond ≈ 4e-10 of the reaction (measured: 3.6e-10 with
+    NumPy 2.4 / SciPy 1.17), while their sum is determined to rounding."""
     sc = pair_scene(1e-3 / 8)
     ref = run(sc, "lemke", "dual").reactions
     assert (ref[[8, 9]] > 0).all()  # both in contact: the split matters
+    assert abs(ref[8] - ref[9]) <= 1e-8 * ref.max()  # the dual's split: right to its conditioning
+    ref[[8, 9]] = ref[[8, 9]].mean()  # by symmetry
     np.testing.assert_allclose(run(sc, "pdas", "primal").reactions, ref, rtol=0, atol=1e-10 * ref.max())
     check_claim(run(sc, backend, formulation), ref)
 
