@@ -215,9 +215,12 @@ def cmd_solve(args) -> int:
 
 
 def cmd_demo(args) -> int:
-    from .demo import run
+    from .demo import DEFAULT_OUT, output_files, run
 
-    return run([args.name] if args.name else None, Path(args.out) if args.out else None)
+    names = [args.name] if args.name else None
+    files = output_files(names)  # an unknown scene: SceneError before any folder is made
+    out = _out_dir(args.out or DEFAULT_OUT, files, args.force)  # before any work
+    return run(names, out)
 
 
 def cmd_backends(args) -> int:
@@ -339,7 +342,9 @@ def main(argv=None) -> int:
     sub = ap.add_subparsers(dest="cmd", required=True)
     d = sub.add_parser("demo", help="solve a built-in scene and print a summary")
     d.add_argument("name", nargs="?", help=f"one of: {', '.join(scenes.names())} (default: all)")
-    d.add_argument("--out", help="folder for the reports")
+    d.add_argument("--out", metavar="DIR", help="folder for the figures, JSON files and report.html "
+                   "(default: ./plateqp-demo)")
+    d.add_argument("--force", action="store_true", help="--out: overwrite files that exist")
     s = sub.add_parser("solve", help="solve a scene file (or a built-in scene)")
     s.add_argument("scene", help="a scene file, or the name of a built-in scene")
     s.add_argument("--backend", default="auto")
