@@ -311,22 +311,21 @@ def _scene_or_builtin(text: str) -> Scene:
 def cmd_export(args) -> int:
     """``plateqp export``: the contact problem as a QPS file or a qpbenchmark test set."""
     from .errors import ExportError
-    from .export import contact_qp, write_qpbenchmark, write_qps
+    from .io import check_testset_dir, contact_qp, write_qpbenchmark, write_qps
+    from .io.files import check_file
 
     out = Path(args.out)
-    if args.format == "qpbenchmark" and (not args.testset.isidentifier() or args.testset.startswith("_")):
-        raise ExportError(f"--testset {args.testset!r}: must be a Python identifier (qpbenchmark imports it)")
     if args.format == "qps":
-        if out.is_dir():
-            raise ExportError(f"--out {out}: is a directory; --format qps writes one file")
-        if out.exists() and not args.force:
-            raise ExportError(f"--out {out}: exists; use --force to overwrite it")
-    elif out.exists() and (not out.is_dir() or any(out.iterdir())) and not args.force:
-        raise ExportError(f"--out {out}: exists and is not an empty directory; use --force to write into it")
+        check_file(out, force=args.force, label=f"--out {out}", flag="--force")
+    else:
+        check_testset_dir(out, args.testset, force=args.force, label=f"--out {out}")
     scene = _scene_or_builtin(args.scene)
     exported = contact_qp(scene, args.formulation, name=args.name)
     if args.format == "qps":
-        out.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            out.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exn:
+            raise ExportError(f"--out {out}: cannot make its folder ({exn.strerror or exn})") from None
         path = write_qps(exported, out)
     else:
         path = write_qpbenchmark([exported], out, name=args.testset, force=args.force)
