@@ -17,7 +17,6 @@ import argparse
 import contextlib
 import json
 import os
-import re
 import sys
 import warnings
 from pathlib import Path
@@ -31,6 +30,8 @@ from .contact import formulations_for
 from .solving import solve
 from .errors import NoEquilibriumError, PlateQPError, ProblemError, SceneError, SolverError
 from .scene import Scene
+from .io.files import safe_filename
+from .io.vtk import vtu_files, write_vtu
 
 
 def _probe(text: str) -> tuple[float, float]:
@@ -83,15 +84,6 @@ def _backend_name(name: str) -> str:
             raise ProblemError(f"--backend: {exn}") from None
     return name
 
-
-#: Characters allowed in a file name made from a scene's name.
-_SAFE = re.compile(r"[^A-Za-z0-9._-]+")
-
-
-def safe_filename(name: str) -> str:
-    """A scene name as a plain file name: no directories, no leading dot, at most 100 characters."""
-    out = _SAFE.sub("_", str(name)).lstrip(".")[:100]
-    return out or "scene"
 
 
 def _out_dir(text: str, files: list[str], force: bool) -> Path:
@@ -169,13 +161,25 @@ def _summary(result, probes=()) -> str:
     return "\n".join(lines)
 
 
+def _have_meshio() -> bool:
+    try:
+        import meshio  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 def cmd_solve(args) -> int:
     _set_memory_limit(args.max_memory)
     scene = _scene_or_builtin(args.scene)
     opts = _options(args.options)
     _backend_name(args.backend)
     stem = safe_filename(scene.name)
-    out = _out_dir(args.out, [f"{stem}.json", f"{stem}-w.npy"], args.force) if args.out else None
+    vtu = bool(args.out) and _have_meshio()
+    if args.out and not vtu:
+        print("plateqp: meshio is not installed: no .vtu written (pip install 'plateqp[results]')", file=sys.stderr)
+    files = [f"{stem}.json", f"{stem}-w.npy"] + (vtu_files(stem) if vtu else [])
+    out = _out_dir(args.out, files, args.force) if args.out else None
     reached = True
     with warnings.catch_warnings(), _stdout_to_stderr():
         warnings.simplefilter("ignore")  # the status says it; the warning would repeat it on stderr
@@ -211,6 +215,8 @@ def cmd_solve(args) -> int:
     if out is not None:
         (out / f"{stem}.json").write_text(json.dumps(result.to_dict(args.probe), indent=1))
         np.save(out / f"{stem}-w.npy", result.w_nodes())
+        if vtu:
+            write_vtu(result, out, stem, force=True)  # the folder was checked before any work
     return 0 if result.status in (Status.OPTIMAL,) and reached else 5
 
 
@@ -358,7 +364,8 @@ def main(argv=None) -> int:
     s.add_argument("--probe", type=_probe, action="append", default=[], metavar="X,Y")
     s.add_argument("--options", help="backend options as a JSON object, passed through untouched")
     s.add_argument("--json", action="store_true")
-    s.add_argument("--out", metavar="DIR", help="write <name>.json and <name>-w.npy (nodal w) into DIR")
+    s.add_argument("--out", metavar="DIR", help="write <name>.json, <name>-w.npy (nodal w) and, with meshio, "
+                   "<name>.vtu and <name>-supports.vtu (ParaView) into DIR")
     s.add_argument("--force", action="store_true", help="--out: overwrite files that exist")
     s.add_argument("--max-memory", metavar="BYTES",
                    help="refuse meshes estimated to need more (e.g. 8G; default 80%% of this machine's memory)")

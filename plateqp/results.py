@@ -191,6 +191,30 @@ class Result:
             d["discretisation_error"] = self.extras.get("discretisation_error")
         return d
 
+    # -- in the tools users already use (plateqp.io.fields, plateqp.io.vtk) -----------------------
+    def to_xarray(self, quantities=post.QUANTITIES):
+        """The nodal fields (w, moments, stresses, σ1, σ2) as an :class:`xarray.Dataset` on the
+        node coordinates, NaN off the plate: :func:`plateqp.io.fields.to_xarray`."""
+        from .io.fields import to_xarray
+        return to_xarray(self, quantities)
+
+    @property
+    def supports(self):
+        """One row per one-sided contact point (1-based support numbers, position, stiffness,
+        gaps, reaction, contact) as a :class:`pandas.DataFrame`:
+        :func:`plateqp.io.fields.supports_frame`."""
+        from .io.fields import supports_frame
+        return supports_frame(self)
+
+    def write_vtu(self, folder, stem: str | None = None, force: bool = False) -> list:
+        """``<stem>.vtu`` (the plate and its fields) and ``<stem>-supports.vtu`` into ``folder``
+        for ParaView / pyvista; nothing overwritten unless ``force``:
+        :func:`plateqp.io.vtk.write_vtu`. ``stem`` defaults to the scene's name made a plain
+        file name."""
+        from .io.files import safe_filename
+        from .io.vtk import write_vtu
+        return write_vtu(self, folder, stem or safe_filename(self.scene.name), force=force)
+
 
 def _unwrap(v):
     a = np.asarray(v)

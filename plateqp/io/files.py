@@ -9,9 +9,19 @@ that exists (a dangling one too: writing through it would write somewhere else).
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path, PurePath
 
 from ..errors import ExportError
+
+#: Characters allowed in a file name made from a scene's name.
+_SAFE = re.compile(r"[^A-Za-z0-9._-]+")
+
+
+def safe_filename(name: str) -> str:
+    """A scene name as a plain file name: no directories, no leading dot, at most 100 characters."""
+    out = _SAFE.sub("_", str(name)).lstrip(".")[:100]
+    return out or "scene"
 
 
 def _usable_folder(folder: Path, label: str) -> None:

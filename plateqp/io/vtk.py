@@ -1,0 +1,104 @@
+"""A solved plate as VTK files for ParaView or pyvista, written through meshio.
+
+:func:`write_vtu` writes two VTK unstructured-grid files:
+
+- ``<stem>.vtu``: the plate's kept cells (quads) on its nodes, z = 0, with the nodal fields
+  (:data:`plateqp.post.QUANTITIES`: w, moments, surface stresses, σ1, σ2; averaged over the
+  cells around a node) and ``displacement`` = (0, 0, −w) for ParaView's "Warp By Vector" (w is
+  positive downward, z up); for a tensionless bed also the bed's ``reaction`` and ``contact``
+  (1 in contact, 0 lifted, NaN where the bed does not reach) at its nodes;
+- ``<stem>-supports.vtu`` (when the scene has discrete one-sided supports): one vertex per
+  support at its position with its ``number`` (1-based, as in the figures), ``reaction``,
+  ``initial_gap``, ``gap``, ``stiffness`` and ``contact``.
+
+Both are plain XML VTK files, opened by ParaView, pyvista or meshio without conversion.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ExportError
+from .files import safe_filename
+from .fields import _grid, _optional, node_fields, supports_columns
+
+
+def vtu_files(stem: str, result=None) -> list[str]:
+    """The names :func:`write_vtu` writes for ``stem`` (both when ``result`` is None: the files it
+    may write, for checking a folder before any work)."""
+    names = [f"{stem}.vtu"]
+    if result is None or _has_supports(result):
+        names.append(f"{stem}-supports.vtu")
+    return names
+
+
+def _has_supports(result) -> bool:
+    c = result.model.contacts
+    return c is not None and bool(np.any(np.asarray(c.source) == "support"))
+
+
+def plate_mesh(result):
+    """The meshio Mesh of the plate (see the module docstring)."""
+    meshio = _optional("meshio")
+    g = _grid(result)
+    model = result.model
+    keep = g.node_mask()
+    new = np.full(g.n_nodes, -1, dtype=np.int64)
+    new[keep] = np.arange(int(keep.sum()))
+    xy = g.node_xy()[keep]
+    points = np.column_stack([xy, np.zeros(len(xy))])
+    quads = new[g.cell_nodes()[model.cells]]
+    data = {q: v.ravel()[keep] for q, v in node_fields(result).items()}
+    data["displacement"] = np.column_stack([np.zeros(len(xy)), np.zeros(len(xy)), -data["w"]])
+    c = model.contacts
+    if c is not None and np.any(np.asarray(c.source) == "bed"):
+        bed = np.asarray(c.source) == "bed"
+        nodes = np.asarray(c.index)[bed].astype(np.int64)
+        react = np.full(g.n_nodes, np.nan)
+        contact = np.full(g.n_nodes, np.nan)
+        react[nodes] = np.asarray(result.reactions, dtype=float)[bed]
+        contact[nodes] = np.asarray(result.active, dtype=float)[bed]
+        data["reaction"] = react[keep]
+        data["contact"] = contact[keep]
+    return meshio.Mesh(points, [("quad", quads)], point_data=data)
+
+
+def supports_mesh(result):
+    """The meshio Mesh of the discrete one-sided supports as vertices (see the module docstring)."""
+    meshio = _optional("meshio")
+    cols = supports_columns(result)
+    sel = cols["source"] == "support"
+    n = int(sel.sum())
+    points = np.column_stack([cols["x"][sel], cols["y"][sel], np.zeros(n)])
+    data = {k: np.asarray(cols[k][sel], dtype=float) for k in ("number", "reaction", "initial_gap", "gap",
+                                                                 "stiffness")}
+    data["contact"] = cols["active"][sel].astype(float)
+    return meshio.Mesh(points, [("vertex", np.arange(n).reshape(-1, 1))], point_data=data)
+
+
+def write_vtu(result, folder, stem: str, force: bool = False) -> list[Path]:
+    """Write ``<stem>.vtu`` (and ``<stem>-supports.vtu``) into ``folder``; returns the paths.
+
+    Nothing is overwritten unless ``force``; every target is checked before the first is
+    written. Raises :class:`~plateqp.errors.ExportError` for a target that exists or cannot be
+    written, :class:`~plateqp.errors.PlateQPError` when meshio is missing.
+    """
+    meshio = _optional("meshio")
+    if safe_filename(stem) != stem:
+        raise ExportError(f"{stem!r}: not a plain file name (letters, digits, '._-', no leading dot); "
+                          f"for example {safe_filename(stem)!r}")
+    folder = Path(folder)
+    paths = [folder / name for name in vtu_files(stem, result)]
+    if not force:
+        for p in paths:
+            if p.exists() or p.is_symlink():
+                raise ExportError(f"{p}: exists; use --force to overwrite")
+    meshes = [plate_mesh(result)] + ([supports_mesh(result)] if len(paths) > 1 else [])
+    for p, mesh in zip(paths, meshes):
+        try:
+            meshio.write(p, mesh, file_format="vtu")
+        except OSError as exn:
+            raise ExportError(f"{p}: cannot be written ({exn.strerror or exn})") from None
+    return paths
