@@ -160,9 +160,7 @@ for sc in (heave, settle):
     total = 20000.0 + 0.05 * 400.0**2
     assert abs(one.reactions.sum() - total) < 1e-8 * total     # statics: a floating plate"""),
 md("## Deflection along a section through the load (solid one-sided, dashed two-sided)"),
-code("""import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
+code("""import matplotlib.pyplot as plt  # the notebook's own (inline) backend: the figure shows
 fig, ax = plt.subplots(figsize=(6, 3))
 for sc, colour in ((heave, "C0"), (settle, "C1")):
     one = pq.solve(sc, backend="lemke", formulation="condensed")
@@ -172,7 +170,8 @@ for sc, colour in ((heave, "C0"), (settle, "C1")):
     ax.plot(s, w1, colour, label=f"{sc.name}, one-sided")
     ax.plot(s, w2, colour, ls="--", label=f"{sc.name}, two-sided")
 ax.invert_yaxis(); ax.set_xlabel("x along y = 250 cm [cm]"); ax.set_ylabel("w [cm] (down)")
-ax.legend(fontsize=7); fig.tight_layout()"""),
+ax.legend(fontsize=7); fig.tight_layout()
+plt.show()"""),
 ])
 
 save("04_backends_compared.ipynb", [

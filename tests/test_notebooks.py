@@ -23,3 +23,8 @@ def test_notebook_runs(path, tmp_path):
     client = nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
                                      resources={"metadata": {"path": str(tmp_path)}})
     client.execute()  # raises CellExecutionError on any failing cell
+    if "matplotlib" in "".join(c.source for c in nb.cells if c.cell_type == "code"):
+        # a notebook that draws must show its figure (a figure drawn on the Agg backend never did)
+        images = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
+                  if "image/png" in o.get("data", {})]
+        assert images, f"{path.name} draws a figure that is never shown"
