@@ -220,6 +220,75 @@ def cmd_solve(args) -> int:
     return 0 if result.status in (Status.OPTIMAL,) and reached else 5
 
 
+def _numbers(text: str, what: str, cast=float) -> list:
+    try:
+        vals = [cast(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise PlateQPError(f"{what}: a comma-separated list of numbers (got {text!r})") from None
+    if not vals:
+        raise PlateQPError(f"{what}: empty")
+    return vals
+
+
+def cmd_regulate(args) -> int:
+    """Gaps that make the chosen supports carry the target reactions, checked by solving the
+    regulated scene (:func:`plateqp.studies.regulate_gaps`)."""
+    from .io.files import check_file
+    from .studies import regulate_gaps
+
+    scene = _scene_or_builtin(args.scene)
+    target = _numbers(args.target, "--target")
+    ns = len(scene.supports)
+    chosen = None
+    if args.supports is not None:
+        numbers = _numbers(args.supports, "--supports", int)
+        if any(k < 1 or k > ns for k in numbers) or len(set(numbers)) != len(numbers):
+            raise PlateQPError(f"--supports: distinct support numbers 1..{ns} (got {args.supports})")
+        chosen = [k - 1 for k in numbers]
+    n_reg = ns if chosen is None else len(chosen)
+    if len(target) not in (1, n_reg):
+        raise PlateQPError(f"--target: one value, or one per regulated support ({n_reg}); got {len(target)}")
+    if args.out:
+        check_file(args.out, force=args.force, label=f"--out {args.out}", flag="--force")
+    _backend_name(args.backend)
+    with warnings.catch_warnings(), _stdout_to_stderr():
+        warnings.simplefilter("ignore")
+        reg = regulate_gaps(scene, target if len(target) > 1 else target[0], supports=chosen,
+                            backend=args.backend, formulation=args.formulation)
+        check = solve(reg.scene, backend=args.backend, formulation=args.formulation, accuracy="high")
+    got = check.reactions[reg.supports]
+    scale = max(float(np.abs(reg.reactions).max(initial=0.0)), float(np.abs(check.reactions).max(initial=0.0)), 1e-300)
+    error = float(np.abs(got - reg.reactions).max(initial=0.0) / scale)
+    ok = check.status == Status.OPTIMAL and error <= 1e-6
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        reg.scene.to_toml(args.out)
+    rows = [{"support": int(k) + 1, "gap_before": float(scene.supports[k].gap), "gap": float(reg.gaps[k]),
+             "target": float(t), "reaction": float(r), "reaction_check": float(g)}
+            for k, t, r, g in zip(reg.supports, reg.target, reg.reactions, got)]
+    if args.json:
+        print(json.dumps({"scene": scene.name, "reachable": reg.reachable, "projection": reg.projection,
+                          "status": check.status.value, "check_error": error, "supports": rows,
+                          "gaps": [float(g) for g in reg.gaps], "out": args.out}, indent=1))
+    else:
+        print(f"{scene.name}: gaps for {len(rows)} regulated supports (numbers from 1)")
+        print(f"{'support':>7} {'gap before':>12} {'gap':>12} {'target R':>12} {'R':>12} {'R check':>12}")
+        for r in rows:
+            print(f"{r['support']:>7} {r['gap_before']:12.5g} {r['gap']:12.5g} {r['target']:12.5g} "
+                  f"{r['reaction']:12.5g} {r['reaction_check']:12.5g}")
+        print(f"check: {check.status.value}, reactions within {error:.1e} of the regulated ones"
+              + (f"; the regulated scene is in {args.out}" if args.out else ""))
+    if not reg.reachable:
+        print(f"plateqp: regulate: the target is not in equilibrium with the load: the nearest reachable "
+              f"reactions are used (relative distance {reg.projection:.2e})", file=sys.stderr)
+        return 5
+    if not ok:
+        print(f"plateqp: regulate: solving the regulated scene gave reactions {error:.1e} off "
+              f"(status {check.status.value})", file=sys.stderr)
+        return 5
+    return 0
+
+
 def cmd_demo(args) -> int:
     from .demo import DEFAULT_OUT, output_files, run
 
@@ -397,13 +466,23 @@ def main(argv=None) -> int:
     x.add_argument("--name", help="problem name (default: SCENE_FORMULATION)")
     x.add_argument("--testset", default="plateqp_contact", help="qpbenchmark test-set module name")
     x.add_argument("--force", action="store_true", help="overwrite an existing file / write into a non-empty directory")
+    r = sub.add_parser("regulate", help="gaps that make chosen supports carry target reactions (checked by a solve)")
+    r.add_argument("scene", help="a scene file, or the name of a built-in scene")
+    r.add_argument("--target", required=True, metavar="R[,R...]",
+                   help="target reactions (compression >= 0): one for all, or one per regulated support")
+    r.add_argument("--supports", metavar="N[,N...]", help="the regulated supports, numbered from 1 (default: all)")
+    r.add_argument("--backend", default="auto")
+    r.add_argument("--formulation", default="auto", choices=["auto", "primal", "condensed", "dual"])
+    r.add_argument("--json", action="store_true")
+    r.add_argument("--out", metavar="FILE.toml", help="write the regulated scene (checked before any work)")
+    r.add_argument("--force", action="store_true", help="--out: overwrite the file if it exists")
     b = sub.add_parser("backends", help="list the backends and the formulations each takes")
     b.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
     saved_limit = os.environ.get("PLATEQP_MAX_MEMORY")  # --max-memory holds for this command only
     try:
         return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends,
-                "export": cmd_export}[args.cmd](args)
+                "export": cmd_export, "regulate": cmd_regulate}[args.cmd](args)
     except KeyboardInterrupt:
         print("plateqp: interrupted", file=sys.stderr)
         return 130
