@@ -22,7 +22,7 @@ from .formulations import ContactSolution, Formulation, formulate
 from .kkt import kkt_report
 from .routing import choose, formulations_for
 from .scaling import Scaled
-from .statics import NO_EQUILIBRIUM, equilibrium_possible
+from .statics import NO_EQUILIBRIUM, supports_reach
 
 
 def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto",
@@ -31,16 +31,21 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     """Solve the contact problem of a built model; see :func:`plateqp.solve`.
 
     ``check_statics``: before solving, check by statics that the supports can carry the load
-    at all (:func:`plateqp.contact.statics.equilibrium_possible`) and raise NoEquilibriumError at once
+    at all (:func:`plateqp.contact.statics.supports_reach`) and raise NoEquilibriumError at once
     if not. Whatever it is set to, a backend's claim of "no equilibrium" is checked against
-    the same statics, and a false claim is a SolverError, never a NoEquilibriumError.
+    the same statics, and a false claim is a SolverError, never a NoEquilibriumError. Within
+    the asked accuracy of the edge of the supports' reach statics cannot tell, and the
+    backend's verdict stands either way.
     """
     acc = Accuracy.parse(accuracy)  # ProblemError for a bad one, before any work
     t0 = time.perf_counter()
     data = Scaled.from_model(model)
-    possible, why = equilibrium_possible(data)
-    if check_statics and not possible:
-        raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({why}; found by statics, before any solve)")
+    reach = supports_reach(data, band=acc.tol)
+    if check_statics and not reach.possible and not reach.marginal:
+        raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({reach.why}; found by statics, before any solve)")
+    # within the band of the asked accuracy around the edge of the supports' reach, statics cannot
+    # tell, and a solver's own verdict stands: "no equilibrium" there is no solver failure
+    possible, why = reach.certain, reach.why
     asked_backend, asked_formulation = backend, formulation
     backend, formulation = choose(data, backend, formulation)
     b = get_backend(backend)

@@ -1,0 +1,102 @@
+"""Statics of one-sided supports (plateqp.contact.statics), against statics by hand.
+
+* The edge of the supports' reach: a floating plate on four posts at the corners of
+  [0.25, 0.75]², a point load P at (0.75 + d, 0.5). For d > 0 the load lies outside the posts'
+  hull and there is no equilibrium; for d ≤ 0 the lever rule and the scene's symmetry give
+  the reactions: each post at x = 0.25 carries P·(−d), each at x = 0.75 carries P/2 + P·d.
+  At every distance 1e-12 … 1e-6 on either side, no solver that was right may be blamed
+  (SolverError, exit 4), the statics pre-check must say "no equilibrium" wherever that is
+  certain, and every answer given must satisfy the lever rule.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import plateqp as pq
+from plateqp.accuracy import Status
+from plateqp.backends.base import RawSolution
+
+P = 10.0
+POSTS = [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]
+DISTANCES = [1e-6, 1e-8, 1e-10, 1e-12, 0.0, -1e-12, -1e-10, -1e-8, -1e-6]
+EXACT = ["bpp", "lemke", "pdas"]
+
+
+def posts(d: float) -> pq.Scene:
+    return pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(8, 8),
+                    loads=[pq.PointLoad(P, 0.75 + d, 0.5)], supports=[pq.Support(x, y) for x, y in POSTS])
+
+
+def lever_rule(d: float) -> np.ndarray:
+    """Reactions of the four posts (scene order) for a load at (0.75 + d, 0.5), d ≤ 0."""
+    left, right = -P * d, P / 2 + P * d
+    return np.array([left, right, right, left])
+
+
+@pytest.mark.parametrize("backend", EXACT + ["osqp"])
+@pytest.mark.parametrize("d", DISTANCES)
+def test_no_solver_is_blamed_at_the_edge_of_the_supports_reach(backend, d):
+    if backend not in pq.available_backends():
+        pytest.skip(f"{backend} is not installed")
+    try:
+        res = pq.solve(posts(d), backend=backend)
+    except pq.NoEquilibriumError as exn:
+        assert d > 0, f"{backend}: no equilibrium claimed for a load inside the posts' hull ({exn})"
+        return
+    except pq.SolverError as exn:  # before: bpp, lemke, pdas at d = 1e-10 ("the solver failed")
+        pytest.fail(f"{backend} blamed at d = {d:g}: {exn}")
+    # an answer: only where statics cannot tell (on the edge, within 1e-10 outside) or inside
+    assert d <= 1e-10, f"{backend} answered for a load {d:g} outside the hull: the pre-check must refuse it"
+    assert res.status == Status.OPTIMAL
+    np.testing.assert_allclose(res.reactions, lever_rule(min(d, 0.0)), rtol=0, atol=1e-5 * P)
+    assert res.reactions.sum() == pytest.approx(P, rel=1e-5)  # 10 × the asked accuracy
+
+
+@pytest.mark.parametrize("d", [1e-8, 1e-6, 1e-3])
+def test_outside_by_more_than_rounding_statics_says_no_before_any_solve(d):
+    with pytest.raises(pq.NoEquilibriumError, match="found by statics"):
+        pq.solve(posts(d), backend="bpp")
+
+
+class _ClaimsNoEquilibrium:
+    """bpp, except that it always answers "infeasible" (a solver whose certificate is approximate)."""
+
+    def __init__(self, real):
+        self._real = real
+
+    def __getattr__(self, name):
+        return getattr(self._real, name)
+
+    def solve(self, problem, accuracy=None, options=None):
+        return RawSolution(Status.INFEASIBLE, solver_status="primal infeasible (claimed)")
+
+
+def test_within_the_asked_accuracy_of_the_edge_the_solvers_verdict_stands(monkeypatch):
+    """Inside the hull by less than the asked accuracy, "no equilibrium" is within a solver's
+    tolerance: NoEquilibriumError (exit 3); well inside, a solver that finds none has failed
+    (SolverError)."""
+    import plateqp.contact.pipeline as pipeline
+
+    real = pipeline.get_backend
+    monkeypatch.setattr(pipeline, "get_backend", lambda name: _ClaimsNoEquilibrium(real(name)))
+    with pytest.raises(pq.NoEquilibriumError):
+        pq.solve(posts(-1e-8), backend="bpp")  # 1e-8 inside, default accuracy 1e-6
+    with pytest.raises(pq.SolverError, match="failed"):
+        pq.solve(posts(-1e-8), backend="bpp", accuracy="high")  # 1e-9: now 1e-8 inside is a margin
+    with pytest.raises(pq.SolverError, match="failed"):
+        pq.solve(posts(-0.25), backend="bpp")  # the load at the centre
+
+
+def test_cli_exit_code_at_the_edge(tmp_path, capsys):
+    """The user sees "no equilibrium" (exit 3), never "the solver failed" (exit 4), for a load
+    1e-10 outside the posts' hull."""
+    from plateqp.cli import main
+
+    f = tmp_path / "edge.toml"
+    posts(1e-10).to_toml(f)
+    for backend in EXACT:
+        code = main(["solve", str(f), "--backend", backend])
+        err = capsys.readouterr().err
+        assert code == 3 and "failed" not in err and err.count("\n") == 1, (backend, code, err)
