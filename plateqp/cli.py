@@ -159,6 +159,9 @@ def _summary(result, probes=()) -> str:
                      f" complementarity {k.complementarity:.1e} (tol {k.tol:.0e}: {'ok' if k.ok else 'NOT MET'})")
         lines.append(f"  {int(result.active.sum())} of {result.active.size} supports in contact;"
                      f" sum of reactions {result.reactions.sum():.6g}")
+        if not result.deflection_unique:
+            lines.append("  reactions unique, deflection not unique: the supports that carry the load leave a rigid"
+                         " motion of the plate free; shown: its lowest position, nearest the level")
         lines.append("  support      x          y        gap0        reaction     in contact")
         sc = result.scene
         for i, s in enumerate(sc.supports):

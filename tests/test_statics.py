@@ -100,3 +100,79 @@ def test_cli_exit_code_at_the_edge(tmp_path, capsys):
         code = main(["solve", str(f), "--backend", backend])
         err = capsys.readouterr().err
         assert code == 3 and "failed" not in err and err.count("\n") == 1, (backend, code, err)
+
+
+# ---------------------------------------------------------------------------------------------
+# Reactions unique, deflection not unique
+# ---------------------------------------------------------------------------------------------
+
+CORNERS = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+
+
+def on_corners(x: float, y: float, posts=CORNERS) -> pq.Scene:
+    return pq.Scene(name="free-tilt", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(8, 8),
+                    loads=[pq.PointLoad(P, x, y)], supports=[pq.Support(px, py) for px, py in posts])
+
+
+#: name → (scene, reactions by statics alone). The load on corner post 0 is carried by it
+#: alone; the load at the middle of the edge y = 0 by the two posts of that edge (moment about
+#: that edge: R2 + R3 = 0 with R ≥ 0); the load on the line between two posts by them. Each
+#: leaves a tilt of the plate free (one way, or both for the two posts alone).
+TILTS = {
+    "on a corner post": (on_corners(0.0, 0.0), [P, 0.0, 0.0, 0.0]),
+    "between two posts": (on_corners(0.5, 0.0), [P / 2, P / 2, 0.0, 0.0]),
+    "on the line of two posts": (on_corners(0.5, 0.5, [(0.0, 0.5), (1.0, 0.5)]), [P / 2, P / 2]),
+}
+PAIRS = [(b, f) for b in pq.available_backends() for f in ("primal", "condensed")
+         if f in __import__("plateqp.contact", fromlist=["formulations_for"]).formulations_for(b)]
+
+
+@pytest.mark.parametrize("name", list(TILTS))
+@pytest.mark.filterwarnings("ignore::plateqp.errors.PlateQPWarning")
+def test_every_backend_gives_the_same_deflection_when_it_is_not_unique(name):
+    """Before: OPTIMAL from every backend, with w_max from 0 to −0.08 (tilted either way).
+    Now: each OPTIMAL answer is flagged, its reactions are those of statics, and its deflection
+    is the canonical one: for the first two scenes that of the same plate with all four posts
+    two-sided (their reactions at the unloaded posts are zero by the same statics, so that
+    answer is one of the one-sided answers, and it is unique); for the last, symmetric about
+    the line of the posts (the scene is, so the least-norm answer is)."""
+    scene, R_ref = TILTS[name]
+    W = 0.01 * P / scene.plate.D  # the load's deflection scale
+    ref = pq.solve_bilateral(scene).w_nodes() if len(R_ref) == 4 else None
+    checked = 0
+    for backend, form in PAIRS:
+        try:
+            res = pq.solve(scene, backend=backend, formulation=form)
+        except pq.PlateQPError:  # refused (floating plate on the condensed form, indefinite P) or failed
+            continue
+        if res.status != Status.OPTIMAL:
+            continue
+        checked += 1
+        assert not res.deflection_unique, (backend, form)
+        np.testing.assert_allclose(res.reactions, R_ref, rtol=0, atol=1e-5 * P, err_msg=f"{backend}/{form}")
+        w = res.w_nodes()
+        if ref is not None:
+            np.testing.assert_allclose(w, ref, rtol=0, atol=1e-5 * W, err_msg=f"{backend}/{form}")
+        else:
+            np.testing.assert_allclose(w, w[::-1, :], rtol=0, atol=1e-5 * W, err_msg=f"{backend}/{form}")
+    assert checked >= 3
+
+
+def test_a_unique_deflection_is_left_alone():
+    res = pq.solve(on_corners(0.4, 0.3), backend="bpp")
+    assert res.deflection_unique and res.to_dict()["deflection_unique"] is True
+    assert pq.solve(posts(-0.25), backend="pdas").deflection_unique
+
+
+def test_cli_says_the_deflection_is_not_unique(tmp_path, capsys):
+    import json
+
+    from plateqp.cli import main
+
+    f = tmp_path / "corner.toml"
+    on_corners(0.0, 0.0).to_toml(f)
+    assert main(["solve", str(f), "--backend", "clarabel", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["deflection_unique"] is False and abs(d["w_max"]) < 1e-5 * 0.01 * P / on_corners(0, 0).plate.D
+    assert main(["solve", str(f), "--backend", "bpp"]) == 0
+    assert "reactions unique, deflection not unique" in capsys.readouterr().out

@@ -22,7 +22,7 @@ from .formulations import ContactSolution, Formulation, formulate
 from .kkt import kkt_report
 from .routing import choose, formulations_for
 from .scaling import Scaled
-from .statics import NO_EQUILIBRIUM, supports_reach
+from .statics import NO_EQUILIBRIUM, settle, supports_reach
 
 
 def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto",
@@ -113,8 +113,19 @@ def finish(model: Model, form: Formulation, raw: RawSolution, accuracy: str | fl
 
 def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, backend: str, formulation: str,
               accuracy: str | float | Accuracy) -> Result:
-    """A contact solution of the scaled problem back in the user's units, as a :class:`Result`."""
-    u = data.dof_scale * c.u
+    """A contact solution of the scaled problem back in the user's units, as a :class:`Result`.
+
+    A solved answer whose deflection is not unique (a rigid motion of a floating plate left free
+    by the supports that carry load) is replaced by the canonical one, the same whatever the
+    backend, and flagged ``deflection_unique = False`` (:func:`plateqp.contact.statics.settle`;
+    the reactions and the KKT report are those of the backend's answer).
+    """
+    acc = Accuracy.parse(accuracy)
+    tol = max(acc.tol, 1e-9)
+    u_s, unique = c.u, True
+    if status.solved and formulation != "bilateral" and np.all(np.isfinite(c.u)) and np.all(np.isfinite(c.R)):
+        u_s, unique = settle(data, c.u, c.R, c.s, tol)
+    u = data.dof_scale * u_s
     R = data.F0 * c.R
     s = data.W * c.s
     w = model.contacts.B @ u
@@ -123,11 +134,10 @@ def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, ba
     res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))
     # in contact: the reaction carries load, or the support touches (gap ≈ 0), both judged at
     # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports)
-    acc = Accuracy.parse(accuracy)
-    tol = max(acc.tol, 1e-9)
     active = (R > tol * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= tol * max(data.W, 1e-300))
     return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
-                  accuracy=acc.asked, reactions=R, gaps=gaps, compressions=s, active=active, residual=res)
+                  accuracy=acc.asked, reactions=R, gaps=gaps, compressions=s, active=active, residual=res,
+                  deflection_unique=unique)
 
 
 def solve_bilateral(model: Model) -> Result:

@@ -131,3 +131,125 @@ def equilibrium_possible(data: Scaled) -> tuple[bool, str]:
     """
     r = supports_reach(data)
     return r.possible, r.why
+
+
+def _null_space(A: np.ndarray, k: int) -> np.ndarray:
+    """An orthonormal basis (k, r) of {z : A z = 0} (A may have no rows)."""
+    if A.shape[0] == 0:
+        return np.eye(k)
+    _, sv, vt = np.linalg.svd(A)
+    rank = int(np.sum(sv > 1e-9 * max(sv.max(initial=0.0), 1e-300)))
+    return vt[rank:].T
+
+
+def _least_distance(E: np.ndarray, f: np.ndarray) -> np.ndarray | None:
+    """min ‖x‖ subject to E x ≥ f (Lawson and Hanson's least distance programming, by NNLS on
+    [Eᵀ; fᵀ] y ≈ e_last); None if the constraints are infeasible."""
+    from scipy.optimize import nnls
+
+    p, r = E.shape
+    if p == 0:
+        return np.zeros(r)
+    M = np.vstack([E.T, f[None, :]])
+    e = np.zeros(r + 1)
+    e[-1] = 1.0
+    y, _ = nnls(M, e, maxiter=50 * p + 100)
+    res = M @ y - e
+    if abs(res[-1]) <= 1e-14:
+        return None
+    return -res[:r] / res[-1]
+
+
+def _cone_is_zero(M: np.ndarray, r: int) -> bool:
+    """True if d = 0 is the only solution of M d ≤ 0 (d in R^r): no direction is left free."""
+    from scipy.optimize import linprog
+
+    if r == 0:
+        return True
+    if M.shape[0] == 0:
+        return False
+    scale = np.maximum(np.linalg.norm(M, axis=1, keepdims=True), 1e-300)
+    for j in range(r):
+        for sign in (1.0, -1.0):
+            c = np.zeros(r)
+            c[j] = -sign
+            res = linprog(c, A_ub=M / scale, b_ub=np.zeros(M.shape[0]), bounds=(-1.0, 1.0), method="highs")
+            if res.status == 0 and -res.fun > 1e-7:
+                return False
+    return True
+
+
+def _least_norm(A: np.ndarray, b: np.ndarray, C: np.ndarray, d: np.ndarray) -> np.ndarray | None:
+    """min ‖b + A y‖ subject to C y ≤ d (A of full column rank, d ≥ 0 so that y = 0 is
+    feasible): with A = Q T and x = T y + Qᵀb a least distance problem in x. None if that
+    fails, or if its answer misses the constraints (least distance programming is delicate
+    where the feasible set is thin)."""
+    r = A.shape[1]
+    Qm, T = np.linalg.qr(A)
+    if r == 0 or np.linalg.matrix_rank(T) < r:
+        return None
+    Ti = np.linalg.inv(T)
+    a = Qm.T @ b
+    CT = C @ Ti
+    x = _least_distance(-CT, -(d + CT @ a))
+    if x is None:
+        return None
+    y = Ti @ (x - a)
+    if C.shape[0] and np.any(C @ y > d + 1e-9 * (1.0 + np.abs(d).max())):
+        return None
+    return y
+
+
+def settle(data: Scaled, u: np.ndarray, R: np.ndarray, s: np.ndarray, tol: float) -> tuple[np.ndarray, bool]:
+    """The canonical deflection of a floating plate, and whether the deflection is unique.
+
+    An answer u is one of many when the supports that carry load (R > tol·max R) leave a rigid
+    motion of the plate free: every u + V z that keeps those supports where they are and opens
+    no gap (gap − B V z ≥ 0 elsewhere) is an answer too, with the same reactions (K V = 0).
+    This returns the one a vanishing uniform load would choose, the lowest position (the
+    largest mean nodal deflection over that set; an LP), and among equally low ones the one
+    nearest the level (least ‖w‖ over the nodes; least-distance programming): it depends on
+    the set of answers only, so every backend gives the same. ``unique`` is False when some
+    rigid motion stays free at it (none of the supports that touch stops it).
+
+    All quantities scaled (:class:`Scaled`); u, R, s from a formulation's ``recover``.
+    """
+    from scipy.optimize import linprog
+
+    V = data.modes
+    k = V.shape[1]
+    if k == 0 or data.m == 0:
+        return u, True
+    BV = np.asarray(data.B @ V)
+    gap = data.g0 + s - data.B @ u
+    carries = R > tol * max(np.abs(R).max(initial=0.0), 1e-300)
+    N = _null_space(BV[carries], k)  # rigid motions that keep the loaded supports where they are
+    r = N.shape[1]
+    if r == 0:
+        return u, True
+    G = BV[~carries] @ N  # a motion z closes the other gaps by G z
+    h = np.maximum(gap[~carries], 0.0)
+    near = 1e-9 * (1.0 + h.max(initial=0.0))
+    L = V[data.is_w] @ N  # the motion's deflections at the nodes
+    w0 = u[data.is_w]
+    z = np.zeros(r)
+    face = np.eye(r)  # the directions in which the lowest positions extend (ties)
+    c = L.mean(axis=0)
+    if np.linalg.norm(c) > 1e-12 * max(np.linalg.norm(L), 1e-300):
+        lp = linprog(-c, A_ub=G if G.shape[0] else None, b_ub=h if G.shape[0] else None,
+                     bounds=(None, None), method="highs")
+        if lp.status == 0:  # else: no lowest position (the plate would topple under its own weight)
+            z = lp.x
+            face = _null_space(c[None, :], r)
+            tight = h - G @ z <= near
+            if face.shape[1] == 0 or _cone_is_zero(G[tight] @ face, face.shape[1]):
+                face = np.zeros((r, 0))  # one lowest position
+    if face.shape[1]:
+        y = _least_norm(L @ face, w0 + L @ z, G @ face, np.maximum(h - G @ z, 0.0))
+        if y is not None:
+            z = z + face @ y
+    u_new = u + V @ (N @ z)
+    gap_new = gap - BV @ (N @ z)
+    delta = max(np.abs(u_new[data.is_w]).max(initial=0.0), np.abs(data.g0).max(initial=0.0), 1e-300)
+    touching = ~carries & (gap_new <= 1e-7 * delta)
+    return u_new, _cone_is_zero(G[touching[~carries]], r)
