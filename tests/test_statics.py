@@ -176,3 +176,28 @@ def test_cli_says_the_deflection_is_not_unique(tmp_path, capsys):
     assert d["deflection_unique"] is False and abs(d["w_max"]) < 1e-5 * 0.01 * P / on_corners(0, 0).plate.D
     assert main(["solve", str(f), "--backend", "bpp"]) == 0
     assert "reactions unique, deflection not unique" in capsys.readouterr().out
+
+
+# ---------------------------------------------------------------------------------------------
+# The contact flag is judged per support
+# ---------------------------------------------------------------------------------------------
+
+def test_an_open_support_is_not_in_contact_because_another_settles_far():
+    """Four posts at the corners of [0.25, 0.75]² carry a centre load P/4 each (symmetry); a
+    fifth support under the centre sits 1e-5 below the deflected plate (its gap set from the
+    four-post answer), so it stays open with R = 0. Before: with a sixth support settled by
+    1000 at a corner, every gap within tol · 1000 of zero counted as touching, and the fifth
+    support was reported in contact with R = 0 and its gap 1e-5 open."""
+    def scene(extra):
+        return pq.Scene(name="flag", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(8, 8),
+                        loads=[pq.PointLoad(P, 0.5, 0.5)], supports=[pq.Support(x, y) for x, y in POSTS] + extra)
+
+    wc = pq.solve(scene([]), backend="bpp").w_nodes()[4, 4]
+    for far in ([], [pq.Support(0.0, 0.0, gap=1000.0)]):
+        sc = scene([pq.Support(0.5, 0.5, gap=wc + 1e-5)] + far)
+        for backend in ("bpp", "lemke", "pdas", "osqp"):
+            res = pq.solve(sc, backend=backend)
+            assert res.status == Status.OPTIMAL, backend
+            np.testing.assert_allclose(res.reactions[:4], P / 4, rtol=1e-6)
+            assert abs(res.reactions[4]) <= 1e-9 * P and res.gaps[4] > 0.9e-5, (backend, res.gaps)
+            assert list(res.active) == [True] * 4 + [False] * (1 + len(far)), (backend, far, res.active)

@@ -125,8 +125,13 @@ def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, ba
     stat = model.K @ u - model.f + model.contacts.B.T @ R
     res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))
     # in contact: the reaction carries load, or the support touches (gap ≈ 0), both judged at
-    # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports)
-    active = (R > tol * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= tol * max(data.W, 1e-300))
+    # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports).
+    # The gap is judged at each support's own deflection scale (the load's, its own initial gap, its
+    # deflection and compression), not at W: for a floating plate W counts every gap, and one support
+    # settled by 1000 would call every support within tol · 1000 of touching in contact
+    local = np.maximum.reduce([np.full(R.shape, data.w_load * data.W), np.abs(model.contacts.g0), np.abs(w),
+                               np.abs(s)]) if R.size else np.zeros(0)
+    active = (R > tol * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= tol * np.maximum(local, 1e-300))
     return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
                   accuracy=acc.asked, reactions=R, gaps=gaps, compressions=s, active=active, residual=res,
                   deflection_unique=unique)
