@@ -160,6 +160,10 @@ def _summary(result, probes=()) -> str:
                      f" complementarity {k.complementarity:.1e} (tol {k.tol:.0e}: {'ok' if k.ok else 'NOT MET'})")
         lines.append(f"  {int(result.active.sum())} of {result.active.size} supports in contact;"
                      f" sum of reactions {result.reactions.sum():.6g}")
+        est = result.extras.get("discretisation_error")
+        if est and est.get("trusted") is False:
+            lines.append(f"  accuracy auto: the meshes disagree (mesh error estimated {est['worst']:.2g}, then"
+                         f" {est['observed']:.2g} from this mesh): the estimate is not to be trusted; refine the mesh")
         if not result.deflection_unique:
             lines.append("  reactions unique, deflection not unique: the supports that carry the load leave a rigid"
                          " motion of the plate free; shown: its lowest position, nearest the level")
