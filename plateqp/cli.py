@@ -2,7 +2,8 @@
 
 Errors go to stderr as one line (what is wrong and where) with exit code 2 for bad input,
 3 for no equilibrium, 4 for a solver failure, 5 for an answer that missed the asked accuracy
-(or a ``--target`` not reached), 130 when interrupted; 1 only for an internal error (a bug:
+(or a ``--target`` not reached), 130 when interrupted (a sweep: 143 on SIGTERM; it stops its
+workers and prints the rows done so far); 1 only for an internal error (a bug:
 the line says so; ``PLATEQP_DEBUG=1`` shows the traceback).
 
 While a command works, anything a solver prints on standard output (HiGHS's banner, OSQP's
@@ -151,6 +152,13 @@ def _summary(result, probes=()) -> str:
                      f" complementarity {k.complementarity:.1e} (tol {k.tol:.0e}: {'ok' if k.ok else 'NOT MET'})")
         lines.append(f"  {int(result.active.sum())} of {result.active.size} supports in contact;"
                      f" sum of reactions {result.reactions.sum():.6g}")
+        est = result.extras.get("discretisation_error")
+        if est and est.get("trusted") is False:
+            lines.append(f"  accuracy auto: the meshes disagree (mesh error estimated {est['worst']:.2g}, then"
+                         f" {est['observed']:.2g} from this mesh): the estimate is not to be trusted; refine the mesh")
+        if not result.deflection_unique:
+            lines.append("  reactions unique, deflection not unique: the supports that carry the load leave a rigid"
+                         " motion of the plate free; shown: its lowest position, nearest the level")
         lines.append("  support      x          y        gap0        reaction     in contact")
         sc = result.scene
         for i, s in enumerate(sc.supports):
@@ -356,11 +364,27 @@ def cmd_sweep(args) -> int:
     values = _sweep_values(args)
     opts = _options(args.options)
     _backend_name(args.backend)
-    with _stdout_to_stderr():
-        res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
-                    accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
-                    max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
-                    refine_breakpoints=not args.no_refine, rtol=args.rtol, warm_start=not args.no_warm_start)
+    from .studies import SweepInterrupted
+
+    with _sigterm_as_interrupt() as seen:
+        try:
+            with _stdout_to_stderr():
+                res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
+                            accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
+                            max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                            refine_breakpoints=not args.no_refine, rtol=args.rtol,
+                            warm_start=not args.no_warm_start)
+        except SweepInterrupted as exn:
+            part = exn.result
+            print(json.dumps(part.to_dict(), indent=1) if args.json else part)
+            sys.stdout.flush()
+            left = part.interrupted["not_done"]
+            where = 'JSON, with "interrupted"' if args.json else "the table"
+            print(f"plateqp: sweep interrupted ({'SIGTERM' if seen else 'Ctrl-C'}), workers stopped: the"
+                  f" {part.interrupted['done']} of {part.interrupted['of']} values done are on standard output"
+                  f" ({where}); not done: {len(left)}"
+                  + (f" (from {args.param} = {left[0]})" if left else ""), file=sys.stderr)
+            return 143 if seen else 130
     if args.json:
         print(json.dumps(res.to_dict(), indent=1))
     else:
@@ -371,6 +395,29 @@ def cmd_sweep(args) -> int:
               f"(first: {args.param} = {bad[0]['value']}: {bad[0]['error'] or bad[0]['status']})", file=sys.stderr)
         return 5
     return 0
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt():
+    """While the block runs, SIGTERM raises KeyboardInterrupt (so a sweep stops its workers and
+    keeps its rows, as on Ctrl-C); yields a list that is non-empty once SIGTERM came."""
+    import signal
+
+    seen: list = []
+
+    def on_term(signum, frame):
+        seen.append(signum)
+        raise KeyboardInterrupt
+
+    try:
+        old = signal.signal(signal.SIGTERM, on_term)
+    except ValueError:  # not the main thread: leave SIGTERM alone
+        yield seen
+        return
+    try:
+        yield seen
+    finally:
+        signal.signal(signal.SIGTERM, old)
 
 
 def _scene_or_builtin(text: str) -> Scene:

@@ -12,7 +12,9 @@ and uses it two ways:
 
 * :func:`auto_tolerance` (``solve(..., accuracy="auto")``): estimate the error of the scene's
   own mesh from the two coarser meshes (h·2, h·4; a quarter and a sixteenth of the work)
-  and ask the solver for a fraction of it;
+  and ask the solver for a fraction of it; once the mesh itself is solved, :func:`confirm`
+  checks the estimate against the finer pair (h·2, h) and marks it not trusted when the
+  meshes disagree (a warning, and ``trusted: false`` in the result);
 * :func:`plateqp.studies.refinement.solve_to_target` (``plateqp solve --target REL``): refine from a coarse mesh until the
   estimated error of max |w| and of the reactions is below REL, solving each mesh at a solver
   tolerance of a tenth of REL: the coarsest mesh and the loosest setting that reach it.
@@ -107,14 +109,23 @@ class ErrorEstimate:
     w: float
     reactions: float = 0.0
     bed: float = 0.0
+    #: after the mesh itself is solved (:func:`confirm`): the same error estimated from the
+    #: finer pair (h·2, h), and whether it agrees with this one (None: not checked)
+    observed: float | None = None
+    trusted: bool | None = None
+    #: the quantities of the finer coarse mesh (h·2), kept for :func:`confirm`
+    basis: Quantities | None = field(default=None, repr=False, compare=False)
 
     @property
     def worst(self) -> float:
         return max(self.w, self.reactions, self.bed)
 
     def as_dict(self) -> dict:
-        return {"mesh": list(self.mesh), "from_meshes": [list(m) for m in self.from_meshes], "order": self.order,
-                "w": self.w, "reactions": self.reactions, "bed": self.bed, "worst": self.worst}
+        d = {"mesh": list(self.mesh), "from_meshes": [list(m) for m in self.from_meshes], "order": self.order,
+             "w": self.w, "reactions": self.reactions, "bed": self.bed, "worst": self.worst}
+        if self.trusted is not None:
+            d["observed"], d["trusted"] = self.observed, self.trusted
+        return d
 
 
 def _rel(a: float, b: float) -> float:
@@ -129,6 +140,28 @@ def richardson(coarse: Quantities, fine: Quantities, order: float = ORDER, steps
     nx, ny = fine.mesh
     mesh = (nx * 2 ** steps, ny * 2 ** steps)
     return ErrorEstimate(mesh, (coarse.mesh, fine.mesh), order, f * d["w"], f * d["reactions"], f * d["bed"])
+
+
+#: An estimate is not trusted when the finer pair of meshes changes the answer more than this
+#: many times what it predicted (the meshes are not in the asymptotic range: a support next
+#: to a clamped edge carries nothing on 2² and 4², 196 on 8², 22 on 128²) ...
+DISTRUST_FACTOR = 4.0
+#: ... and more than this (below it the change is the solvers' tolerance, not the mesh's).
+DISTRUST_FLOOR = 1e-8
+
+
+def confirm(est: ErrorEstimate, final: Result, order: float = ORDER) -> ErrorEstimate:
+    """Check an estimate from the meshes h·4, h·2 against the answer on h itself: the error of
+    h estimated again from the pair (h·2, h) (``observed``) must not exceed
+    :data:`DISTRUST_FACTOR` × the prediction (and :data:`DISTRUST_FLOOR`); else ``trusted``
+    is False (the meshes disagree: Richardson's assumption q(h) = q* + C hᵖ does not hold
+    there). Sets and returns ``est``."""
+    if est.basis is None:
+        return est
+    again = richardson(est.basis, Quantities.of(final), order, steps=0)
+    est.observed = again.worst
+    est.trusted = bool(again.worst <= max(DISTRUST_FACTOR * est.worst, DISTRUST_FLOOR))
+    return est
 
 
 def with_mesh(scene: Scene, nx: int, ny: int) -> Scene:
@@ -169,9 +202,11 @@ def auto_tolerance(scene: Scene, solve: Callable[..., Result], backend: str = "a
         return LOOSEST, None
     est = richardson(qs[0], qs[1], order, steps=1)
     est.mesh = (nx, ny)
+    est.basis = qs[1] if qs[1].mesh == (round(nx / 2), round(ny / 2)) and 2 * qs[1].mesh[0] == nx \
+        and 2 * qs[1].mesh[1] == ny else None
     tol = float(np.clip(fraction * est.worst, 1e-12, LOOSEST))
     return tol, est
 
 
-__all__ = ["COARSE_FAILURES", "ErrorEstimate", "Quantities", "auto_tolerance", "changes", "quiet_solve", "richardson",
+__all__ = ["COARSE_FAILURES", "DISTRUST_FACTOR", "DISTRUST_FLOOR", "ErrorEstimate", "confirm", "Quantities", "auto_tolerance", "changes", "quiet_solve", "richardson",
            "with_mesh"]

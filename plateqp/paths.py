@@ -6,7 +6,9 @@ A PATH names a scene field with dots: ``plate.h``, ``mesh.nx``, ``loads.0.P``,
 :func:`set_param` returns a validated deep copy with it changed. A support stiffness accepts
 ``"rigid"`` (also ``math.inf`` or ``"inf"``, stored as ``"rigid"``): the paper's stiffness study
 starts from c = ∞. A bad path or value is a :class:`~plateqp.errors.SceneError` that names the
-path and what exists there.
+path and what exists there; so is a path that names a table or a list (``plate``,
+``supports``, ``supports.0``) where :func:`set_param` wants a value: it lists the fields to
+name instead.
 """
 
 from __future__ import annotations
@@ -147,6 +149,33 @@ def _coerce(where: str, old, value):
     return value
 
 
+def _is_table(where: str, old) -> bool:
+    """True if the field at ``where`` holds a table or a list of them, not a value: the scene's
+    sections (``plate``, ``supports``, ``foundation`` even when absent), one item of a list, the
+    edges. (An edge itself, ``edges.left``, and a gap profile, ``foundation.gap``, are values.)"""
+    if "." not in where and where in _TOP and where != "name":
+        return True
+    if isinstance(old, Edge):
+        return False
+    return isinstance(old, list) or is_dataclass(old) or (isinstance(old, dict) and where == "edges")
+
+
+def _table_error(path: str, old) -> SceneError:
+    """What to write instead of a PATH that names a table or a list (a one-line SceneError)."""
+    if isinstance(old, dict) or path == "edges":
+        return SceneError(f"{path}: names the table of edges, not a value; name one edge: "
+                          f"{', '.join(f'edges.{e}' for e in EDGE_NAMES)}")
+    if isinstance(old, list) or old is None and path in ("openings", "pins", "loads", "supports"):
+        if not old:
+            return SceneError(f"{path}: names a list of tables, not a value (and the scene has no {path})")
+        return SceneError(f"{path}: names a list of tables, not a value; name a field of one item: "
+                          f"{', '.join(f'{path}.0.{n}' for n in _names(old[0]))} (or {path}.*.<field>)")
+    if old is None:  # an absent section (foundation)
+        return SceneError(f"{path}: names a table, not a value (and the scene has no [{path}] section)")
+    return SceneError(f"{path}: names a table, not a value; name one of its fields: "
+                      f"{', '.join(f'{path}.{n}' for n in _names(old))}")
+
+
 def set_param(scene: Scene, path: str, value) -> Scene:
     """A validated deep copy of ``scene`` with the field PATH set to ``value``.
 
@@ -160,8 +189,10 @@ def set_param(scene: Scene, path: str, value) -> Scene:
     per_item = ("*" in parts and not isinstance(value, (str, dict)) and np.ndim(value) == 1
                 and len(value) == len(leaves) and len(leaves) > 0)
     for j, (c, k, where) in enumerate(leaves):
-        v = _coerce(where, _read(c, k) if not isinstance(c, dict) or k in c else None,
-                    value[j] if per_item else value)
+        old = _read(c, k) if not isinstance(c, dict) or k in c else None
+        if _is_table(where, old) and not (is_dataclass(value) and type(value) is type(old)):
+            raise _table_error(path, old)
+        v = _coerce(where, old, value[j] if per_item else value)
         if isinstance(c, (list, dict)):
             c[k] = v
         else:

@@ -59,6 +59,11 @@ class Result:
     reactions, gaps, compressions, active : one entry per contact point (discrete supports in
         scene order, then bed nodes); empty for a two-sided scene
     residual : ‖K u − f + Bᵀ R‖ / ‖f‖ of the final field
+    deflection_unique : False when the reactions are unique but the deflection is not: the
+        supports that carry load leave a rigid motion of a floating plate free (a load exactly
+        on a support, or on the line between two). ``u`` is then the canonical answer, the
+        same whatever the backend: the lowest position, nearest the level
+        (:func:`plateqp.contact.statics.settle`)
     kkt : :class:`KKTReport` (contact scenes)
     status : :class:`~plateqp.backends.base.Status`
     times : seconds for "build", "formulate", "solve", "recover", "total"
@@ -76,6 +81,7 @@ class Result:
     compressions: np.ndarray = field(default_factory=lambda: np.zeros(0))
     active: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     residual: float = 0.0
+    deflection_unique: bool = True
     kkt: KKTReport | None = None
     iterations: int | None = None
     times: dict = field(default_factory=dict)
@@ -166,7 +172,8 @@ class Result:
     def to_dict(self, probes=()) -> dict:
         """The JSON shape of ``plateqp solve --json`` (see DESIGN.md): scene, backend, formulation,
         accuracy, status, w_max and its x, y, ``probes`` (w at each (x, y) given), reactions,
-        active, gaps, residual, kkt, iterations, times (build, solve, total); with
+        active, gaps, residual, ``deflection_unique`` (False: reactions unique, deflection not
+        unique; see the class), kkt, iterations, times (build, solve, total); with
         ``accuracy="auto"`` also the discretisation error estimate."""
         w, x, y = self.w_max()
         d = {
@@ -183,6 +190,7 @@ class Result:
             "active": np.asarray(self.active).tolist(),
             "gaps": np.asarray(self.gaps).tolist(),
             "residual": self.residual,
+            "deflection_unique": bool(self.deflection_unique),
             "kkt": self.kkt.as_dict() if self.kkt is not None else None,
             "iterations": self.iterations,
             "times": {k: self.times.get(k) for k in ("build", "solve", "total")},

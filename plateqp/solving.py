@@ -9,6 +9,7 @@ the function ``plateqp.solve`` would shadow it.)
 from __future__ import annotations
 
 import time
+import warnings
 
 import numpy as np
 
@@ -16,8 +17,8 @@ from .accuracy import Accuracy
 from .assembly import Model, build_model
 from .contact import solve_bilateral as _solve_bilateral
 from .contact import solve_contact
-from .errors import MechanismError
-from .estimate import auto_tolerance
+from .errors import MechanismError, PlateQPWarning
+from .estimate import auto_tolerance, confirm
 from .linalg import Factor
 from .results import Result
 from .scene import Scene
@@ -57,7 +58,9 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
         between 1e-14 and 0.1 (each backend maps it to its own settings: the nearest preset's,
         with its tolerances scaled; see :func:`plateqp.backends.base.preset`), or "auto": a
         tenth of the discretisation error of the scene's mesh, estimated from the two coarser
-        meshes (:func:`plateqp.estimate.auto_tolerance`; ``extras["discretisation_error"]``)
+        meshes (:func:`plateqp.estimate.auto_tolerance`; ``extras["discretisation_error"]``),
+        then checked against this mesh's answer (:func:`plateqp.estimate.confirm`: a
+        PlateQPWarning and ``"trusted": false`` there when the meshes disagree)
     options : passed to the backend untouched
     model : a model built before from the same scene (skips the assembly)
     check_statics : check first, by statics alone, that the one-sided supports can carry the
@@ -88,6 +91,13 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
                            options=options, check_statics=check_statics)
     if auto:
         result.extras["accuracy"] = "auto"
+        if estimate is not None and result.status.solved:
+            confirm(estimate, result)
+            if estimate.trusted is False:
+                warnings.warn(f'accuracy="auto": the meshes disagree (error of the {scene.mesh.nx}x{scene.mesh.ny}'
+                              f" mesh estimated {estimate.worst:.2g} from the two coarser meshes, {estimate.observed:.2g}"
+                              " from the next coarser and this one): the error estimate is not to be trusted;"
+                              " refine the mesh (plateqp solve --target)", PlateQPWarning, stacklevel=2)
         result.extras["discretisation_error"] = estimate.as_dict() if estimate is not None else None
         result.times["estimate"] = t_est
     result.times["build"] = t_build

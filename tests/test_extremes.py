@@ -35,6 +35,7 @@ Which test pins which fix (each fails with its fix undone; see benchmarks/README
 
 from __future__ import annotations
 
+import os
 import warnings
 
 import numpy as np
@@ -86,15 +87,50 @@ def run(scene, backend, formulation, accuracy="high", **kw):
         return pq.solve(scene, backend=backend, formulation=formulation, accuracy=accuracy, **kw)
 
 
+#: The cases that give up today (not OPTIMAL), as data: (test, backend, formulation) → the
+#: status each must still end with. Anything else must be OPTIMAL and right; a case listed
+#: here that now succeeds fails until it is removed (so no backend passes by giving up).
+KNOWN_GIVE_UP = {
+    # deliberate: OSQP told eps = 1e-1 and no polishing while "high" is asked
+    ("test_absurdly_loose_solver_options_are_flagged", "osqp", "condensed"): "inaccurate",
+    ("test_absurdly_loose_solver_options_are_flagged", "osqp", "primal"): "inaccurate",
+    # two rigid supports 1e-3 of a cell apart: the interior-point / ADMM answers miss "high"
+    ("test_close_rigid_supports_are_solved", "clarabel", "condensed"): "inaccurate",
+    ("test_close_rigid_supports_are_solved", "clarabel", "primal"): "inaccurate",
+    ("test_close_rigid_supports_are_solved", "qpsolvers:proxqp", "condensed"): "inaccurate",
+    # a support settled 1e2 × the free deflection
+    ("test_far_settled_support_does_not_set_the_deflection_scale", "clarabel", "condensed"): "inaccurate",
+    ("test_far_settled_support_does_not_set_the_deflection_scale", "clarabel", "primal"): "error",
+    ("test_far_settled_support_does_not_set_the_deflection_scale", "pgs", "condensed"): "inaccurate",
+    # PGS (iterative) when nothing touches
+    ("test_settlement_beyond_reach_gives_the_free_plate", "pgs", "condensed"): "inaccurate",
+    # springs of 1e-8 D: soft rows the interior-point / ADMM solvers do not resolve to "high"
+    ("test_soft_supports_tend_to_no_support", "clarabel", "condensed"): "inaccurate",
+    ("test_soft_supports_tend_to_no_support", "clarabel", "primal"): "inaccurate",
+    ("test_soft_supports_tend_to_no_support", "qpsolvers:proxqp", "primal"): "inaccurate",
+}
+
+
+def current_test() -> str:
+    """The name of the running test function (without its parameters)."""
+    return os.environ["PYTEST_CURRENT_TEST"].split("::")[-1].split(" ")[0].split("[")[0]
+
+
 def check_claim(res, ref, rtol=1e-7):
-    """OPTIMAL must be right (reactions within rtol of max |ref|); anything else must say so."""
+    """OPTIMAL must be right (reactions within rtol of max |ref|); a case that gives up must be
+    one of :data:`KNOWN_GIVE_UP`, end with its status there, and say so honestly (INACCURATE
+    only with the KKT check failed)."""
+    key = (current_test(), res.backend, res.formulation)
+    known = KNOWN_GIVE_UP.get(key)
     if res.status == pq.Status.OPTIMAL:
+        assert known is None, f"{key} now succeeds: remove it from KNOWN_GIVE_UP"
         assert res.kkt.ok
         np.testing.assert_allclose(res.reactions, ref, rtol=0, atol=rtol * max(np.abs(ref).max(), 1e-300))
-    elif res.status == pq.Status.INACCURATE:
+        return
+    assert known is not None, f"{key} gave up ({res.status.value}); it is not a known give-up"
+    assert res.status.value == known, f"{key} ended {res.status.value}, KNOWN_GIVE_UP says {known}"
+    if res.status == pq.Status.INACCURATE:
         assert not res.kkt.ok
-    else:
-        assert res.status in (pq.Status.MAX_ITER, pq.Status.ERROR), res.status
 
 
 @pytest.fixture(scope="module")

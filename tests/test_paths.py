@@ -62,3 +62,37 @@ def test_bad_paths_and_values_say_what_exists(path, value, words):
                                            (3, 3.0), (np.float32(0.5), 0.5)])
 def test_as_number(value, number):
     assert as_number(value) == number
+
+
+@pytest.mark.parametrize("path, words", [
+    ("plate", ["plate", "a table", "plate.h"]),
+    ("mesh", ["mesh", "a table", "mesh.nx"]),
+    ("supports", ["supports", "list", "supports.0.gap"]),
+    ("supports.0", ["supports.0", "a table", "supports.0.gap"]),
+    ("supports.*", ["supports.*", "a table", "supports.*.gap"]),
+    ("loads", ["loads", "list"]),
+    ("loads.0", ["loads.0", "a table", "loads.0.P"]),
+    ("edges", ["edges", "edges.left"]),
+    ("pins", ["pins", "list"]),
+    ("openings", ["openings", "list"]),
+])
+def test_a_path_that_names_a_table_is_refused(path, words):
+    """A path must name a number (or a word such as an edge kind), never a whole table or list:
+    setting one to a number used to leave an int where the scene expects its section."""
+    with pytest.raises(pq.SceneError) as exn:
+        set_param(fig5(), path, 1.0)
+    for w in words:
+        assert w in str(exn.value), str(exn.value)
+    s4 = pq.Scene(foundation=pq.Foundation(k=100.0), loads=[pq.UniformLoad(q=1.0)])
+    with pytest.raises(pq.SceneError, match="foundation.k"):
+        set_param(s4, "foundation", 2.0)
+
+
+@pytest.mark.parametrize("path", ["plate", "supports", "supports.0", "loads.0", "edges", "mesh", "foundation"])
+def test_sweep_of_a_table_is_one_line_exit_2(capsys, path):
+    from plateqp.cli import main
+
+    code = main(["sweep", "heave", "--param", path, "--values", "1,2", "--workers", "1"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and err.startswith("plateqp: ") and "internal error" not in err, err
+    assert path in err

@@ -22,7 +22,7 @@ from .formulations import ContactSolution, Formulation, formulate
 from .kkt import kkt_report
 from .routing import choose, formulations_for
 from .scaling import Scaled
-from .statics import NO_EQUILIBRIUM, equilibrium_possible
+from .statics import NO_EQUILIBRIUM, settle, supports_reach
 
 
 def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto",
@@ -31,17 +31,21 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     """Solve the contact problem of a built model; see :func:`plateqp.solve`.
 
     ``check_statics``: before solving, check by statics that the supports can carry the load
-    at all (:func:`plateqp.contact.statics.equilibrium_possible`) and raise NoEquilibriumError at once
+    at all (:func:`plateqp.contact.statics.supports_reach`) and raise NoEquilibriumError at once
     if not. Whatever it is set to, a backend's claim of "no equilibrium" (status INFEASIBLE or
     UNBOUNDED, with its certificate) is checked against the same statics, and a false claim is a
-    SolverError, never a NoEquilibriumError.
+    SolverError, never a NoEquilibriumError. Within the asked accuracy of the edge of the
+    supports' reach statics cannot tell, and the backend's verdict stands either way.
     """
     acc = Accuracy.parse(accuracy)  # ProblemError for a bad one, before any work
     t0 = time.perf_counter()
     data = Scaled.from_model(model)
-    possible, why = equilibrium_possible(data)
-    if check_statics and not possible:
-        raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({why}; found by statics, before any solve)")
+    reach = supports_reach(data, band=acc.tol)
+    if check_statics and not reach.possible and not reach.marginal:
+        raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({reach.why}; found by statics, before any solve)")
+    # within the band of the asked accuracy around the edge of the supports' reach, statics cannot
+    # tell, and a solver's own verdict stands: "no equilibrium" there is no solver failure
+    possible, why = reach.certain, reach.why
     asked_backend, asked_formulation = backend, formulation
     backend, formulation = choose(data, backend, formulation)
     b = get_backend(backend)
@@ -101,8 +105,19 @@ def finish(model: Model, form: Formulation, raw: RawSolution, accuracy: str | fl
 
 def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, backend: str, formulation: str,
               accuracy: str | float | Accuracy) -> Result:
-    """A contact solution of the scaled problem back in the user's units, as a :class:`Result`."""
-    u = data.dof_scale * c.u
+    """A contact solution of the scaled problem back in the user's units, as a :class:`Result`.
+
+    A solved answer whose deflection is not unique (a rigid motion of a floating plate left free
+    by the supports that carry load) is replaced by the canonical one, the same whatever the
+    backend, and flagged ``deflection_unique = False`` (:func:`plateqp.contact.statics.settle`;
+    the reactions and the KKT report are those of the backend's answer).
+    """
+    acc = Accuracy.parse(accuracy)
+    tol = max(acc.tol, 1e-9)
+    u_s, unique = c.u, True
+    if status.solved and formulation != "bilateral" and np.all(np.isfinite(c.u)) and np.all(np.isfinite(c.R)):
+        u_s, unique = settle(data, c.u, c.R, c.s, tol)
+    u = data.dof_scale * u_s
     R = data.F0 * c.R
     s = data.W * c.s
     w = model.contacts.B @ u
@@ -110,12 +125,16 @@ def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, ba
     stat = model.K @ u - model.f + model.contacts.B.T @ R
     res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))
     # in contact: the reaction carries load, or the support touches (gap ≈ 0), both judged at
-    # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports)
-    acc = Accuracy.parse(accuracy)
-    tol = max(acc.tol, 1e-9)
-    active = (R > tol * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= tol * max(data.W, 1e-300))
+    # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports).
+    # The gap is judged at each support's own deflection scale (the load's, its own initial gap, its
+    # deflection and compression), not at W: for a floating plate W counts every gap, and one support
+    # settled by 1000 would call every support within tol · 1000 of touching in contact
+    local = np.maximum.reduce([np.full(R.shape, data.w_load * data.W), np.abs(model.contacts.g0), np.abs(w),
+                               np.abs(s)]) if R.size else np.zeros(0)
+    active = (R > tol * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= tol * np.maximum(local, 1e-300))
     return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
-                  accuracy=acc.asked, reactions=R, gaps=gaps, compressions=s, active=active, residual=res)
+                  accuracy=acc.asked, reactions=R, gaps=gaps, compressions=s, active=active, residual=res,
+                  deflection_unique=unique)
 
 
 def solve_bilateral(model: Model) -> Result:

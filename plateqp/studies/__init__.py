@@ -26,13 +26,14 @@ from .design import GapRegulation, UniformStiffness, most_uniform_stiffness, reg
 from .refinement import (ConvergenceTable, TargetResult, auto_tolerance, convergence, quantity, solve_to_target,
                          start_mesh)
 from .reuse import adapt_model
-from .sweep import SERIAL_BELOW, WARM_START_BACKENDS, SweepResult, sweep
+from .sweep import SERIAL_BELOW, WARM_START_BACKENDS, SweepInterrupted, SweepResult, sweep
 
 __all__ = [
     "SERIAL_BELOW",
     "WARM_START_BACKENDS",
     "ConvergenceTable",
     "GapRegulation",
+    "SweepInterrupted",
     "SweepResult",
     "TargetResult",
     "UniformStiffness",

@@ -3,14 +3,18 @@
 
 Every runner has the same two calls: ``submit(fn, *args)`` and ``as_completed(tasks)``, which
 yields (task, future) pairs as they finish (in order for :class:`Serial`, which runs each task
-when its result is asked for). Local worker processes start from a fresh interpreter
-(forkserver/spawn), never by forking a process whose numerical libraries have run threads.
+when its result is asked for), ``close()`` (wait for what runs) and ``abort()`` (on Ctrl-C or
+SIGTERM: cancel what has not started and stop our own worker processes at once). Local worker
+processes start from a fresh interpreter (forkserver/spawn), never by forking a process whose
+numerical libraries have run threads, and ignore SIGINT: a Ctrl-C at the terminal reaches the
+whole process group, and the sweep, not each worker, decides what happens (it stops them).
 """
 
 from __future__ import annotations
 
 import concurrent.futures as cf
 import pickle
+import signal
 import sys
 import warnings
 
@@ -45,6 +49,9 @@ class Serial:
     def close(self):
         pass
 
+    def abort(self):
+        pass
+
 
 class Futures:
     """A concurrent.futures executor (ours or the user's) or a Dask distributed Client."""
@@ -52,11 +59,12 @@ class Futures:
     def __init__(self, executor, own: bool, dask: bool, workers: int):
         self.ex, self.own, self.dask, self.workers = executor, own, dask, workers
         self.kind = "dask" if dask else "futures"
+        self.submitted: list = []
 
     def submit(self, fn, *args):
-        if self.dask:
-            return self.ex.submit(fn, *args, pure=False)
-        return self.ex.submit(fn, *args)
+        fut = self.ex.submit(fn, *args, pure=False) if self.dask else self.ex.submit(fn, *args)
+        self.submitted.append(fut)
+        return fut
 
     def as_completed(self, futs):
         if self.dask:
@@ -71,6 +79,33 @@ class Futures:
     def close(self):
         if self.own:
             self.ex.shutdown(wait=True)
+
+    def abort(self, grace: float = 2.0):
+        """Cancel every task not yet started; stop our own worker processes (SIGTERM, then
+        SIGKILL after ``grace`` seconds), without waiting for the tasks they run. A user's
+        executor or Dask client is left running (only our tasks are cancelled)."""
+        for fut in self.submitted:
+            try:
+                fut.cancel()
+            except Exception:  # noqa: BLE001 - a Dask client already closed: nothing to cancel
+                pass
+        if not self.own:
+            return
+        procs = list((getattr(self.ex, "_processes", None) or {}).values())
+        self.ex.shutdown(wait=False, cancel_futures=True)
+        for p in procs:
+            if p.is_alive():
+                p.terminate()
+        for p in procs:
+            p.join(grace)
+            if p.is_alive():
+                p.kill()
+                p.join(grace)
+
+
+def _ignore_sigint():
+    """Worker initializer: Ctrl-C is the parent's to handle (it stops the workers)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def mp_context():
@@ -98,8 +133,8 @@ def make_runner(executor, n: int, max_workers: int, payload):
             warnings.warn("the scene cannot be pickled (a Python callable in it?): sweeping in this process",
                           PlateQPWarning, stacklevel=3)
             return Serial()
-        return Futures(cf.ProcessPoolExecutor(max_workers=max_workers, mp_context=mp_context()), True, False,
-                       max_workers)
+        return Futures(cf.ProcessPoolExecutor(max_workers=max_workers, mp_context=mp_context(),
+                                              initializer=_ignore_sigint), True, False, max_workers)
     if is_dask(executor):
         try:
             workers = max(1, sum(executor.nthreads().values()))

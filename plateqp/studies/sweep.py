@@ -31,6 +31,17 @@ from .parallel import SERIAL_BELOW, Progress, make_runner
 from .worker import WARM_START_BACKENDS, Context, forget, next_start, run_chunk, solve_value
 
 
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped by Ctrl-C (or a SIGTERM its caller turned into one) after its worker
+    processes were stopped; ``result`` is the :class:`SweepResult` of the values done so far
+    (``result.interrupted`` says which were not). A KeyboardInterrupt, so code that does not
+    know it stops as before."""
+
+    def __init__(self, result: "SweepResult"):
+        super().__init__(f"sweep interrupted: {result.interrupted['done']} of {result.interrupted['of']} values done")
+        self.result = result
+
+
 @dataclass
 class SweepResult:
     """The rows of a sweep (one per value) and the breakpoints between them.
@@ -54,10 +65,17 @@ class SweepResult:
     rows: list[dict]
     breakpoints: list[dict]
     times: dict = field(default_factory=dict)
+    #: None, or for a sweep stopped by Ctrl-C / SIGTERM (:class:`SweepInterrupted`):
+    #: ``{"done": k, "of": n, "not_done": [values]}``; ``rows`` then holds the k rows done
+    interrupted: dict | None = None
 
     def to_dict(self) -> dict:
-        """The JSON shape of ``plateqp sweep --json``: {rows, breakpoints}."""
-        return {"rows": self.rows, "breakpoints": self.breakpoints}
+        """The JSON shape of ``plateqp sweep --json``: {rows, breakpoints}, and ``interrupted``
+        for a sweep that was stopped (see the field)."""
+        d = {"rows": self.rows, "breakpoints": self.breakpoints}
+        if self.interrupted is not None:
+            d["interrupted"] = self.interrupted
+        return d
 
     @property
     def reactions(self) -> np.ndarray:
@@ -74,6 +92,9 @@ class SweepResult:
         head = (f"{'value':>12s} {'status':>10s} {'contact':>8s} {'sum R':>12s} {'w_max':>12s}"
                 f" {'max s1':>12s} {'KKT worst':>9s} {'time s':>8s}")
         lines = [f"sweep of {self.path}: {len(self.rows)} values", head]
+        if self.interrupted is not None:
+            lines[0] += (f" (interrupted: {self.interrupted['done']} of {self.interrupted['of']} done;"
+                         f" not done: {self.interrupted['not_done']})")
         for r in self.rows:
             v = r["value"]
             vs = v if isinstance(v, str) else f"{v:.6g}"
@@ -132,6 +153,12 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
     -------
     SweepResult. A value whose solve fails is recorded as a row with its status and error;
     the sweep goes on. A change between a failed value and its neighbours is not bisected.
+
+    Raises
+    ------
+    SweepInterrupted
+        on Ctrl-C (KeyboardInterrupt) while it runs: our worker processes are stopped at once
+        (not waited for), and the exception carries the rows done so far.
     """
     values = [v.item() if isinstance(v, np.generic) else v for v in values]
     if not values:
@@ -160,6 +187,7 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
     actives: list = [None] * n
     found: dict[int, list[dict]] = {}
     solves = bisection_steps = 0
+    stopped = False
     try:
         bar = Progress(n, f"sweep {path}", progress)
         try:
@@ -213,8 +241,19 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
                 found[i] = [{"between": [values[i], values[i + 1]], "at": None,
                              "bracket": [values[i], values[i + 1]],
                              "before": contact_set(actives[i]), "after": contact_set(actives[i + 1])}]
+    except KeyboardInterrupt:
+        stopped = True
+        runner.abort()
+        done = [i for i in range(n) if rows[i] is not None]
+        partial = SweepResult(path, [values[i] for i in done], [rows[i] for i in done],
+                              [b for i in sorted(found) for b in found[i]],
+                              times={"total": time.perf_counter() - t0, "executor": runner.kind},
+                              interrupted={"done": len(done), "of": n,
+                                           "not_done": [values[i] for i in range(n) if rows[i] is None]})
+        raise SweepInterrupted(partial) from None
     finally:
-        runner.close()
+        if not stopped:
+            runner.close()
         forget(ctx.token)
     breakpoints = [b for i in sorted(found) for b in found[i]]
     t2 = time.perf_counter()
@@ -224,4 +263,4 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
                               "executor": runner.kind})
 
 
-__all__ = ["SERIAL_BELOW", "SweepResult", "WARM_START_BACKENDS", "sweep"]
+__all__ = ["SERIAL_BELOW", "SweepInterrupted", "SweepResult", "WARM_START_BACKENDS", "sweep"]

@@ -121,7 +121,8 @@ def solve_value(ctx: Context, value, warm=None):
         status = "infeasible" if isinstance(exn, NoEquilibriumError) else "error"
         row = {"value": value, "scene": ctx.scene.name, "backend": ctx.backend, "formulation": ctx.formulation,
                "accuracy": ctx.accuracy, "status": status, "w_max": None, "w_max_x": None, "w_max_y": None,
-               "probes": [], "reactions": None, "active": None, "gaps": None, "residual": None, "kkt": None,
+               "probes": [], "reactions": None, "active": None, "gaps": None, "residual": None,
+               "deflection_unique": None, "kkt": None,
                "iterations": None,
                "times": {"build": None, "solve": None, "total": time.perf_counter() - t0, "scene": None,
                          "formulate": None, "recover": None, "post": None},
