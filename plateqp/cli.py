@@ -169,12 +169,35 @@ def _summary(result, probes=()) -> str:
     return "\n".join(lines)
 
 
+def _sensitivity(result, as_json: bool):
+    """--sensitivity: the gap-sensitivity matrix dR_i/dg0_j of the solution
+    (:func:`plateqp.sensitivity`), as its JSON shape or as lines of text."""
+    from .sensitivity import sensitivity
+
+    sens = sensitivity(result, "gaps")
+    if as_json:
+        return sens.to_dict()
+    if sens.smooth:
+        sides = [("dR_i/dg0_j", sens.increasing)]
+    else:
+        at = ", ".join(str(int(i)) for i in sens.degenerate)
+        sides = [(f"dR_i/dg0_j as the gap increases (support(s) {at} at lift-off)", sens.increasing),
+                 (f"dR_i/dg0_j as the gap decreases (support(s) {at} at lift-off)", sens.decreasing)]
+    lines = []
+    for title, der in sides:
+        lines.append(f"  {title}:")
+        lines += ["  " + " ".join(f"{v:12.5g}" for v in row) for row in der.reactions]
+    return "\n".join(lines)
+
+
 def cmd_solve(args) -> int:
     _set_memory_limit(args.max_memory)
     scene = _scene_or_builtin(args.scene)
     opts = _options(args.options)
     _backend_name(args.backend)
     stem = safe_filename(scene.name)
+    if args.sensitivity and not scene.one_sided:
+        raise ProblemError("--sensitivity: the scene has no one-sided supports (nothing to differentiate)")
     out = _out_dir(args.out, [f"{stem}.json", f"{stem}-w.npy"], args.force) if args.out else None
     reached = True
     with warnings.catch_warnings(), _stdout_to_stderr():
@@ -203,11 +226,15 @@ def cmd_solve(args) -> int:
             d["target"] = {"target": tr.target, "reached": tr.reached, "tolerance": tr.tolerance,
                            "mesh": [result.scene.mesh.nx, result.scene.mesh.ny],
                            "meshes": [{**r, "mesh": list(r["mesh"])} for r in tr.rows]}
+        if args.sensitivity:
+            d["sensitivity"] = _sensitivity(result, True)
         print(json.dumps(d, indent=1))
     else:
         if args.target is not None:
             print(tr)
         print(_summary(result, args.probe))
+        if args.sensitivity:
+            print(_sensitivity(result, False))
     if out is not None:
         (out / f"{stem}.json").write_text(json.dumps(result.to_dict(args.probe), indent=1))
         np.save(out / f"{stem}-w.npy", result.w_nodes())
@@ -358,6 +385,8 @@ def main(argv=None) -> int:
     s.add_argument("--probe", type=_probe, action="append", default=[], metavar="X,Y")
     s.add_argument("--options", help="backend options as a JSON object, passed through untouched")
     s.add_argument("--json", action="store_true")
+    s.add_argument("--sensitivity", action="store_true",
+                   help="add the exact gap sensitivities dR_i/dg0_j of the solution (with --json: a 'sensitivity' object)")
     s.add_argument("--out", metavar="DIR", help="write <name>.json and <name>-w.npy (nodal w) into DIR")
     s.add_argument("--force", action="store_true", help="--out: overwrite files that exist")
     s.add_argument("--max-memory", metavar="BYTES",

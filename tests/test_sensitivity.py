@@ -15,6 +15,7 @@
 
 from __future__ import annotations
 
+import json
 import warnings
 
 import numpy as np
@@ -213,3 +214,20 @@ def test_errors():
                               pq.Support(0.5, 1.0, gap=0.1)])
     with pytest.raises(pq.MechanismError, match="not unique"):
         pq.sensitivity(solve(line), "gaps")
+
+
+def test_cli_sensitivity(tmp_path, capsys):
+    from plateqp.cli import main
+
+    path = tmp_path / "corners.toml"
+    corners().to_toml(path)
+    assert main(["solve", str(path), "--backend", "lemke", "--json", "--sensitivity"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    k = 2 * corners().plate.D * (1 - NU) / A**2
+    np.testing.assert_allclose(d["sensitivity"]["reactions"][0][2], -k, rtol=1e-9)
+    assert d["sensitivity"]["parameters"][2] == "supports.2.gap" and d["sensitivity"]["smooth"]
+    two_sided = pq.Scene(name="t", edges={"left": "clamped"}, loads=[pq.UniformLoad(1.0)], mesh=pq.MeshSpec(4, 4))
+    two_sided.to_toml(tmp_path / "t.toml")
+    assert main(["solve", str(tmp_path / "t.toml"), "--sensitivity"]) == 2
+    err = capsys.readouterr().err
+    assert "--sensitivity" in err and len(err.strip().splitlines()) == 1
