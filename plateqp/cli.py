@@ -300,6 +300,19 @@ def _sweep_values(args) -> list:
     return [float(v) for v in np.linspace(a, b, n)]
 
 
+def _sweep_exact(scene, values, opts, args):
+    """sweep --exact: the breakpoints of the exact path (:func:`plateqp.studies.exact_sweep`);
+    a parameter that does not enter linearly is a ProblemError (exit 2) before any work."""
+    from .studies import exact_sweep
+
+    if args.no_refine:
+        raise ProblemError("--exact and --no-refine: choose one")
+    return exact_sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
+                       accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
+                       max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                       warm_start=not args.no_warm_start)
+
+
 def cmd_sweep(args) -> int:
     from .studies import sweep
 
@@ -309,12 +322,15 @@ def cmd_sweep(args) -> int:
     opts = _options(args.options)
     _backend_name(args.backend)
     with _stdout_to_stderr():
-        res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
-                    accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
-                    max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
-                    refine_breakpoints=not args.no_refine, rtol=args.rtol, warm_start=not args.no_warm_start)
+        if args.exact:
+            res = _sweep_exact(scene, values, opts, args)
+        else:
+            res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
+                        accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
+                        max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                        refine_breakpoints=not args.no_refine, rtol=args.rtol, warm_start=not args.no_warm_start)
     if args.json:
-        print(json.dumps(res.to_dict(), indent=1))
+        print(json.dumps({"method": "none" if args.no_refine else "bisection", **res.to_dict()}, indent=1))
     else:
         print(res)
     bad = [r for r in res.rows if r["status"] != Status.OPTIMAL.value]
@@ -404,6 +420,9 @@ def main(argv=None) -> int:
     w.add_argument("--options", help="backend options as a JSON object, passed through untouched")
     w.add_argument("--rtol", type=float, default=1e-3, help="relative width of each breakpoint's bracket")
     w.add_argument("--no-refine", action="store_true", help="report changes between values without bisection")
+    w.add_argument("--exact", action="store_true",
+                   help="breakpoints exactly, by parametric pivoting, for a parameter that enters linearly "
+                        "(a gap, a load, a prescribed displacement); refused for a stiffness")
     w.add_argument("--workers", type=int, default=2, help="local worker processes (1: serial)")
     w.add_argument("--no-warm-start", action="store_true",
                    help="start each value's solve cold (warm starts: bpp and pdas, from the previous contact set)")

@@ -147,7 +147,7 @@ def one_direction(a: Piece, unit: Piece, D: np.ndarray, sign: float) -> tuple[Pi
     """:func:`directional` for one parameter (1-D ``a``). Returns (slopes, mask over D of the
     points that open, unique): ``unique`` is False where two opened sets both solve the
     problem with different deflections (the plate may rock: a rigid motion is free on that
-    side; the reactions' slopes are the same in both, the first found is returned)."""
+    side; the reactions' slopes are the same in both, the one of least motion ‖du‖ is returned)."""
     aR = sign * a.dR[D]
     Hm = unit.dR[D]  # (|D|, |D|): dR_D per unit gap at D (negative semi-definite)
     nD = D.size
@@ -180,7 +180,10 @@ def one_direction(a: Piece, unit: Piece, D: np.ndarray, sign: float) -> tuple[Pi
     first = found[0][0]
     scale = max(np.abs(first.dgap).max(initial=0.0), 1.0)
     unique = all(np.abs(p.dgap - first.dgap).max(initial=0.0) <= 1e-8 * scale for p, _ in found[1:])
-    return first, found[0][1], unique
+    # where the plate may rock, the least motion (smallest ‖du‖): a settling support lifts off
+    # and the plate stays, rather than the plate rolling over onto it
+    best = min(found, key=lambda pf: float(np.linalg.norm(pf[0].du)))
+    return best[0], best[1], unique
 
 
 def classify(data: Scaled, R: np.ndarray, gap: np.ndarray, tol: float):
