@@ -244,8 +244,11 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
                            "lifts_off": off})
         # the next event: a held reaction falls to zero, or an open gap closes
         remaining = abs(x1 - t)
-        rs = max(np.abs(slope.dR).max(initial=0.0), 1e-300)
-        gs = max(np.abs(slope.dgap).max(initial=0.0), 1e-300)
+        # slopes that move a reaction (a gap) by less than 1e-8 of the largest (of the deflection
+        # scale) over the whole range are rounding, not events
+        span = max(abs(x1 - x0), 1e-300)
+        rs = max(np.abs(slope.dR).max(initial=0.0), np.abs(state_R).max(initial=0.0) / span, 1e-300)
+        gs = max(np.abs(slope.dgap).max(initial=0.0), max(np.abs(state_gap).max(initial=0.0), 1.0) / span)
         steps = np.full(m, np.inf)
         falling = held & (sign * slope.dR < -1e-8 * rs)
         steps[falling] = np.maximum(state_R[falling], 0.0) / (-sign * slope.dR[falling])
@@ -272,7 +275,8 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
         g_next[events] = 0.0
         _, deg = classify(data, R_next, g_next, tol)
         deg[events] = True
-        D = np.flatnonzero(deg & held)
+        held |= deg  # a touching point without force is held, then released by the one-sided step if it opens
+        D = np.flatnonzero(deg)
         t = t_next
     return ExactPath(path, x0, x1, breaks, pieces, _data=data, _model=model, _affine=affine)
 
