@@ -97,6 +97,7 @@ def test_prescribed_displacement_is_linear():
     ("supports.0.stiffness", (1e3, 1e4), "stiffness"),
     ("plate.h", (0.01, 0.02), "stiffness matrix"),
     ("mesh.nx", (4, 8), "mesh"),
+    ("loads.1.x", (0.3, 0.7), "affine"),  # a point load moving: K stays, f is not affine in x
 ])
 def test_refuses_parameters_that_are_not_linear(param, values, what):
     with pytest.raises(pq.ProblemError, match=f"not enter the problem linearly.*{what}|{what}.*linearly"):
