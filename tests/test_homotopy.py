@@ -89,19 +89,27 @@ def test_path_matches_bisection(seed, param):
 def test_prescribed_displacement_is_linear():
     scene = random_scene(1)  # held by a simple left edge
     path = exact_path(scene, "edges.left.w", 0.0, 1e-4)
-    r = solve(set_param(scene, "edges.left.w", 5e-5))
-    np.testing.assert_allclose(path.reactions(5e-5), r.reactions, atol=1e-8 * np.abs(r.reactions).max())
+    for t in (2e-5, 5e-5, 1e-4):
+        r = solve(set_param(scene, "edges.left.w", t))
+        np.testing.assert_allclose(path.reactions(t), r.reactions, atol=1e-8 * np.abs(r.reactions).max())
+        w = np.array([r.deflection(s.x, s.y) for s in scene.supports])  # through the element, edge included
+        np.testing.assert_allclose(path.deflections(t), w, atol=1e-8 * np.abs(w).max())
 
 
 @pytest.mark.parametrize("param, values, what", [
-    ("supports.0.stiffness", (1e3, 1e4), "stiffness"),
+    ("supports.0.stiffness", (1e3, 1e4), "flexibility 1/c"),
+    ("foundation.k", (1e3, 1e4), "flexibility 1/c"),
     ("plate.h", (0.01, 0.02), "stiffness matrix"),
     ("mesh.nx", (4, 8), "mesh"),
     ("loads.1.x", (0.3, 0.7), "affine"),  # a point load moving: K stays, f is not affine in x
 ])
 def test_refuses_parameters_that_are_not_linear(param, values, what):
-    with pytest.raises(pq.ProblemError, match=f"not enter the problem linearly.*{what}|{what}.*linearly"):
-        exact_path(random_scene(1), param, *values)
+    scene = random_scene(1)
+    if param.startswith("foundation"):
+        scene.foundation = pq.Foundation(k=1e3, region=[0.5, 1.0, 0.0, 1.0])
+        scene.validate()
+    with pytest.raises(pq.ProblemError, match=f"not enter the problem linearly.*{what}"):
+        exact_path(scene, param, *values)
 
 
 def test_exact_sweep_needs_monotone_values():

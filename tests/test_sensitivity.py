@@ -15,6 +15,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import warnings
 
@@ -214,6 +215,16 @@ def test_errors():
                               pq.Support(0.5, 1.0, gap=0.1)])
     with pytest.raises(pq.MechanismError, match="not unique"):
         pq.sensitivity(solve(line), "gaps")
+    # the same plate answered level on three collinear supports, the other two open: the contact
+    # set leaves the rotation about their line free (the answer a solver may give; not unique)
+    three = pq.Scene(name="three", mesh=pq.MeshSpec(4, 4), loads=[pq.PointLoad(1.0, 0.25, 0.5)],
+                     supports=[pq.Support(0.0, 0.5), pq.Support(0.5, 0.5), pq.Support(1.0, 0.5),
+                               pq.Support(0.5, 0.0, gap=0.1), pq.Support(0.5, 1.0, gap=0.1)])
+    r = solve(three)
+    level = dataclasses.replace(r, gaps=np.array([0.0, 0.0, 0.0, 0.1, 0.1]),
+                                reactions=np.array([0.5, 0.5, 1e-3, 0.0, 0.0]))  # all three held
+    with pytest.raises(pq.MechanismError, match="rigid motion"):
+        pq.sensitivity(level, "gaps")
 
 
 def test_cli_sensitivity(tmp_path, capsys):
