@@ -73,6 +73,7 @@ class ExactPath:
     _data: Scaled | None = field(default=None, repr=False)
     _model: Model | None = field(default=None, repr=False)
     _affine: list[tuple] = field(default_factory=list, repr=False)  # (t0, t1, R, gap, u, dR, dgap, du) scaled
+    _dshift: np.ndarray | None = field(default=None, repr=False)  # d(shift)/dt (prescribed displacements)
 
     def _piece(self, t: float):
         lo, hi = min(self.start, self.stop), max(self.start, self.stop)
@@ -97,7 +98,8 @@ class ExactPath:
         """w at the contact points at ``t`` (including the prescribed dofs' share)."""
         p = self._piece(t)
         u = p[4] + (t - p[0]) * p[7]
-        return self._data.W * np.asarray(self._data.B @ u) + self._model.contacts.shift
+        shift = self._model.contacts.shift + (t - self.start) * (0.0 if self._dshift is None else self._dshift)
+        return self._data.W * np.asarray(self._data.B @ u) + shift
 
     def contact(self, t: float) -> list[int]:
         """The contact set on the piece holding ``t``."""
@@ -121,9 +123,11 @@ class ExactPath:
         return "\n".join(lines)
 
 
-def linear_data(scene: Scene, path: str, start: float, stop: float) -> tuple[Model, np.ndarray, np.ndarray]:
-    """(model at ``start``, df/dt on the free dofs, dg0/dt at the contact points) if PATH enters
-    the problem linearly between ``start`` and ``stop``; a ProblemError saying why not otherwise."""
+def linear_data(scene: Scene, path: str, start: float, stop: float):
+    """(model at ``start``, df/dt on the free dofs, dg0/dt at the contact points, d(shift)/dt)
+    if PATH enters the problem linearly between ``start`` and ``stop``; a ProblemError saying
+    why not otherwise. ``shift`` is the deflection the prescribed dofs give each contact point
+    (:class:`plateqp.assembly.ContactOperator`): it moves with a prescribed displacement."""
     get_param(scene, path)  # a bad path names what exists
     leaf = path.rsplit(".", 1)[-1]
     if leaf == "stiffness" or path.startswith("foundation.k"):
@@ -143,9 +147,10 @@ def linear_data(scene: Scene, path: str, start: float, stop: float) -> tuple[Mod
             raise ProblemError(f"--exact: {path} does not enter the problem linearly ({why} changes between "
                                f"{start} and {where} of the range); sweep it without --exact (bisection)")
     if x1 == x0:
-        return m0, np.zeros(m0.n_free), np.zeros(m0.contacts.m)
+        return m0, np.zeros(m0.n_free), np.zeros(m0.contacts.m), np.zeros(m0.contacts.m)
     df = (models[2].f - m0.f) / (x1 - x0)
     dg = (models[2].contacts.g0 - m0.contacts.g0) / (x1 - x0)
+    dshift = (models[2].contacts.shift - m0.contacts.shift) / (x1 - x0)
     fm = m0.f + 0.5 * (x1 - x0) * df
     gm = m0.contacts.g0 + 0.5 * (x1 - x0) * dg
     fs = max(np.abs(m0.f).max(initial=0.0), np.abs(models[2].f).max(initial=0.0), 1e-300)
@@ -154,7 +159,7 @@ def linear_data(scene: Scene, path: str, start: float, stop: float) -> tuple[Mod
             or np.abs(models[1].contacts.g0 - gm).max(initial=0.0) > 1e3 * LINEAR_RTOL * gs):
         raise ProblemError(f"--exact: {path} does not enter the problem linearly (the load or the gaps are not "
                            "affine in it); sweep it without --exact (bisection)")
-    return m0, df, dg
+    return m0, df, dg, dshift
 
 
 def _differs(a: Model, b: Model) -> str | None:
@@ -193,7 +198,7 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
     ``gaps(t)``, ``deflections(t)``.
     """
     x0, x1 = as_number(start), as_number(stop)
-    model, df_user, dg_user = linear_data(scene, path, start, stop)
+    model, df_user, dg_user, dshift = linear_data(scene, path, start, stop)
     res = solve(model.scene, backend=backend, formulation=formulation, accuracy="high", model=model)
     data = Scaled.from_model(model)
     df = data.dof_scale * df_user / (data.F0 * data.W)
@@ -265,9 +270,7 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
         if step >= remaining:
             break
         events = np.flatnonzero(steps <= step * (1.0 + 1e-9) + 1e-300)
-        entering = events[~held[events]]
         held = held.copy()
-        held[entering] = True
         # degenerate at the event: the event's points, and any other touching one with no reaction
         R_next = np.maximum(state_R + sign * step * slope.dR, 0.0)
         g_next = np.maximum(state_gap + sign * step * slope.dgap, 0.0)
@@ -275,10 +278,11 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
         g_next[events] = 0.0
         _, deg = classify(data, R_next, g_next, tol)
         deg[events] = True
-        held |= deg  # a touching point without force is held, then released by the one-sided step if it opens
+        held |= deg  # the event's points (closing gaps, vanishing reactions) and any touching point without
+        # force are held here, then released by the one-sided step if they open
         D = np.flatnonzero(deg)
         t = t_next
-    return ExactPath(path, x0, x1, breaks, pieces, _data=data, _model=model, _affine=affine)
+    return ExactPath(path, x0, x1, breaks, pieces, _data=data, _model=model, _affine=affine, _dshift=dshift)
 
 
 @dataclass
