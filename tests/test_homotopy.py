@@ -139,3 +139,8 @@ def test_cli_sweep_exact(tmp_path, capsys):
     assert main(["sweep", str(path), "--param", "supports.2.stiffness", "--values", "1e3,1e4", "--exact"]) == 2
     err = capsys.readouterr().err
     assert "linearly" in err and len(err.strip().splitlines()) == 1
+
+
+def test_step_limit_is_an_error():
+    with pytest.raises(pq.ProblemError, match="more than 1 pieces"):
+        exact_path(corners(4), "supports.2.gap", 0.0, 0.05, max_pieces=1)

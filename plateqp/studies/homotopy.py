@@ -190,7 +190,7 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
         lemke, bpp or pdas, gives the start to rounding: "auto" picks one)
     tol : contact points whose reaction (relative to the largest) and gap (relative to the
         deflection scale) are both within ``tol`` of zero at the start are degenerate
-    max_pieces : stop with a ProblemError after this many pieces (default 4 m + 50)
+    max_pieces : stop with a ProblemError after this many steps along the path (default 4 m + 50)
 
     Returns
     -------
@@ -214,8 +214,10 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
     pieces, breaks, affine = [], [], []
     prev_contact = None
     zeros = np.zeros((m, 1))
+    steps_taken = 0
     while True:
-        if len(pieces) >= limit:
+        steps_taken += 1
+        if steps_taken > limit:  # counts every step (pieces that change nothing are merged)
             raise ProblemError(f"exact path of {path}: more than {limit} pieces before {stop} (stopped at {t:g})")
         if D.size > MAX_DEGENERATE:
             raise ProblemError(f"exact path of {path}: {D.size} contact points degenerate at {t:g} "
