@@ -36,6 +36,7 @@ from .scene import (
     Support,
     UniformLoad,
 )
+from .sensitivity import Sensitivity, sensitivity
 from .solving import solve, solve_bilateral
 
 __version__ = "0.1.0"
@@ -44,6 +45,6 @@ __version__ = "0.1.0"
 __all__ = [
     "Accuracy", "Edge", "ExportError", "Foundation", "KKTReport", "MechanismError", "MeshSpec", "NoEquilibriumError", "Opening",
     "PatchLoad", "Pin", "Plate", "PlateQPError", "PlateQPWarning", "PointLoad", "ProblemError", "ResourceError", "Result",
-    "Scene", "SceneError", "SolverError", "Status", "Support", "UniformLoad", "available_backends",
-    "get_backend", "registry", "solve", "solve_bilateral",
+    "Scene", "SceneError", "Sensitivity", "SolverError", "Status", "Support", "UniformLoad", "available_backends",
+    "get_backend", "registry", "sensitivity", "solve", "solve_bilateral",
 ]

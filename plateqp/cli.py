@@ -177,12 +177,35 @@ def _have_meshio() -> bool:
     return True
 
 
+def _sensitivity(result, as_json: bool):
+    """--sensitivity: the gap-sensitivity matrix dR_i/dg0_j of the solution
+    (:func:`plateqp.sensitivity`), as its JSON shape or as lines of text."""
+    from .sensitivity import sensitivity
+
+    sens = sensitivity(result, "gaps")
+    if as_json:
+        return sens.to_dict()
+    if sens.smooth:
+        sides = [("dR_i/dg0_j", sens.increasing)]
+    else:
+        at = ", ".join(str(int(i)) for i in sens.degenerate)
+        sides = [(f"dR_i/dg0_j as the gap increases (support(s) {at} at lift-off)", sens.increasing),
+                 (f"dR_i/dg0_j as the gap decreases (support(s) {at} at lift-off)", sens.decreasing)]
+    lines = []
+    for title, der in sides:
+        lines.append(f"  {title}:")
+        lines += ["  " + " ".join(f"{v:12.5g}" for v in row) for row in der.reactions]
+    return "\n".join(lines)
+
+
 def cmd_solve(args) -> int:
     _set_memory_limit(args.max_memory)
     scene = _scene_or_builtin(args.scene)
     opts = _options(args.options)
     _backend_name(args.backend)
     stem = safe_filename(scene.name)
+    if args.sensitivity and not scene.one_sided:
+        raise ProblemError("--sensitivity: the scene has no one-sided supports (nothing to differentiate)")
     vtu = bool(args.out) and _have_meshio()
     if args.out and not vtu:
         print("plateqp: meshio is not installed: no .vtu written (pip install 'plateqp[results]')", file=sys.stderr)
@@ -215,11 +238,15 @@ def cmd_solve(args) -> int:
             d["target"] = {"target": tr.target, "reached": tr.reached, "tolerance": tr.tolerance,
                            "mesh": [result.scene.mesh.nx, result.scene.mesh.ny],
                            "meshes": [{**r, "mesh": list(r["mesh"])} for r in tr.rows]}
+        if args.sensitivity:
+            d["sensitivity"] = _sensitivity(result, True)
         print(json.dumps(d, indent=1))
     else:
         if args.target is not None:
             print(tr)
         print(_summary(result, args.probe))
+        if args.sensitivity:
+            print(_sensitivity(result, False))
     if out is not None:
         (out / f"{stem}.json").write_text(json.dumps(result.to_dict(args.probe), indent=1))
         np.save(out / f"{stem}-w.npy", result.w_nodes())
@@ -356,27 +383,43 @@ def _sweep_values(args) -> list:
     return [float(v) for v in np.linspace(a, b, n)]
 
 
+def _sweep_exact(scene, values, opts, args):
+    """sweep --exact: the breakpoints of the exact path (:func:`plateqp.studies.exact_sweep`);
+    a parameter that does not enter linearly is a ProblemError (exit 2) before any work."""
+    from .studies import exact_sweep
+
+    if args.no_refine:
+        raise ProblemError("--exact and --no-refine: choose one")
+    return exact_sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
+                       accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
+                       max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                       warm_start=not args.no_warm_start)
+
+
 def cmd_sweep(args) -> int:
-    from .studies import sweep
+    from .studies import SweepInterrupted, sweep
 
     _set_memory_limit(args.max_memory)
     scene = _scene_or_builtin(args.scene)
     values = _sweep_values(args)
     opts = _options(args.options)
     _backend_name(args.backend)
-    from .studies import SweepInterrupted
-
     with _sigterm_as_interrupt() as seen:
         try:
             with _stdout_to_stderr():
-                res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
-                            accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
-                            max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
-                            refine_breakpoints=not args.no_refine, rtol=args.rtol,
-                            warm_start=not args.no_warm_start)
+                if args.exact:
+                    res = _sweep_exact(scene, values, opts, args)
+                else:
+                    res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
+                                accuracy=args.accuracy, options=opts,
+                                executor="serial" if args.workers <= 1 else None,
+                                max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                                refine_breakpoints=not args.no_refine, rtol=args.rtol,
+                                warm_start=not args.no_warm_start)
         except SweepInterrupted as exn:
             part = exn.result
-            print(json.dumps(part.to_dict(), indent=1) if args.json else part)
+            print(json.dumps({"method": "none" if args.no_refine else "bisection", **part.to_dict()}, indent=1)
+                  if args.json else part)
             sys.stdout.flush()
             left = part.interrupted["not_done"]
             where = 'JSON, with "interrupted"' if args.json else "the table"
@@ -386,7 +429,7 @@ def cmd_sweep(args) -> int:
                   + (f" (from {args.param} = {left[0]})" if left else ""), file=sys.stderr)
             return 143 if seen else 130
     if args.json:
-        print(json.dumps(res.to_dict(), indent=1))
+        print(json.dumps({"method": "none" if args.no_refine else "bisection", **res.to_dict()}, indent=1))
     else:
         print(res)
     bad = [r for r in res.rows if r["status"] != Status.OPTIMAL.value]
@@ -480,6 +523,8 @@ def main(argv=None) -> int:
     s.add_argument("--probe", type=_probe, action="append", default=[], metavar="X,Y")
     s.add_argument("--options", help="backend options as a JSON object, passed through untouched")
     s.add_argument("--json", action="store_true")
+    s.add_argument("--sensitivity", action="store_true",
+                   help="add the exact gap sensitivities dR_i/dg0_j of the solution (with --json: a 'sensitivity' object)")
     s.add_argument("--out", metavar="DIR", help="write <name>.json, <name>-w.npy (nodal w) and, with meshio, "
                    "<name>.vtu and <name>-supports.vtu (ParaView) into DIR")
     s.add_argument("--force", action="store_true", help="--out: overwrite files that exist")
@@ -498,6 +543,9 @@ def main(argv=None) -> int:
     w.add_argument("--options", help="backend options as a JSON object, passed through untouched")
     w.add_argument("--rtol", type=float, default=1e-3, help="relative width of each breakpoint's bracket")
     w.add_argument("--no-refine", action="store_true", help="report changes between values without bisection")
+    w.add_argument("--exact", action="store_true",
+                   help="breakpoints exactly, by parametric pivoting, for a parameter that enters linearly "
+                        "(a gap, a load, a prescribed displacement); refused for a stiffness")
     w.add_argument("--workers", type=int, default=2, help="local worker processes (1: serial)")
     w.add_argument("--no-warm-start", action="store_true",
                    help="start each value's solve cold (warm starts: bpp and pdas, from the previous contact set)")

@@ -273,7 +273,7 @@ def test_cli_sweep_json(capsys, tmp_path):
     out = capsys.readouterr()
     assert code == 0 and out.err == ""
     d = json.loads(out.out)
-    assert set(d) == {"rows", "breakpoints"}
+    assert set(d) == {"rows", "breakpoints", "method"} and d["method"] == "bisection"
     one = solve(fig5()).to_dict()
     assert [r["value"] for r in d["rows"]] == ["rigid", 1e6, 5e5]
     for r in d["rows"]:

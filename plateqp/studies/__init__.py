@@ -13,6 +13,8 @@ module                 job
                        stiffnesses or loads, without re-assembly
 :mod:`.design`         :func:`regulate_gaps` (gaps for prescribed reactions) and
                        :func:`most_uniform_stiffness`
+:mod:`.homotopy`       :func:`exact_path`: the exact piecewise-linear path along a parameter that
+                       enters linearly (gap, load, prescribed displacement), every breakpoint
 =====================  ==========================================================================
 
 Scene fields are named by dotted paths (:mod:`plateqp.paths`: :func:`get_param`,
@@ -22,6 +24,7 @@ Scene fields are named by dotted paths (:mod:`plateqp.paths`: :func:`get_param`,
 from __future__ import annotations
 
 from ..paths import get_param, set_param
+from .homotopy import ExactPath, ExactSweepResult, exact_path, exact_sweep
 from .design import GapRegulation, UniformStiffness, most_uniform_stiffness, regulate_gaps
 from .refinement import (ConvergenceTable, TargetResult, auto_tolerance, convergence, quantity, solve_to_target,
                          start_mesh)
@@ -32,6 +35,8 @@ __all__ = [
     "SERIAL_BELOW",
     "WARM_START_BACKENDS",
     "ConvergenceTable",
+    "ExactPath",
+    "ExactSweepResult",
     "GapRegulation",
     "SweepInterrupted",
     "SweepResult",
@@ -40,6 +45,8 @@ __all__ = [
     "adapt_model",
     "auto_tolerance",
     "convergence",
+    "exact_path",
+    "exact_sweep",
     "get_param",
     "most_uniform_stiffness",
     "quantity",
