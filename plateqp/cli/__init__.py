@@ -1,0 +1,135 @@
+"""The ``plateqp`` command: demo, solve, sweep, export, backends.
+
+Errors go to stderr as one line (what is wrong and where) with exit code 2 for bad input,
+3 for no equilibrium, 4 for a solver failure, 5 for an answer that missed the asked accuracy
+(or a ``--target`` not reached), 130 when interrupted (a sweep: 143 on SIGTERM; it stops its
+workers and prints the rows done so far); 1 only for an internal error (a bug:
+the line says so; ``PLATEQP_DEBUG=1`` shows the traceback).
+
+While a command works, anything a solver prints on standard output (HiGHS's banner, OSQP's
+"Polishing not needed") is sent to standard error, so that ``--json`` output is JSON alone.
+Files are written only inside ``--out``, under names made safe from the scene's name, never
+over an existing file unless ``--force`` is given, and ``--out`` is checked before any work.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from .. import scenes
+from ..errors import NoEquilibriumError, PlateQPError, SolverError
+from ..io.files import safe_filename
+from .common import _accuracy, _out_dir, _probe, _target
+from .solve import cmd_solve
+from .studies import cmd_regulate, cmd_sweep
+from .tools import cmd_backends, cmd_demo, cmd_export
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="plateqp", description="Thin plates on one-sided supports, contact as a convex QP.")
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    d = sub.add_parser("demo", help="solve a built-in scene and print a summary")
+    d.add_argument("name", nargs="?", help=f"one of: {', '.join(scenes.names())} (default: all)")
+    d.add_argument("--out", metavar="DIR", help="folder for the figures, JSON files and report.html "
+                   "(default: ./plateqp-demo)")
+    d.add_argument("--force", action="store_true", help="--out: overwrite files that exist")
+    s = sub.add_parser("solve", help="solve a scene file (or a built-in scene)")
+    s.add_argument("scene", help="a scene file, or the name of a built-in scene")
+    s.add_argument("--backend", default="auto")
+    s.add_argument("--formulation", default="auto", choices=["auto", "primal", "condensed", "dual"])
+    s.add_argument("--accuracy", default="default", type=_accuracy,
+                   help="low, default, high (KKT tolerance 1e-3, 1e-6, 1e-9), a tolerance such as 1e-7, "
+                        "or auto (a tenth of the mesh's estimated discretisation error)")
+    s.add_argument("--target", type=_target, metavar="REL",
+                   help="pick the coarsest mesh (halving from 4 cells a side) whose estimated relative error "
+                        "of max |w| and of the reactions is at most REL, solved at a tolerance of REL/10")
+    s.add_argument("--max-mesh", type=int, default=256, metavar="N", help="--target: most cells a side")
+    s.add_argument("--probe", type=_probe, action="append", default=[], metavar="X,Y")
+    s.add_argument("--options", help="backend options as a JSON object, passed through untouched")
+    s.add_argument("--json", action="store_true")
+    s.add_argument("--sensitivity", action="store_true",
+                   help="add the exact gap sensitivities dR_i/dg0_j of the solution (with --json: a 'sensitivity' object)")
+    s.add_argument("--out", metavar="DIR", help="write <name>.json, <name>-w.npy (nodal w) and, with meshio, "
+                   "<name>.vtu and <name>-supports.vtu (ParaView) into DIR")
+    s.add_argument("--force", action="store_true", help="--out: overwrite files that exist")
+    s.add_argument("--max-memory", metavar="BYTES",
+                   help="refuse meshes estimated to need more (e.g. 8G; default 80%% of this machine's memory)")
+    w = sub.add_parser("sweep", help="solve a scene for a range of one parameter; find where the contact set changes")
+    w.add_argument("scene")
+    w.add_argument("--param", required=True, metavar="PATH", help="e.g. supports.*.stiffness, supports.3.gap, loads.0.P")
+    wv = w.add_mutually_exclusive_group(required=True)
+    wv.add_argument("--values", metavar="V1,V2,...", help="values in sweep order ('rigid' allowed for a stiffness)")
+    wv.add_argument("--range", metavar="A:B:N[:log]", help="N values from A to B, evenly or log spaced")
+    w.add_argument("--backend", default="auto")
+    w.add_argument("--formulation", default="auto", choices=["auto", "primal", "condensed", "dual"])
+    w.add_argument("--accuracy", default="default", type=_accuracy,
+                   help="low, default, high, a tolerance such as 1e-7, or auto")
+    w.add_argument("--options", help="backend options as a JSON object, passed through untouched")
+    w.add_argument("--rtol", type=float, default=1e-3, help="relative width of each breakpoint's bracket")
+    w.add_argument("--no-refine", action="store_true", help="report changes between values without bisection")
+    w.add_argument("--exact", action="store_true",
+                   help="breakpoints exactly, by parametric pivoting, for a parameter that enters linearly "
+                        "(a gap, a load, a prescribed displacement); refused for a stiffness")
+    w.add_argument("--workers", type=int, default=2, help="local worker processes (1: serial)")
+    w.add_argument("--no-warm-start", action="store_true",
+                   help="start each value's solve cold (warm starts: bpp and pdas, from the previous contact set)")
+    w.add_argument("--max-values", type=int, default=10_000, metavar="N", help="most values a sweep takes")
+    w.add_argument("--max-memory", metavar="BYTES", help="refuse meshes estimated to need more (e.g. 8G)")
+    w.add_argument("--json", action="store_true")
+    x = sub.add_parser("export", help="write the contact problem as a QPS file or a qpbenchmark test set")
+    x.add_argument("scene", help="a scene file, or the name of a built-in scene")
+    x.add_argument("--formulation", default="primal", choices=["primal", "condensed", "dual"])
+    x.add_argument("--format", default="qps", choices=["qps", "qpbenchmark"],
+                   help="qps: one Maros-Meszaros QPS file; qpbenchmark: a directory with the .npz and the test-set module")
+    x.add_argument("--out", required=True, metavar="PATH", help="the .qps file, or the test set's directory")
+    x.add_argument("--name", help="problem name (default: SCENE_FORMULATION)")
+    x.add_argument("--testset", default="plateqp_contact", help="qpbenchmark test-set module name")
+    x.add_argument("--force", action="store_true", help="overwrite an existing file / write into a non-empty directory")
+    r = sub.add_parser("regulate", help="gaps that make chosen supports carry target reactions (checked by a solve)")
+    r.add_argument("scene", help="a scene file, or the name of a built-in scene")
+    r.add_argument("--target", required=True, metavar="R[,R...]",
+                   help="target reactions (compression >= 0): one for all, or one per regulated support")
+    r.add_argument("--supports", metavar="N[,N...]", help="the regulated supports, numbered from 1 (default: all)")
+    r.add_argument("--backend", default="auto")
+    r.add_argument("--formulation", default="auto", choices=["auto", "primal", "condensed", "dual"])
+    r.add_argument("--json", action="store_true")
+    r.add_argument("--out", metavar="FILE.toml", help="write the regulated scene (checked before any work)")
+    r.add_argument("--force", action="store_true", help="--out: overwrite the file if it exists")
+    b = sub.add_parser("backends", help="list the backends and the formulations each takes")
+    b.add_argument("--json", action="store_true")
+    args = ap.parse_args(argv)
+    saved_limit = os.environ.get("PLATEQP_MAX_MEMORY")  # --max-memory holds for this command only
+    try:
+        return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends,
+                "export": cmd_export, "regulate": cmd_regulate}[args.cmd](args)
+    except KeyboardInterrupt:
+        print("plateqp: interrupted", file=sys.stderr)
+        return 130
+    except NoEquilibriumError as exn:
+        print(f"plateqp: no equilibrium: {exn}", file=sys.stderr)
+        return 3
+    except SolverError as exn:
+        print(f"plateqp: solver error: {exn}", file=sys.stderr)
+        return 4
+    except PlateQPError as exn:
+        print(f"plateqp: {exn}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print("plateqp: out of memory: use a coarser mesh, or fewer contact points", file=sys.stderr)
+        return 2
+    except Exception as exn:  # noqa: BLE001 - a bug: one line, not a traceback (PLATEQP_DEBUG=1 shows it)
+        if os.environ.get("PLATEQP_DEBUG"):
+            raise
+        print(f"plateqp: internal error (a bug in plateqp, please report it with the command): "
+              f"{type(exn).__name__}: {str(exn).splitlines()[0] if str(exn) else ''}", file=sys.stderr)
+        return 1
+    finally:
+        if saved_limit is None:
+            os.environ.pop("PLATEQP_MAX_MEMORY", None)
+        else:
+            os.environ["PLATEQP_MAX_MEMORY"] = saved_limit
+
+
+__all__ = ["main", "safe_filename", "_out_dir"]

@@ -1,0 +1,7 @@
+"""``python -m plateqp.cli``: the ``plateqp`` command."""
+
+import sys
+
+from . import main
+
+sys.exit(main())

@@ -1,0 +1,141 @@
+"""Helpers shared by the ``plateqp`` subcommands: argument parsing, ``--out`` checked before any
+work, solver output kept off standard output, the memory limit.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import sys
+from pathlib import Path
+
+
+from .. import scenes
+from ..backends import get_backend
+from ..accuracy import accuracy_tol
+from ..errors import PlateQPError, ProblemError, SceneError, SolverError
+from ..scene import Scene
+
+
+def _probe(text: str) -> tuple[float, float]:
+    try:
+        x, y = (float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--probe wants X,Y (got {text!r})") from None
+    return x, y
+
+
+def _accuracy(text: str):
+    """--accuracy: a preset, "auto", or a tolerance such as 1e-7."""
+    if text in ("low", "default", "high", "auto"):
+        return text
+    try:
+        return accuracy_tol(text)
+    except PlateQPError as exn:
+        raise argparse.ArgumentTypeError(f"{exn} (or auto)") from None
+
+
+def _target(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 1e-8 <= v < 1.0:
+        raise argparse.ArgumentTypeError(f"--target wants a relative error between 1e-8 and 1 (got {text!r})")
+    return v
+
+
+def _options(text: str | None) -> dict | None:
+    """--options: a JSON object, or a one-line error naming what is wrong with it."""
+    if not text:
+        return None
+    try:
+        opts = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exn:
+        raise ProblemError(f"--options: not valid JSON ({getattr(exn, 'msg', 'nested too deep')})") from None
+    if not isinstance(opts, dict):
+        raise ProblemError(f"--options: must be a JSON object such as '{{\"max_iter\": 100}}' (got {type(opts).__name__})")
+    return opts
+
+
+def _backend_name(name: str) -> str:
+    """An unknown backend is bad input (exit 2), found before any work."""
+    if name != "auto":
+        try:
+            get_backend(name)
+        except SolverError as exn:  # unknown or not installed: what was asked is not there
+            raise ProblemError(f"--backend: {exn}") from None
+    return name
+
+
+def _out_dir(text: str, files: list[str], force: bool) -> Path:
+    """Check ``--out`` before any work: a folder (made if missing) that is writable and holds none
+    of ``files`` (unless ``force``)."""
+    out = Path(text)
+    if out.exists() and not out.is_dir():
+        raise ProblemError(f"--out {out}: exists and is not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exn:
+        raise ProblemError(f"--out {out}: cannot be made ({exn.strerror or exn})") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise ProblemError(f"--out {out}: is not writable")
+    there = [f for f in files if (out / f).exists()]
+    if there and not force:
+        raise ProblemError(f"--out {out}: {there[0]} exists; use --force to overwrite")
+    return out
+
+
+@contextlib.contextmanager
+def _stdout_to_stderr():
+    """Send everything written to standard output (Python's and the C libraries') to standard
+    error while the block runs; the command's own output is printed after it."""
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:  # no file descriptor 1 (embedded): Python-level redirection only
+        saved = None
+    try:
+        if saved is not None:
+            os.dup2(2, 1)
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
+    finally:
+        sys.stdout.flush()
+        if saved is not None:
+            try:
+                sys.__stdout__.flush()
+            except (OSError, ValueError, AttributeError):
+                pass
+            os.dup2(saved, 1)
+            os.close(saved)
+
+
+def _set_memory_limit(text: str | None) -> None:
+    if text:
+        from ..assembly import MEMORY_ENV, parse_bytes
+
+        parse_bytes(text, "--max-memory")
+        os.environ[MEMORY_ENV] = text  # worker processes inherit it
+
+
+def _scene_or_builtin(text: str) -> Scene:
+    """A scene file, or the name of a built-in scene (``plateqp demo`` lists them)."""
+    path = Path(text)
+    if not path.exists():
+        if text in scenes.names():
+            return scenes.load(text)
+        raise SceneError(f"{text}: no such file, nor a built-in scene ({', '.join(scenes.names())})")
+    return Scene.from_toml(path)
+
+
+def _numbers(text: str, what: str, cast=float) -> list:
+    try:
+        vals = [cast(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise PlateQPError(f"{what}: a comma-separated list of numbers (got {text!r})") from None
+    if not vals:
+        raise PlateQPError(f"{what}: empty")
+    return vals

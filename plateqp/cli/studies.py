@@ -1,0 +1,192 @@
+"""``plateqp sweep`` (bisection or exact paths; Ctrl-C and SIGTERM keep the rows done) and
+``plateqp regulate`` (gaps for target reactions).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..accuracy import Status
+from ..solving import solve
+from ..errors import PlateQPError, ProblemError
+from .common import _options, _backend_name, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, _numbers
+
+
+def cmd_regulate(args) -> int:
+    """Gaps that make the chosen supports carry the target reactions, checked by solving the
+    regulated scene (:func:`plateqp.studies.regulate_gaps`)."""
+    from ..io.files import check_file
+    from ..studies import regulate_gaps
+
+    scene = _scene_or_builtin(args.scene)
+    target = _numbers(args.target, "--target")
+    ns = len(scene.supports)
+    chosen = None
+    if args.supports is not None:
+        numbers = _numbers(args.supports, "--supports", int)
+        if any(k < 1 or k > ns for k in numbers) or len(set(numbers)) != len(numbers):
+            raise PlateQPError(f"--supports: distinct support numbers 1..{ns} (got {args.supports})")
+        chosen = [k - 1 for k in numbers]
+    n_reg = ns if chosen is None else len(chosen)
+    if len(target) not in (1, n_reg):
+        raise PlateQPError(f"--target: one value, or one per regulated support ({n_reg}); got {len(target)}")
+    if args.out:
+        check_file(args.out, force=args.force, label=f"--out {args.out}", flag="--force")
+    _backend_name(args.backend)
+    with warnings.catch_warnings(), _stdout_to_stderr():
+        warnings.simplefilter("ignore")
+        reg = regulate_gaps(scene, target if len(target) > 1 else target[0], supports=chosen,
+                            backend=args.backend, formulation=args.formulation)
+        check = solve(reg.scene, backend=args.backend, formulation=args.formulation, accuracy="high")
+    got = check.reactions[reg.supports]
+    scale = max(float(np.abs(reg.reactions).max(initial=0.0)), float(np.abs(check.reactions).max(initial=0.0)), 1e-300)
+    error = float(np.abs(got - reg.reactions).max(initial=0.0) / scale)
+    ok = check.status == Status.OPTIMAL and error <= 1e-6
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        reg.scene.to_toml(args.out)
+    rows = [{"support": int(k) + 1, "gap_before": float(scene.supports[k].gap), "gap": float(reg.gaps[k]),
+             "target": float(t), "reaction": float(r), "reaction_check": float(g)}
+            for k, t, r, g in zip(reg.supports, reg.target, reg.reactions, got)]
+    if args.json:
+        print(json.dumps({"scene": scene.name, "reachable": reg.reachable, "projection": reg.projection,
+                          "status": check.status.value, "check_error": error, "supports": rows,
+                          "gaps": [float(g) for g in reg.gaps], "out": args.out}, indent=1))
+    else:
+        print(f"{scene.name}: gaps for {len(rows)} regulated supports (numbers from 1)")
+        print(f"{'support':>7} {'gap before':>12} {'gap':>12} {'target R':>12} {'R':>12} {'R check':>12}")
+        for r in rows:
+            print(f"{r['support']:>7} {r['gap_before']:12.5g} {r['gap']:12.5g} {r['target']:12.5g} "
+                  f"{r['reaction']:12.5g} {r['reaction_check']:12.5g}")
+        print(f"check: {check.status.value}, reactions within {error:.1e} of the regulated ones"
+              + (f"; the regulated scene is in {args.out}" if args.out else ""))
+    if not reg.reachable:
+        print(f"plateqp: regulate: the target is not in equilibrium with the load: the nearest reachable "
+              f"reactions are used (relative distance {reg.projection:.2e})", file=sys.stderr)
+        return 5
+    if not ok:
+        print(f"plateqp: regulate: solving the regulated scene gave reactions {error:.1e} off "
+              f"(status {check.status.value})", file=sys.stderr)
+        return 5
+    return 0
+
+
+def _sweep_values(args) -> list:
+    """--values V1,V2,... ("rigid" allowed) or --range A:B:N[:log]."""
+    if args.values is not None:
+        out = []
+        for v in args.values.split(","):
+            v = v.strip()
+            if v.lower() in ("rigid", "inf"):
+                out.append("rigid")
+                continue
+            try:
+                out.append(int(v) if v.lstrip("+-").isdigit() else float(v))
+            except ValueError:
+                raise PlateQPError(f"--values: not a number or 'rigid': {v!r}") from None
+        if len(out) > args.max_values:
+            raise PlateQPError(f"--values: {len(out)} values is more than --max-values {args.max_values}")
+        return out
+    parts = args.range.split(":")
+    try:
+        if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
+            raise ValueError
+        a, b, n = float(parts[0]), float(parts[1]), int(parts[2])
+    except ValueError:
+        raise PlateQPError(f"--range wants A:B:N or A:B:N:log (got {args.range!r})") from None
+    if n < 1:
+        raise PlateQPError(f"--range: N must be >= 1 (got {n})")
+    if n > args.max_values:
+        raise PlateQPError(f"--range: {n} values is more than --max-values {args.max_values}; "
+                           "raise --max-values if you mean it")
+    if len(parts) == 4 and parts[3] == "log":
+        if a <= 0 or b <= 0:
+            raise PlateQPError(f"--range {args.range}: a log range needs A, B > 0")
+        return [float(v) for v in np.geomspace(a, b, n)]
+    return [float(v) for v in np.linspace(a, b, n)]
+
+
+def _sweep_exact(scene, values, opts, args):
+    """sweep --exact: the breakpoints of the exact path (:func:`plateqp.studies.exact_sweep`);
+    a parameter that does not enter linearly is a ProblemError (exit 2) before any work."""
+    from ..studies import exact_sweep
+
+    if args.no_refine:
+        raise ProblemError("--exact and --no-refine: choose one")
+    return exact_sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
+                       accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
+                       max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                       warm_start=not args.no_warm_start)
+
+
+def cmd_sweep(args) -> int:
+    from ..studies import SweepInterrupted, sweep
+
+    _set_memory_limit(args.max_memory)
+    scene = _scene_or_builtin(args.scene)
+    values = _sweep_values(args)
+    opts = _options(args.options)
+    _backend_name(args.backend)
+    with _sigterm_as_interrupt() as seen:
+        try:
+            with _stdout_to_stderr():
+                if args.exact:
+                    res = _sweep_exact(scene, values, opts, args)
+                else:
+                    res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
+                                accuracy=args.accuracy, options=opts,
+                                executor="serial" if args.workers <= 1 else None,
+                                max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                                refine_breakpoints=not args.no_refine, rtol=args.rtol,
+                                warm_start=not args.no_warm_start)
+        except SweepInterrupted as exn:
+            part = exn.result
+            print(json.dumps({"method": "none" if args.no_refine else "bisection", **part.to_dict()}, indent=1)
+                  if args.json else part)
+            sys.stdout.flush()
+            left = part.interrupted["not_done"]
+            where = 'JSON, with "interrupted"' if args.json else "the table"
+            print(f"plateqp: sweep interrupted ({'SIGTERM' if seen else 'Ctrl-C'}), workers stopped: the"
+                  f" {part.interrupted['done']} of {part.interrupted['of']} values done are on standard output"
+                  f" ({where}); not done: {len(left)}"
+                  + (f" (from {args.param} = {left[0]})" if left else ""), file=sys.stderr)
+            return 143 if seen else 130
+    if args.json:
+        print(json.dumps({"method": "none" if args.no_refine else "bisection", **res.to_dict()}, indent=1))
+    else:
+        print(res)
+    bad = [r for r in res.rows if r["status"] != Status.OPTIMAL.value]
+    if bad:
+        print(f"plateqp: sweep: {len(bad)} of {len(res.rows)} values failed or missed the asked accuracy "
+              f"(first: {args.param} = {bad[0]['value']}: {bad[0]['error'] or bad[0]['status']})", file=sys.stderr)
+        return 5
+    return 0
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt():
+    """While the block runs, SIGTERM raises KeyboardInterrupt (so a sweep stops its workers and
+    keeps its rows, as on Ctrl-C); yields a list that is non-empty once SIGTERM came."""
+    import signal
+
+    seen: list = []
+
+    def on_term(signum, frame):
+        seen.append(signum)
+        raise KeyboardInterrupt
+
+    try:
+        old = signal.signal(signal.SIGTERM, on_term)
+    except ValueError:  # not the main thread: leave SIGTERM alone
+        yield seen
+        return
+    try:
+        yield seen
+    finally:
+        signal.signal(signal.SIGTERM, old)
