@@ -215,9 +215,12 @@ def cmd_solve(args) -> int:
 
 
 def cmd_demo(args) -> int:
-    from .demo import run
+    from .demo import DEFAULT_OUT, output_files, run
 
-    return run([args.name] if args.name else None, Path(args.out) if args.out else None)
+    names = [args.name] if args.name else None
+    files = output_files(names)  # an unknown scene: SceneError before any folder is made
+    out = _out_dir(args.out or DEFAULT_OUT, files, args.force)  # before any work
+    return run(names, out)
 
 
 def cmd_backends(args) -> int:
@@ -308,22 +311,21 @@ def _scene_or_builtin(text: str) -> Scene:
 def cmd_export(args) -> int:
     """``plateqp export``: the contact problem as a QPS file or a qpbenchmark test set."""
     from .errors import ExportError
-    from .export import contact_qp, write_qpbenchmark, write_qps
+    from .io import check_testset_dir, contact_qp, write_qpbenchmark, write_qps
+    from .io.files import check_file
 
     out = Path(args.out)
-    if args.format == "qpbenchmark" and (not args.testset.isidentifier() or args.testset.startswith("_")):
-        raise ExportError(f"--testset {args.testset!r}: must be a Python identifier (qpbenchmark imports it)")
     if args.format == "qps":
-        if out.is_dir():
-            raise ExportError(f"--out {out}: is a directory; --format qps writes one file")
-        if out.exists() and not args.force:
-            raise ExportError(f"--out {out}: exists; use --force to overwrite it")
-    elif out.exists() and (not out.is_dir() or any(out.iterdir())) and not args.force:
-        raise ExportError(f"--out {out}: exists and is not an empty directory; use --force to write into it")
+        check_file(out, force=args.force, label=f"--out {out}", flag="--force")
+    else:
+        check_testset_dir(out, args.testset, force=args.force, label=f"--out {out}")
     scene = _scene_or_builtin(args.scene)
     exported = contact_qp(scene, args.formulation, name=args.name)
     if args.format == "qps":
-        out.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            out.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exn:
+            raise ExportError(f"--out {out}: cannot make its folder ({exn.strerror or exn})") from None
         path = write_qps(exported, out)
     else:
         path = write_qpbenchmark([exported], out, name=args.testset, force=args.force)
@@ -339,7 +341,9 @@ def main(argv=None) -> int:
     sub = ap.add_subparsers(dest="cmd", required=True)
     d = sub.add_parser("demo", help="solve a built-in scene and print a summary")
     d.add_argument("name", nargs="?", help=f"one of: {', '.join(scenes.names())} (default: all)")
-    d.add_argument("--out", help="folder for the reports")
+    d.add_argument("--out", metavar="DIR", help="folder for the figures, JSON files and report.html "
+                   "(default: ./plateqp-demo)")
+    d.add_argument("--force", action="store_true", help="--out: overwrite files that exist")
     s = sub.add_parser("solve", help="solve a scene file (or a built-in scene)")
     s.add_argument("scene", help="a scene file, or the name of a built-in scene")
     s.add_argument("--backend", default="auto")

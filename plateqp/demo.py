@@ -5,7 +5,10 @@ scene has one-sided supports, the source paper's comparison (:func:`plateqp.solv
 every support made two-sided). Prints one summary line per scene to stdout, the paper's
 quantitative statements for our scenes (:func:`compare`), and writes the figures (PNG), one
 JSON file per scene and a self-contained ``report.html`` (figures embedded as base64 PNG)
-into the output folder. Progress goes to stderr.
+into the output folder. Progress goes to stderr. The figures come from
+:mod:`plateqp.plotting`, the summary table and the HTML from :mod:`plateqp.report`;
+:func:`output_files` lists every file a run may write, so that the command line can check
+the folder before any work and refuse to overwrite without ``--force``.
 
 The paper's statements, and how they are measured here
 ------------------------------------------------------
@@ -28,8 +31,7 @@ solution; the relative difference (σ1_one − σ1_two) / |σ1_two|.
 
 from __future__ import annotations
 
-import base64
-import html
+import importlib.util
 import json
 import math
 import sys
@@ -42,9 +44,13 @@ import numpy as np
 
 from . import scenes
 from .errors import PlateQPWarning
+from .plotting.data import support_spacing
+from .report import format_table, report_html, summary_row
 
 DEFAULT_OUT = "plateqp-demo"
 DPI = 100
+#: The figures of a scene, as ``<scene>-<stem>.png`` (a scene draws those that apply to it).
+FIGURES = ("mesh", "surface", "contours", "sections", "difference", "sigma1", "reactions", "convergence")
 # units of the built-in scenes that do not state them in a "# units: length, force" comment
 UNITS_FALLBACK: dict[str, tuple[str, str]] = {"slab": ("m", "N")}
 
@@ -74,16 +80,6 @@ def scene_notes(name: str) -> tuple[str, tuple[str, str] | None]:
 
 
 # -- the paper's statements ---------------------------------------------------------------------
-def support_spacing(xy: np.ndarray) -> float:
-    """Median distance from a support to its nearest neighbour (inf for fewer than two)."""
-    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-    if xy.shape[0] < 2:
-        return math.inf
-    d = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
-    np.fill_diagonal(d, np.inf)
-    return float(np.median(d.min(axis=1)))
-
-
 def zones(result) -> np.ndarray:
     """Per plate node, (ny+1, nx+1): +1 contact zone, −1 lift-off zone, 0 neither (see module doc)."""
     sc = result.scene
@@ -266,6 +262,8 @@ def run_scene(name: str, figures: bool = True) -> SceneRun:
         secs = pl.default_sections(one)
 
         def put(stem, caption, make):
+            if stem not in FIGURES:  # output_files must know every file the demo may write
+                raise ValueError(f"figure {stem!r} is not in demo.FIGURES")
             fig = make()
             figs[f"{name}-{stem}"] = pl.png_bytes(fig, dpi=DPI)
             caps[f"{name}-{stem}"] = caption
@@ -300,9 +298,7 @@ def run_scene(name: str, figures: bool = True) -> SceneRun:
                 "would have to pull the plate down).", lambda: pl.plot_reactions(one, two, units))
             conv = convergence_plot(scene, one)
             if conv is not None:
-                fig, caption = conv
-                figs[f"{name}-convergence"] = pl.png_bytes(fig, dpi=DPI)
-                caps[f"{name}-convergence"] = caption
+                put("convergence", conv[1], lambda: conv[0])
     t3 = time.perf_counter()
     return SceneRun(name, story, units, one, two, comp, figs, caps, t1 - t0, t2 - t1, t3 - t2)
 
@@ -332,31 +328,41 @@ def convergence_plot(scene, one):
 
     Uses :func:`plateqp.studies.convergence` on meshes 4, 8, 16, 32 (a mesh on which the
     scene cannot be built is left out). Returns (figure, caption), or None with a note on
-    stderr if the study cannot run.
+    stderr if the study cannot run: plateqp.studies or matplotlib is not installed, or the
+    study raises a :class:`~plateqp.errors.PlateQPError`. Any other exception is a bug and
+    propagates.
     """
     from . import plotting as pl
     from .errors import PlateQPError
 
+    # Only what is expected is caught (a missing module, a scene the study cannot take); a
+    # programming error (AttributeError, TypeError, KeyError, ...) must surface, not vanish
+    # into a "skipped" note.
     try:
         from .studies import convergence
-
-        idx = characteristic_supports(one)
-        quantities = ["w_max"] + [f"reactions.{i}" for i in idx]
-        tab = convergence(scene, meshes=CONVERGENCE_MESHES, quantities=quantities, target=CONVERGENCE_TARGET,
-                          accuracy="high")
-        labels = {"w_max": "w at max |w|"}
-        for k, i in enumerate(idx):
-            s = scene.supports[i]
-            what = ("most loaded" if k == 0 else "heaved" if s.gap < 0 else "settled" if s.gap > 0
-                    else "least loaded in contact")
-            labels[f"reactions.{i}"] = f"R of support {i + 1}" + (f" ({what})" if what else "")
-        diffs = {labels[q]: np.asarray(tab.diff[q], dtype=float) for q in quantities}
-        fig = pl.plot_convergence(tab.meshes, diffs, CONVERGENCE_TARGET,
-                                  ylabel="relative change when the mesh is halved",
-                                  title=f"{scene.name}: convergence under mesh halving")
-    except (ImportError, AttributeError, TypeError, KeyError, ValueError, PlateQPError) as exn:
+    except ModuleNotFoundError as exn:  # plateqp.studies, or a package it needs, is not installed
         _progress(f"{scene.name}: convergence study skipped ({type(exn).__name__}: {exn})")
         return None
+    if importlib.util.find_spec("matplotlib") is None:
+        _progress(f"{scene.name}: convergence study skipped (matplotlib is not installed)")
+        return None
+    idx = characteristic_supports(one)
+    quantities = ["w_max"] + [f"reactions.{i}" for i in idx]
+    try:
+        tab = convergence(scene, meshes=CONVERGENCE_MESHES, quantities=quantities, target=CONVERGENCE_TARGET,
+                          accuracy="high")
+    except PlateQPError as exn:  # the scene cannot be studied on these meshes (one mesh failing is a row)
+        _progress(f"{scene.name}: convergence study skipped ({type(exn).__name__}: {exn})")
+        return None
+    labels = {"w_max": "w at max |w|"}
+    for k, i in enumerate(idx):
+        s = scene.supports[i]
+        what = ("most loaded" if k == 0 else "heaved" if s.gap < 0 else "settled" if s.gap > 0
+                else "least loaded in contact")
+        labels[f"reactions.{i}"] = f"R of support {i + 1}" + (f" ({what})" if what else "")
+    diffs = {labels[q]: np.asarray(tab.diff[q], dtype=float) for q in quantities}
+    fig = pl.plot_convergence(tab.meshes, diffs, CONVERGENCE_TARGET, ylabel="relative change when the mesh is halved",
+                              title=f"{scene.name}: convergence under mesh halving")
     conv = [f"{labels[q]}: {'from ' + '×'.join(map(str, tab.converged_at[q])) if tab.converged_at[q] else 'not yet'}"
             for q in quantities]
     caption = ("Convergence under mesh halving (plateqp.studies.convergence): the relative change of each "
@@ -365,187 +371,20 @@ def convergence_plot(scene, one):
     return fig, caption
 
 
-# -- the summary -----------------------------------------------------------------------------------
-HEADER = ("scene", "contact", "w one-sided", "w two-sided", "max sigma1", "KKT", "t one", "t two", "t figs",
-          "units")
-
-
-def summary_row(r: SceneRun) -> tuple[str, ...]:
-    """One summary line: w is the signed value at the node of largest |w|; times in seconds."""
-    one, two = r.one, r.two
-    n = len(one.scene.supports)
-    contact = f"{int(np.asarray(one.active[:n]).sum())}/{n}" if n else "-"
-    w1 = one.w_max()[0]
-    s1 = float(np.nanmax(one.nodal("s1")))
-    kkt = "-" if one.kkt is None else ("ok" if one.kkt.ok else "NOT MET")
-    if not one.ok:
-        kkt += f" ({one.status.value})"
-    return (r.name, contact, f"{w1:+.4g}", f"{two.w_max()[0]:+.4g}" if two is not None else "-", f"{s1:.4g}", kkt,
-            f"{r.t_one:.2f}", f"{r.t_two:.2f}" if two is not None else "-", f"{r.t_figures:.2f}",
-            ", ".join(r.units) if r.units else "-")
-
-
-def format_table(rows: list[tuple[str, ...]]) -> str:
-    rows = [HEADER] + rows
-    widths = [max(len(row[k]) for row in rows) for k in range(len(HEADER))]
-    lines = ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in rows]
-    lines.insert(1, "  ".join("-" * w for w in widths))
-    return "\n".join(lines)
-
-
-# -- the report ------------------------------------------------------------------------------------
-_CSS = """
-body { font-family: system-ui, -apple-system, Segoe UI, sans-serif; max-width: 1150px; margin: 2em auto;
-       padding: 0 1em; color: #222; line-height: 1.45; }
-h1 { font-size: 1.6em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: .2em; margin-top: 2em; }
-table { border-collapse: collapse; margin: .8em 0; font-size: .92em; }
-th, td { border: 1px solid #ccc; padding: .25em .6em; text-align: left; }
-th { background: #f2f2f2; }
-pre.story { background: #f8f8f4; border-left: 3px solid #bba; padding: .6em .9em; white-space: pre-wrap; }
-figure { margin: 1.2em 0; } figure img { max-width: 100%; border: 1px solid #eee; }
-figcaption { font-size: .9em; color: #555; }
-.bad { color: #b00; font-weight: bold; }
-"""
-
-
-def _img(png: bytes, alt: str) -> str:
-    data = base64.b64encode(png).decode("ascii")
-    return f'<img src="data:image/png;base64,{data}" alt="{html.escape(alt)}">'
-
-
-def report_html(runs: list[SceneRun], table: str) -> str:
-    """The self-contained HTML report (images embedded as base64 PNG)."""
-    import plateqp as pq
-
-    e = html.escape
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>plateqp demo</title>"
-             f"<style>{_CSS}</style></head><body>",
-             "<h1>plateqp demo: plates on one-sided supports, heave and settlement</h1>",
-             f"<p>plateqp {e(pq.__version__)}, {e(time.strftime('%Y-%m-%d %H:%M'))}. Each scene is solved with "
-             "one-sided supports (<code>pq.solve(scene, accuracy='high')</code>) and, as in the source paper "
-             "(Lovtsov &amp; Dolgachev 2012, figures 3–6), with every support made two-sided "
-             "(<code>pq.solve_bilateral(scene)</code>).</p>",
-             "<p>Conventions: w is positive <b>downward</b> (the direction of the load), so every deflection axis "
-             "points down; a gap g0 &lt; 0 is heave (the support pushed up into the plate), g0 &gt; 0 settlement; "
-             "reactions R ≥ 0 push the plate up. Stresses are those of the bottom face (tension &gt; 0).</p>",
-             "<h2>Summary</h2>",
-             "<p>w: the signed deflection at the node of largest |w|; max sigma1: largest principal stress of the "
-             "one-sided solution; KKT: the one-sided result meets the 'high' accuracy; times in seconds "
-             "(one-sided solve, two-sided solve, figures).</p>",
-             _table_html(table)]
-    statements = [r for r in runs if r.comparison is not None]
-    if statements:
-        parts.append("<h2>The source paper's statements, measured on our scenes</h2>")
-        parts.append(
-            "<p>The paper (figures 3–4) finds large deflection differences between one- and two-sided support in "
-            "the lift-off zones, at most 6 % in the contact zone, and σ1 fields that almost coincide at their "
-            "maxima (2 % near the point load). Here: each plate node belongs to the tributary area of its nearest "
-            "support(s) if that support is at most one support spacing away; the node is in the <b>contact zone</b> "
-            "if all its nearest supports are in contact (one-sided solution), in the <b>lift-off zone</b> if none "
-            "is, otherwise in neither. The difference is max |w<sub>one-sided</sub> − w<sub>two-sided</sub>| over "
-            "the zone's nodes, also as a fraction of the largest |w| of either solution. σ1 near the load: the "
-            "largest nodal σ1 within r of the point load, r = max(half the support spacing, two mesh cells), "
-            "relative difference (σ1<sub>one</sub> − σ1<sub>two</sub>) / |σ1<sub>two</sub>|.</p>")
-        rows = ["<tr><th>scene</th><th>in contact</th><th>contact zone: max |Δw|</th>"
-                "<th>lift-off zone: max |Δw|</th><th>max σ1 near the load: one / two-sided</th>"
-                "<th>two-sided tension</th></tr>"]
-        for r in statements:
-            c = r.comparison
-            L = r.units[0] if r.units else ""
-            F = r.units[1] if r.units else ""
-            S = f" {F}/{L}²" if r.units else ""
-
-            def zone(nodes, dw, rel, L=L):
-                return "no nodes" if not nodes else f"{dw:.3g} {e(L)} ({100 * rel:.1f} %), {nodes} nodes"
-
-            s1 = (f"{c.s1_one:.4g} / {c.s1_two:.4g}{e(S)} ({100 * c.s1_rel:+.1f} %), r = {c.s1_radius:g} {e(L)}"
-                  if math.isfinite(c.s1_one) else "no point load")
-            ten = (f"{len(c.tension_supports)} supports, min R = {c.min_R_two:.4g} {e(F)}" if c.tension_supports
-                   else "none")
-            rows.append(f"<tr><td>{e(r.name)}</td><td>{c.n_contact} of {c.n_supports}</td>"
-                        f"<td>{zone(c.contact_nodes, c.dw_contact, c.dw_contact_rel)}</td>"
-                        f"<td>{zone(c.liftoff_nodes, c.dw_liftoff, c.dw_liftoff_rel)}</td><td>{s1}</td>"
-                        f"<td>{ten}</td></tr>")
-        parts.append("<table>" + "".join(rows) + "</table>")
-    for r in runs:
-        parts.append(f"<h2 id='{e(r.name)}'>Scene “{e(r.name)}”</h2>")
-        if r.story:
-            parts.append(f"<pre class='story'>{e(r.story)}</pre>")
-        parts.append(_scene_facts(r))
-        if r.comparison is not None:
-            parts.append("<ul>" + "".join(f"<li>{e(s)}</li>" for s in r.comparison.lines(r.units)) + "</ul>")
-        for stem, png in r.figures.items():
-            parts.append(f"<figure>{_img(png, stem)}<figcaption><b>{e(stem)}.png</b>: {e(r.captions[stem])}"
-                         "</figcaption></figure>")
-    parts.append("</body></html>")
-    return "\n".join(parts)
-
-
-def _table_html(table: str) -> str:
-    lines = table.splitlines()
-    rows = [HEADER]
-    for line in lines[2:]:
-        rows.append(tuple(_split_row(line)))
-    out = ["<table><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in HEADER) + "</tr>"]
-    for row in rows[1:]:
-        cells = []
-        for h, v in zip(HEADER, row):
-            cls = " class='bad'" if (h == "KKT" and v not in ("ok", "-")) else ""
-            cells.append(f"<td{cls}>{html.escape(v)}</td>")
-        out.append("<tr>" + "".join(cells) + "</tr>")
-    return "".join(out) + "</table>"
-
-
-def _split_row(line: str) -> list[str]:
-    # columns are separated by two or more spaces (values never contain two spaces)
-    import re
-
-    cells = re.split(r" {2,}", line.strip())
-    return cells + [""] * (len(HEADER) - len(cells))
-
-
-def _scene_facts(r: SceneRun) -> str:
-    sc = r.one.scene
-    p = sc.plate
-    L = r.units[0] if r.units else ""
-    F = r.units[1] if r.units else ""
-    e = html.escape
-    loads = []
-    for ld in sc.loads:
-        if ld.type == "point":
-            loads.append(f"point P = {ld.P:g} {F} at ({ld.x:g}, {ld.y:g})")
-        elif ld.type == "uniform":
-            loads.append(f"uniform q = {ld.q:g} {F}/{L}²" if r.units else f"uniform q = {ld.q:g}")
-        else:
-            loads.append(f"patch q = {ld.q:g} on [{ld.x0:g}, {ld.x1:g}] × [{ld.y0:g}, {ld.y1:g}]")
-    n = len(sc.supports)
-    Eu, Du = (f" {F}/{L}²", f" {F}·{L}") if r.units else ("", "")
-    facts = [f"plate {p.a:g} × {p.b:g} {L}, h = {p.h:g} {L}, E = {p.E:g}{Eu}, ν = {p.nu:g}, "
-             f"D = {p.D:.4g}{Du}; mesh {sc.mesh.nx} × {sc.mesh.ny} {sc.mesh.element.upper()}",
-             "loads: " + "; ".join(loads)]
-    if n:
-        heaved = [i + 1 for i, s in enumerate(sc.supports) if s.gap < 0]
-        settled = [i + 1 for i, s in enumerate(sc.supports) if s.gap > 0]
-        elastic = sum(not s.rigid for s in sc.supports)
-        on = np.asarray(r.one.active[:n], dtype=bool)
-        facts.append(f"{n} one-sided supports ({elastic} elastic, {n - elastic} rigid); heaved: "
-                     f"{_ids(heaved)}; settled: {_ids(settled)}")
-        facts.append(f"in contact ({int(on.sum())}): {_ids(np.flatnonzero(on) + 1)}; lifted off ({int((~on).sum())}): "
-                     f"{_ids(np.flatnonzero(~on) + 1)}")
-        facts.append(f"sum of reactions {r.one.reactions.sum():.6g} {F}; status {r.one.status.value} "
-                     f"({r.one.backend}, {r.one.formulation}); worst KKT residual "
-                     f"{r.one.kkt.worst:.1e} (tol {r.one.kkt.tol:.0e})" if r.one.kkt is not None else "")
-    else:
-        facts.append(f"two-sided only (no one-sided supports): status {r.one.status.value}")
-    return "<ul>" + "".join(f"<li>{e(f)}</li>" for f in facts if f) + "</ul>"
-
-
-def _ids(ids) -> str:
-    ids = [int(i) for i in ids]
-    return ", ".join(map(str, ids)) if ids else "none"
-
-
 # -- entry point -----------------------------------------------------------------------------------
+def output_files(names: list[str] | None = None) -> list[str]:
+    """Every file :func:`run` may write for the scenes ``names`` (all when None or empty):
+    ``report.html``, ``<scene>.json`` and ``<scene>-<figure>.png`` for each of :data:`FIGURES`
+    (whether or not the scene draws it), so that a folder can be checked before any work.
+
+    Raises :class:`~plateqp.errors.SceneError` for an unknown scene name.
+    """
+    names = list(names) if names else scenes.names()
+    for n in names:
+        scenes.path(n)  # unknown name: SceneError
+    return ["report.html"] + [f for n in names for f in [f"{n}.json"] + [f"{n}-{stem}.png" for stem in FIGURES]]
+
+
 def run(names: list[str] | None = None, out: Path | None = None) -> int:
     """Solve the built-in scenes ``names`` (all when None or empty), print the summary, write the report.
 
@@ -561,8 +400,6 @@ def run(names: list[str] | None = None, out: Path | None = None) -> int:
     out = Path(out) if out is not None else Path.cwd() / DEFAULT_OUT
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    import importlib.util
-
     figures = importlib.util.find_spec("matplotlib") is not None
     if not figures:
         _progress("matplotlib is not installed (pip install 'plateqp[plot]'): the report will have no figures")

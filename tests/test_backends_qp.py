@@ -348,12 +348,33 @@ def test_options_override_preset(name, options):
 
 
 @pytest.mark.parametrize("name", ["osqp", "clarabel"])
-def test_unknown_option_is_a_solver_error(name):
+def test_a_bad_option_value_is_a_problem_error(name):
+    """A setting the solver knows, with a value it refuses (the unknown names of every backend:
+    tests/test_backends.py)."""
     b = BACKENDS[name]
     if not b.available():
         pytest.skip(f"{name} not installed")
-    with pytest.raises(SolverError):
-        b.solve(one_active_inequality()[0], options={"no_such_setting": 1})
+    bad = {"osqp": {"eps_abs": -1.0}, "clarabel": {"max_iter": "many"}}[name]
+    with pytest.raises(ProblemError, match="option|settings"):
+        b.solve(one_active_inequality()[0], options=bad)
+
+
+#: Installed cvxpy solvers that take P through a factorisation of it (a cone program):
+#: an indefinite P is refused while cvxpy compiles (ValueError before the fix, a traceback).
+FACTORISE_P = ("cvxpy:ECOS", "cvxpy:CVXOPT")
+
+
+@pytest.mark.parametrize("name", FACTORISE_P)
+def test_indefinite_p_is_a_one_line_solver_error(name):
+    """cvxpy's "quad_form … indefinite" ValueError (issue 10: cvxpy:ECOS and cvxpy:CVXOPT on the
+    condensed form) becomes a SolverError of one line that keeps the cause."""
+    b = BACKENDS.get(name)
+    if b is None or not b.available():
+        pytest.skip(f"{name} not installed")
+    lcp = LCP(M=np.array([[1.0, 1.0 + 1e-6], [1.0 + 1e-6, 1.0]]), q=np.array([-1.0, -1.0]))  # eigenvalue −1e-6
+    with pytest.raises(SolverError, match="cannot pass this problem") as info:
+        b.solve(lcp, accuracy="high")
+    assert "\n" not in str(info.value) and isinstance(info.value.__cause__, ValueError)
 
 
 def test_cvxpy_records_defaults_for_unmapped_solver(monkeypatch):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import time
+import sys
 
 import numpy as np
 import pytest
@@ -33,13 +33,10 @@ def test_builtin_scene_is_a_real_contact_problem(name):
     sc = scenes.load(name)
     assert (sc.mesh.nx, sc.mesh.ny) == (16, 16)  # the paper's mesh
     assert not sc.edges and not sc.pins  # a floating plate: the supports carry everything
-    t0 = time.perf_counter()
-    res = pq.solve(sc)
-    elapsed = time.perf_counter() - t0
+    res = pq.solve(sc)  # its time is measured in benchmarks/, not asserted here
     assert res.status == pq.Status.OPTIMAL and res.kkt.ok
     assert 0 < res.active.sum() < res.active.size  # mixed contact set
     assert res.reactions.sum() == pytest.approx(total_load(sc), rel=1e-8)  # statics of a floating plate
-    assert elapsed < 5.0  # budget 2 s; generous here against a loaded test machine
     story, units = demo.scene_notes(name)
     assert units == ("cm", "kgf") and len(story) > 200
 
@@ -116,6 +113,8 @@ def test_run_writes_report(tmp_path, capsys):
     rep = json.loads((tmp_path / "heave.json").read_text())
     assert rep["one_sided"]["status"] == "optimal" and "two_sided" in rep
     assert rep["comparison"]["n_contact"] == 17
+    # every file written is one the command line checks before any work (--out, --force)
+    assert {p.name for p in tmp_path.iterdir()} <= set(demo.output_files(["heave"]))
 
 
 def test_run_default_folder_and_two_sided_scene(tmp_path, monkeypatch, capsys):
@@ -140,7 +139,7 @@ def test_convergence_panel_and_its_fallback(monkeypatch, capsys):
     if made is not None:  # plateqp.studies is there
         fig, caption = made
         assert fig.axes[0].get_yscale() == "log" and "target" in caption
-    monkeypatch.setitem(__import__("sys").modules, "plateqp.studies", None)  # as if it were missing
+    monkeypatch.setitem(sys.modules, "plateqp.studies", None)  # as if it were missing
     assert demo.convergence_plot(sc, one) is None
     assert "convergence study skipped" in capsys.readouterr().err
 
@@ -153,3 +152,141 @@ def test_run_without_matplotlib_writes_a_report_without_figures(tmp_path, monkey
     assert demo.run(["slab"], tmp_path) == 0
     assert "no figures" in capsys.readouterr().err
     assert not list(tmp_path.glob("*.png")) and "<img" not in (tmp_path / "report.html").read_text()
+
+
+# -- what the convergence panel may swallow, and what it must not --------------------------------
+
+
+def _raise(exn):
+    def boom(*args, **kwargs):
+        raise exn
+    return boom
+
+
+@pytest.mark.parametrize("exn", [AttributeError("'Result' object has no attribute 'wmax'"),
+                                 TypeError("convergence() got an unexpected keyword argument"),
+                                 KeyError("reactions.3"), ValueError("unknown quantity"),
+                                 ImportError("cannot import name 'ConvergenceTable'")],
+                         ids=lambda e: type(e).__name__)
+def test_convergence_plot_lets_bugs_through(monkeypatch, exn):
+    """A programming error inside the study is not a reason to skip the panel: it surfaces."""
+    import plateqp.studies
+
+    sc = corner_scene()
+    one = pq.solve(sc)
+    monkeypatch.setattr(plateqp.studies, "convergence", _raise(exn))
+    with pytest.raises(type(exn)):
+        demo.convergence_plot(sc, one)
+
+
+def test_convergence_plot_lets_a_plotting_bug_through(monkeypatch):
+    from plateqp import plotting
+
+    pytest.importorskip("matplotlib")
+    sc = corner_scene()
+    one = pq.solve(sc)
+    monkeypatch.setattr(plotting, "plot_convergence", _raise(AttributeError("'Axes' object has no attribute 'x'")))
+    with pytest.raises(AttributeError):
+        demo.convergence_plot(sc, one)
+
+
+def test_convergence_plot_skips_a_scene_the_study_cannot_take(monkeypatch, capsys):
+    """A PlateQPError from the study (e.g. a mesh the scene cannot be built on) skips the panel with a note."""
+    import plateqp.studies
+
+    sc = corner_scene()
+    one = pq.solve(sc)
+    monkeypatch.setattr(plateqp.studies, "convergence", _raise(pq.SolverError("no mesh could be solved")))
+    assert demo.convergence_plot(sc, one) is None
+    assert "convergence study skipped (SolverError: no mesh could be solved)" in capsys.readouterr().err
+
+
+# -- plateqp demo --out DIR [--force]: checked before any work, nothing overwritten --------------
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    """demo.run_scene replaced by a recorder that fails: the list stays empty if no work began."""
+    calls = []
+
+    def fake(name, *args, **kwargs):
+        calls.append(name)
+        raise RuntimeError("the demo started working")
+
+    monkeypatch.setattr(demo, "run_scene", fake)
+    return calls
+
+
+def demo_cli(capsys, *argv):
+    from plateqp.cli import main
+
+    code = main(["demo", *argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def refused(code, err, calls, what):
+    assert code == 2, err
+    assert calls == [], "work began before --out was checked"
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("plateqp: --out") and what in lines[0], err
+
+
+def test_demo_out_naming_a_file_is_refused_before_work(tmp_path, capsys, no_work):
+    f = tmp_path / "taken"
+    f.write_text("mine")
+    code, _, err = demo_cli(capsys, "slab", "--out", str(f))
+    refused(code, err, no_work, "not a folder")
+    assert f.read_text() == "mine"
+
+
+def test_demo_out_that_cannot_be_made_is_refused_before_work(tmp_path, capsys, no_work):
+    (tmp_path / "file").write_text("")
+    code, _, err = demo_cli(capsys, "slab", "--out", str(tmp_path / "file" / "sub"))
+    refused(code, err, no_work, "cannot be made")
+
+
+def test_demo_out_not_writable_is_refused_before_work(tmp_path, capsys, no_work, monkeypatch):
+    import os
+
+    real = os.access
+    # chmod does not stop root (the tests may run as root): the check is what is tested
+    monkeypatch.setattr(os, "access", lambda p, mode, *a, **k: False if str(p) == str(tmp_path / "ro")
+                        else real(p, mode, *a, **k))
+    (tmp_path / "ro").mkdir()
+    code, _, err = demo_cli(capsys, "slab", "--out", str(tmp_path / "ro"))
+    refused(code, err, no_work, "not writable")
+
+
+@pytest.mark.parametrize("existing", ["report.html", "slab-mesh.png", "slab-sigma1.png", "slab.json"])
+def test_demo_does_not_overwrite_without_force(tmp_path, capsys, no_work, existing):
+    (tmp_path / existing).write_text("mine")
+    code, _, err = demo_cli(capsys, "slab", "--out", str(tmp_path))
+    refused(code, err, no_work, f"{existing} exists; use --force")
+    assert (tmp_path / existing).read_text() == "mine"
+
+
+def test_demo_default_folder_is_checked_too(tmp_path, capsys, no_work, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / demo.DEFAULT_OUT).mkdir()
+    (tmp_path / demo.DEFAULT_OUT / "report.html").write_text("mine")
+    code, _, err = demo_cli(capsys, "slab")
+    refused(code, err, no_work, "report.html exists")
+
+
+def test_demo_unknown_scene_is_refused_before_the_folder(tmp_path, capsys, no_work):
+    code, _, err = demo_cli(capsys, "nonesuch", "--out", str(tmp_path / "x"))
+    assert code == 2 and "no built-in scene" in err and no_work == []
+    assert not (tmp_path / "x").exists()
+
+
+def test_demo_force_overwrites(tmp_path, capsys):
+    for name in ("report.html", "slab-mesh.png", "slab.json"):
+        (tmp_path / name).write_text("old")
+    code, out, err = demo_cli(capsys, "slab", "--out", str(tmp_path), "--force")
+    assert code == 0, err
+    assert "slab" in out
+    assert "<!DOCTYPE html>" in (tmp_path / "report.html").read_text()
+    assert json.loads((tmp_path / "slab.json").read_text())["one_sided"]["status"] == "optimal"
+    if (tmp_path / "slab-contours.png").exists():  # figures drawn (matplotlib installed)
+        assert (tmp_path / "slab-mesh.png").read_bytes()[:4] == b"\x89PNG"

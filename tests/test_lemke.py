@@ -8,7 +8,8 @@ References used (never the code's own earlier output):
   ``scipy.optimize.lsq_linear`` (BVLS) through a Cholesky factor M = L Lᵀ:
   ½ zᵀMz + qᵀz = ½ ‖Lᵀz + L⁻¹q‖² − const;
 * problems built from a known solution (z*, w*) or with a hand-proved
-  certificate of infeasibility;
+  certificate of infeasibility (the certificate Lemke's method returns is
+  checked here by its definition, y ≥ 0, Mᵀy ≤ 0, qᵀy < 0);
 * a naive Lemke (smallest-ratio, ties to the last row) written here, which
   is shown to cycle on a degenerate problem.
 """
@@ -18,33 +19,20 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from lcp_reference import brute_force, bvls_reference, random_spd
+from lcp_reference import (INFEASIBLE_PSD, M2, assert_certificate, brute_force, bvls_reference, check_lcp,
+                           net_uplift, random_spd, rounding_zero_lcp)
 import scipy.sparse as sp
 
+from plateqp.backends import get_backend
 from plateqp.backends import lemke as L
 from plateqp.backends.base import LCP, QP, Status
-from plateqp.errors import NoEquilibriumError, ProblemError
+from plateqp.errors import ProblemError
+
+#: The registered backend (``solve(problem, accuracy, options)``).
+B = get_backend("lemke")
 
 
 # ----------------------------------------------------------------------------- helpers
-
-
-def check_lcp(M, q, z, w, rtol=1e-10):
-    """The complementarity conditions, checked directly from M, q."""
-    M, q = np.asarray(M, float), np.asarray(q, float)
-    zs = max(np.abs(z).max(), 1.0)
-    ws = max(np.abs(q).max(), np.abs(M).max() * np.abs(z).max(), 1e-300)
-    np.testing.assert_allclose(w, M @ z + q, rtol=0, atol=1e-13 * ws)
-    assert z.min() >= -rtol * zs
-    assert w.min() >= -rtol * ws
-    assert abs(z @ w) <= rtol * zs * ws * len(q)
-    assert np.abs(z * w).max() <= rtol * zs * ws
-
-
-
-
-
-
 
 
 def naive_lemke(M, q, max_iter=100):
@@ -88,9 +76,6 @@ def naive_lemke(M, q, max_iter=100):
 
 
 # ----------------------------------------------------------------------------- hand-solved
-
-
-M2 = np.array([[2.0, 1.0], [1.0, 2.0]])
 
 
 @pytest.mark.parametrize(
@@ -167,7 +152,7 @@ def test_random_spd_against_bvls(n, seed):
     rng = np.random.default_rng(seed)
     M = random_spd(n, rng)
     q = rng.standard_normal(n)
-    sol = L.solve(LCP(M, q))
+    sol = B.solve(LCP(M, q))
     assert sol.status is Status.OPTIMAL
     check_lcp(M, q, sol.x, sol.w)
     z_ref = bvls_reference(M, q)
@@ -194,7 +179,7 @@ def test_every_preset_is_exact(accuracy):
     n = 150
     M = random_spd(n, rng)
     q = rng.standard_normal(n)
-    sol = L.solve(LCP(M, q), accuracy=accuracy, options={"refactor_every": 20})
+    sol = B.solve(LCP(M, q), accuracy=accuracy, options={"refactor_every": 20})
     assert sol.status is Status.OPTIMAL
     check_lcp(M, q, sol.x, sol.w, rtol=1e-12)
     z_ref = bvls_reference(M, q)
@@ -243,37 +228,41 @@ def test_psd_rank_deficient_with_known_solution(seed):
     assert sol.obj == pytest.approx(0.5 * z_star @ M @ z_star + q @ z_star, rel=1e-10)
 
 
-@pytest.mark.parametrize(
-    "M, q",
-    [
-        # w1 + w2 = (z1 − z2 − 1) + (−z1 + z2 − 1) = −2 for every z: w ≥ 0 impossible
-        (np.array([[1.0, -1.0], [-1.0, 1.0]]), np.array([-1.0, -1.0])),
-        # w = −1 whatever z
-        (np.array([[0.0]]), np.array([-1.0])),
-    ],
-)
-def test_psd_without_solution_raises(M, q):
-    with pytest.raises(NoEquilibriumError, match="cannot carry this load"):
-        L.lemke(M, q)
+@pytest.mark.parametrize("M, q", INFEASIBLE_PSD)
+def test_psd_without_solution_is_infeasible_with_a_certificate(M, q):
+    sol = L.lemke(M, q)
+    assert sol.status is Status.INFEASIBLE and sol.x is None
+    assert "no solution" in sol.solver_status
+    assert_certificate(M, q, sol.extras["certificate"])
 
 
-def test_net_uplift_raises():
-    """Symmetric PSD M with a positive null vector v (a rigid lift-off mode) and vᵀq < 0.
+def test_net_uplift_is_infeasible_with_a_certificate():
+    """A positive null vector v of PSD M with vᵀq < 0 (lcp_reference.net_uplift): no solution."""
+    M, q = net_uplift()
+    sol = B.solve(LCP(M, q))
+    assert sol.status is Status.INFEASIBLE and sol.x is None
+    assert_certificate(M, q, sol.extras["certificate"])
 
-    Then vᵀw = vᵀMz + vᵀq = vᵀq < 0 for every z, while v > 0 and w ≥ 0 would
-    give vᵀw ≥ 0: no solution (net uplift).
-    """
-    rng = np.random.default_rng(7)
-    n = 20
-    v = rng.random(n) + 0.5
-    P = np.eye(n) - np.outer(v, v) / (v @ v)
-    A = rng.standard_normal((n, n))
-    M = P @ A @ A.T @ P
-    q = rng.standard_normal(n)
-    if v @ q > 0:
-        q = -q
-    with pytest.raises(NoEquilibriumError, match="net uplift"):
-        L.solve(LCP(M, q))
+
+def test_ray_without_a_certificate_proves_nothing():
+    """M = [[1, 2], [2, 0]] is symmetric indefinite (not copositive-plus) and LCP(M, (−1, −1)) has
+    solutions (z = (1, 0)); Lemke's method ends on a ray here, which proves nothing: the status
+    is ERROR, never INFEASIBLE (the ray's direction fails the certificate check)."""
+    M, q = np.array([[1.0, 2.0], [2.0, 0.0]]), np.array([-1.0, -1.0])
+    assert any(np.allclose(z, [1.0, 0.0]) for z in brute_force(M, q))  # it has a solution
+    sol = L.lemke(M, q)
+    assert sol.status is Status.ERROR and sol.x is None
+    assert "nothing is proved" in sol.solver_status and "certificate" not in sol.extras
+
+
+def test_zero_matrix_and_a_rounding_negative_q_is_solved():
+    """lcp_reference.rounding_zero_lcp: z = 0 is the answer. Before the fix the pivot on the
+    rounding-negative row met a ray and Lemke's method claimed that no solution exists."""
+    M, q = rounding_zero_lcp()
+    sol = L.lemke(M, q)
+    assert sol.status is Status.OPTIMAL
+    np.testing.assert_array_equal(sol.x, np.zeros(3))
+    assert sol.w.min() >= -1e-15 * np.abs(q).max()
 
 
 # ----------------------------------------------------------------------------- degeneracy
@@ -327,7 +316,7 @@ def test_covering_vector_does_not_change_unique_solution():
     q = rng.standard_normal(n)
     ref = L.lemke(M, q)
     for d in (rng.random(n) + 0.01, np.linspace(1.0, 100.0, n), 3.0):
-        sol = L.solve(LCP(M, q), options={"covering": d})
+        sol = B.solve(LCP(M, q), options={"covering": d})
         assert sol.status is Status.OPTIMAL
         np.testing.assert_allclose(sol.x, ref.x, rtol=0, atol=1e-11)
     np.testing.assert_allclose(ref.x, bvls_reference(M, q), atol=1e-9)
@@ -365,13 +354,13 @@ def test_max_iter_gives_status_not_exception():
     rng = np.random.default_rng(8)
     M = random_spd(10, rng)
     q = -np.abs(rng.standard_normal(10))
-    sol = L.solve(LCP(M, q), options={"max_iter": 2})
+    sol = B.solve(LCP(M, q), options={"max_iter": 2})
     assert sol.status is Status.MAX_ITER and sol.iterations == 2
     assert sol.x is None and sol.extras["z0"] > 0
 
 
 def test_solve_time_and_iterations_recorded():
-    sol = L.solve(LCP(M2, np.array([-5.0, -6.0])))
+    sol = B.solve(LCP(M2, np.array([-5.0, -6.0])))
     assert sol.iterations == 3 and sol.solve_time > 0.0
 
 
@@ -392,15 +381,15 @@ def test_backend_interface():
 
 def test_rejects_qp_unknown_option_and_accuracy():
     with pytest.raises(ProblemError):
-        L.solve(QP(P=M2, q=np.array([-1.0, -1.0]), lb=np.zeros(2)))
+        B.solve(QP(P=M2, q=np.array([-1.0, -1.0]), lb=np.zeros(2)))
     with pytest.raises(ProblemError, match="covering"):
-        L.solve(LCP(M2, np.array([-1.0, -1.0])), options={"tolerance": 1e-3})
+        B.solve(LCP(M2, np.array([-1.0, -1.0])), options={"tolerance": 1e-3})
     with pytest.raises(ProblemError):
-        L.solve(LCP(M2, np.array([-1.0, -1.0])), accuracy="extreme")
+        B.solve(LCP(M2, np.array([-1.0, -1.0])), accuracy="extreme")
     with pytest.raises(ProblemError):
-        L.solve(LCP(M2, np.array([-1.0, -1.0])), options={"max_iter": 0})
+        B.solve(LCP(M2, np.array([-1.0, -1.0])), options={"max_iter": 0})
 
 
 def test_pivot_tol_option_accepted():
-    sol = L.solve(LCP(M2, np.array([-5.0, -6.0])), options={"pivot_tol": 1e-14, "trace": True})
+    sol = B.solve(LCP(M2, np.array([-5.0, -6.0])), options={"pivot_tol": 1e-14, "trace": True})
     np.testing.assert_allclose(sol.x, [4 / 3, 7 / 3], atol=1e-14)

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -116,3 +119,24 @@ def test_sections_default_to_support_rows(pair):
 def test_save_writes_png(pair, tmp_path):
     path = pl.save(pl.plot_reactions(*pair), tmp_path / "r.png", dpi=30)
     assert path.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_matplotlib_is_imported_lazily():
+    """Importing plateqp, its plots, the demo and the report does not import matplotlib; a figure does."""
+    code = ("import sys, plateqp, plateqp.plotting, plateqp.demo, plateqp.report, plateqp.cli\n"
+            "assert 'matplotlib' not in sys.modules, sorted(m for m in sys.modules if 'matplotlib' in m)[:3]\n"
+            "import plateqp.plotting.style as st\n"
+            "st._figure((1, 1))\n"
+            "assert 'matplotlib' in sys.modules\n")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+
+
+def test_public_names_of_the_package():
+    """The names plateqp.plotting had as one module are all there, each from its module by job."""
+    for name in ("save", "png_bytes", "default_sections", "plot_mesh", "plot_deflection_surface",
+                 "plot_deflection_contours", "plot_sections", "plot_principal_stress", "plot_difference",
+                 "plot_reactions", "plot_convergence", "ONE_SIDED", "TWO_SIDED", "HEAVE_COLOR", "SETTLE_COLOR",
+                 "LEVEL_COLOR", "LEVEL_BAR"):
+        assert hasattr(pl, name), name
+    assert set(pl.__all__) <= set(dir(pl))

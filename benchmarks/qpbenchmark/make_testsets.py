@@ -31,7 +31,7 @@ import numpy as np
 
 import plateqp as pq
 from plateqp import scenes
-from plateqp.export import contact_qp, write_qpbenchmark
+from plateqp.io import contact_qp, write_qpbenchmark
 
 HERE = Path(__file__).resolve().parent
 MESHES = (16, 32)

@@ -19,8 +19,9 @@ bound is, so that stationarity reads ``P x + q + Gᵀ z + Aᵀ y + z_box = 0``.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -30,7 +31,8 @@ from ..errors import ProblemError, SolverError
 
 # the shared words, re-exported here for the backends' convenience (they live in plateqp.accuracy)
 __all__ = ["ACCURACIES", "PRESET_TOL", "TOL_RANGE", "Accuracy", "Status", "accuracy_tol", "nearest_preset",
-           "LCP", "QP", "Backend", "RawSolution", "preset", "via_qp", "plateqp_version"]
+           "LCP", "QP", "Backend", "ModuleBackend", "RawSolution", "check_options", "rejected_option", "one_line",
+           "preset", "via_qp", "plateqp_version"]
 
 
 def _is_tolerance(key: str, value) -> bool:
@@ -167,23 +169,100 @@ def plateqp_version() -> str:
         return "plateqp"
 
 
-class Backend(Protocol):
-    """What every backend module provides (one file per backend, one line in the registry).
+class Backend:
+    """The one shape of a backend: every backend is an instance of a subclass of this class.
 
-    ``name``: registry name; ``accepts``: subset of {"qp", "lcp"};
-    ``available()``: importable here; ``version()``;
-    ``solve(problem, accuracy, options)`` → :class:`RawSolution`.
-    Options are passed to the solver untouched and override the preset.
+    A backend module defines ``backends() -> list[Backend]``; the registry
+    (:mod:`plateqp.backends`) lists the module in one line. The capabilities are declared as
+    class (or instance) attributes, and callers read them instead of lists of names:
+
+    ``name``
+        registry name.
+    ``accepts``
+        the problem kinds it takes, a subset of ``{"qp", "lcp"}``.
+    ``formulations``
+        the names of the standard forms (``"primal"``, ``"condensed"``, ``"dual"``) it may be
+        given, where it is built for some only; ``None``: every form its ``accepts`` allows.
+    ``exact``
+        a direct method: its answer is exact up to rounding at every accuracy (the accuracy
+        sets only its acceptance tolerances).
+    ``warm_start``
+        takes ``options["active"]``, a bool array, as its first active set, and returns its
+        final one in ``extras["active"]`` (in the problem's own terms) for the next solve.
+
+    Methods: ``available()`` (importable here), ``version()``, and
+    ``solve(problem, accuracy, options) → RawSolution``. Options are the solver's own and
+    override the accuracy preset; an option the backend does not know is a
+    :class:`~plateqp.errors.ProblemError` (:func:`check_options`, :func:`rejected_option`).
     """
 
-    name: str
-    accepts: frozenset[str]
+    name: str = ""
+    accepts: frozenset[str] = frozenset()
+    formulations: tuple[str, ...] | None = None
+    exact: bool = False
+    warm_start: bool = False
 
-    def available(self) -> bool: ...
+    def available(self) -> bool:
+        return True
 
-    def version(self) -> str | None: ...
+    def version(self) -> str | None:
+        return plateqp_version()
 
-    def solve(self, problem: QP | LCP, accuracy: str | float | Accuracy = "default", options: dict | None = None) -> RawSolution: ...
+    def solve(self, problem: QP | LCP, accuracy: str | float | Accuracy = "default",
+              options: dict | None = None) -> RawSolution:
+        raise NotImplementedError
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.name!r})"
+
+
+class ModuleBackend(Backend):
+    """A backend module of the earlier shape (module-level ``name``, ``accepts``,
+    ``available``, ``version``, ``solve``, optional ``formulations``) seen as a :class:`Backend`;
+    the capabilities it does not declare itself are given here, where it is registered."""
+
+    def __init__(self, module, **capabilities) -> None:
+        self.module = module
+        self.name, self.accepts = module.name, frozenset(module.accepts)
+        for key in ("formulations", "exact", "warm_start"):
+            value = capabilities.get(key, getattr(module, key, getattr(Backend, key)))
+            setattr(self, key, tuple(value) if key == "formulations" and value is not None else value)
+
+    def available(self) -> bool:
+        return self.module.available()
+
+    def version(self) -> str | None:
+        return self.module.version()
+
+    def solve(self, problem, accuracy="default", options=None) -> RawSolution:
+        return self.module.solve(problem, accuracy, options)
+
+
+def check_options(backend: str, options: dict | None, known) -> dict:
+    """A copy of ``options``; a ProblemError naming the unknown keys (and the known ones)."""
+    options = dict(options or {})
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        raise ProblemError(f"unknown option(s) {unknown} for backend {backend}; known: {list(known)}")
+    return options
+
+
+def rejected_option(backend: str, options: dict | None, exn: BaseException) -> ProblemError | None:
+    """For a solver that checks its own options: if its complaint ``exn`` names one of the
+    options the user gave (an unknown setting, or a bad value of one), the ProblemError to
+    raise instead of a solver failure; else None (the complaint is about something else)."""
+    text = str(exn)
+    named = [k for k in (options or {}) if re.search(rf"(?<![A-Za-z0-9_]){re.escape(str(k))}(?![A-Za-z0-9_])", text)]
+    if not named:
+        return None
+    return ProblemError(f"backend {backend} rejected option(s) {named}: {one_line(exn)}")
+
+
+def one_line(exn: BaseException) -> str:
+    """The first line of an exception's message (its type's name if it has none), for a
+    one-line error that wraps it."""
+    text = str(exn).strip()
+    return text.splitlines()[0] if text else type(exn).__name__
 
 
 def via_qp(problem: QP | LCP, solve_qp) -> RawSolution:

@@ -3,9 +3,9 @@ r"""Block principal pivoting (Júdice & Pires 1994) for LCP(M, q), in NumPy/SciP
 The problem
 -----------
 Find ``z ≥ 0`` such that ``w = M z + q ≥ 0`` and ``zᵀ w = 0``; here ``M`` is
-symmetric positive (semi)definite, the condensed stiffness of a plate on
-one-sided supports (or its flexibility, for the dual formulation), or any
-P-matrix.
+symmetric positive (semi)definite, or any P-matrix. (On a plate on one-sided
+supports ``M`` is the condensed stiffness, or the flexibility for the dual
+formulation: symmetric, and only semidefinite for a floating plate.)
 
 The method
 ----------
@@ -33,14 +33,15 @@ complementarity problem*, Opsearch 11, 1974), hence so does the whole method.
 33, 2011, takes the *largest* index: any fixed order of the indices is
 Murty's rule.)
 
-Default start: ``F = {i : q_i < 0}``, i.e. every support with ``q_i ≥ 0`` (in
-compression when all gaps are closed) starts in contact. Option ``active``
-gives another start: a boolean array, ``True`` where ``z_i = 0`` is held (the
-set ``T``). The final split is returned in ``extras["active"]`` in the same
-form, so that a sweep of neighbouring problems can warm start each solve from
-the previous one. **What ``active`` means is the LCP's**: ``z_i = 0``. On the
-condensed formulation (z = gaps) that is "support in contact"; on the dual
-formulation (z = reactions) it is "support *not* in contact".
+Default start: ``F = {i : q_i < −feas_tol ‖q‖∞}``, i.e. ``z_i = 0`` is held where
+``q_i ≥ 0`` up to rounding (``w_i ≥ 0`` at ``z = 0``, by the test that judges every
+``w``). Option ``active`` gives another start: a boolean
+array, ``True`` where ``z_i = 0`` is held (the set ``T``). The final split is
+returned in ``extras["active"]`` in the same form, so that a sequence of
+neighbouring problems can warm start each solve from the previous one. **What
+``active`` means is the LCP's**: ``z_i = 0``. (On a plate's condensed form, z =
+gaps, that is "support in contact"; on its dual, z = reactions, "*not* in
+contact".)
 
 Each step factorises the principal block afresh (Cholesky, ``O(|F|³/3)``
 flops; LU when ``M`` is not symmetric); there are no updates, so rounding
@@ -49,34 +50,33 @@ errors do not accumulate from step to step. ``w`` is then one product
 
 Singular blocks (positive semidefinite M)
 -----------------------------------------
-For symmetric PSD ``M`` (a floating plate: the rigid motions span the null
-space of the condensed stiffness) a principal block ``M_FF`` is singular
-exactly when the supports in ``T`` cannot hold the plate. Such a block is
-detected by a squared pivot below ``1000 · sing_tol`` in the Cholesky factor of
+For symmetric PSD ``M`` a principal block ``M_FF`` can be singular (on a
+floating plate: when the supports in ``T`` leave a rigid motion free). Such a
+block is detected by a squared pivot below ``1000 · sing_tol`` in the Cholesky factor of
 the equilibrated block ``D M_FF D``, ``D = diag(M_FF)^-½`` (or a failed Cholesky),
 and then decomposed ``M_FF = V Λ Vᵀ``; eigenvalues at most
 ``sing_tol · λ_max`` count as zero, ``N`` spans their eigenvectors and
 ``P = N Nᵀ``. With ``b = −q_F``:
 
-* ``P b ≈ 0`` (at the feasibility tolerance, in reaction units): the system is
+* ``P b ≈ 0`` (at the feasibility tolerance, in the units of ``w``): the system is
   consistent and every ``z_F + N c`` solves it (with the same ``w``: ``M`` is
   PSD, so ``M [N c; 0] = 0``). ``z_F`` is the minimum-norm solution
   ``V Λ⁺ Vᵀ b``; if it has negative entries, a small LP looks for a ``c``
   that makes ``z_F + N c ≥ 0`` (or, failing that, least negative), and the
   step goes on as usual with that ``z_F``;
-* otherwise the plate is a mechanism under this split: the energy
-  ``½ zᵀMz + qᵀz`` falls without bound along the null space of ``M_FF``. An LP
-  on that null space (``k`` unknowns, ``k ≤ 3`` on a plate) looks for
-  ``y = N c ≥ 0`` with ``qᵀy < 0``: a Farkas certificate that the LCP has no
-  solution (``w = Mz + q ≥ 0`` would give ``0 ≤ yᵀw = qᵀy < 0``); it is
-  checked on the full ``M`` and :class:`~plateqp.errors.NoEquilibriumError`
-  is raised. Without one, along the steepest descent ``y = P b`` the gaps with
-  ``y_i < 0`` would close first as the plate falls: they are the infeasible
-  indices of ``F`` (they go to ``T``), with ``z_F`` the least-squares solution.
+* otherwise the objective ``½ zᵀMz + qᵀz`` falls without bound along the null
+  space of ``M_FF``. An LP on that null space (``k`` unknowns, ``k ≤ 3`` on a
+  plate) looks for ``y = N c ≥ 0`` with ``qᵀy < 0``: a Farkas certificate that
+  the LCP has no solution (:mod:`~plateqp.backends.lcp`); checked on the full
+  ``M``, it ends the solve with status ``INFEASIBLE`` and ``y`` in
+  ``extras["certificate"]``. Without one, along the steepest descent
+  ``y = P b`` the ``z_i`` with ``y_i < 0`` would reach zero first: they are the
+  infeasible indices of ``F`` (they go to ``T``), with ``z_F`` the
+  least-squares solution.
 
 For PSD ``M`` the finite-termination theorem does not apply, and Murty's rule
 can cycle (measured: a quarter of random rank-deficient ``M = AᵀA``; never on
-the rigid-motion null spaces of floating plates). A split seen twice in the
+the rigid-motion null spaces of floating plates, of dimension ≤ 3). A split seen twice in the
 single-pivot phase, which cannot happen for a P-matrix in exact arithmetic,
 ends the pivoting. Then (also after ``max_iter`` splits if a singular block
 was met):
@@ -84,7 +84,7 @@ was met):
 1. the whole LCP is tested for solvability: for symmetric PSD ``M`` it has no
    solution iff some ``y ≥ 0`` has ``M y = 0`` and ``qᵀy < 0``; an eigen-
    decomposition of ``M`` and the LP above on its null space decide it
-   (→ NoEquilibriumError);
+   (→ ``INFEASIBLE`` with the certificate);
 2. if it has a solution, proximal-point steps (Rockafellar 1976)
    ``z ← solution of LCP(M + ε D, q − ε D z)`` with ``D = diag(M)`` and
    ``ε = PROX_EPS``, each a positive definite problem that the pivoting
@@ -102,16 +102,15 @@ After termination, one clean solve on the final split (the factor of the last
 step, one step of iterative refinement) gives ``z``; negatives down to
 ``feas_tol`` of its scale are set to zero and ``w = M z + q`` is computed from
 the full ``M``. The status comes from an independent check of that answer, the
-relative natural residual (:func:`natural_residual`)
+relative natural residual (:func:`~plateqp.backends.lcp.natural_residual`)
 
 .. math::
 
     r = \frac{\max_i |\min(M_{ii} z_i,\ w_i)|}{\max(\|w\|_\infty, \|q\|_\infty)},
 
-which covers the signs of ``z`` and ``w`` and complementarity at once (gaps
-counted as the force ``M_ii z_i`` it would take to close them, like the
-natural residual of :mod:`plateqp.contact.kkt`): ``OPTIMAL`` if ``r ≤ accept_tol``,
-else ``INACCURATE``. A wrong ``OPTIMAL`` is therefore impossible whatever
+which covers the signs of ``z`` and ``w`` and complementarity at once (``z_i``
+counted as the ``w_i`` it would take to bring it to zero, ``M_ii z_i``):
+``OPTIMAL`` if ``r ≤ accept_tol``, else ``INACCURATE``. A wrong ``OPTIMAL`` is therefore impossible whatever
 happened inside the pivoting.
 
 Accuracy
@@ -133,7 +132,6 @@ Examples
 
 from __future__ import annotations
 
-import sys
 import time
 import warnings
 from dataclasses import dataclass
@@ -141,14 +139,12 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import NoEquilibriumError, ProblemError
-from .base import LCP, QP, RawSolution, Status, plateqp_version, preset
+from ..errors import ProblemError
+from .base import LCP, RawSolution, Status
+from .lcp import (LCPBackend, answer, check_flag, check_int, infeasible, is_certificate, natural_residual,
+                  settings)
 
-__all__ = ["name", "accepts", "ACCURACY", "OPTIONS", "available", "version", "solve", "bpp",
-           "natural_residual", "backends"]
-
-name = "bpp"
-accepts = frozenset({"lcp"})
+__all__ = ["ACCURACY", "OPTIONS", "BACKEND", "bpp", "backends"]
 
 #: Tolerances of each accuracy preset (a direct method: exact up to rounding at every preset).
 #:
@@ -166,9 +162,6 @@ ACCURACY: dict[str, dict[str, float]] = {
     "high": {"feas_tol": 1e-12, "accept_tol": 1e-10},
 }
 
-#: Keys accepted in the ``options`` dict of :func:`solve`.
-OPTIONS = ("active", "max_iter", "p", "sing_tol", "trace") + tuple(ACCURACY["default"])
-
 #: A squared Cholesky pivot of the equilibrated block (unit diagonal) below ``SING_TRIGGER ·
 #: sing_tol`` sends the block to the eigen-decomposition, which decides whether it is singular.
 SING_TRIGGER = 1e3
@@ -177,60 +170,6 @@ SING_TRIGGER = 1e3
 #: ``PROX_STEPS`` steps z ← solution of LCP(M + ε D, q − ε D z), ε = ``PROX_EPS``, D = diag(M).
 PROX_EPS = 1e-2
 PROX_STEPS = 50
-
-_NO_SOLUTION = (
-    "the one-sided supports cannot carry this load (net uplift, or the load resultant lies "
-    "outside the supports' reach): block principal pivoting found y ≥ 0 with M y = 0 and "
-    "qᵀy < 0, a certificate that LCP(M, q) has no solution"
-)
-
-
-def available() -> bool:
-    """Block principal pivoting needs NumPy and SciPy only: always available."""
-    return True
-
-
-version = plateqp_version  # the backend is part of plateqp
-
-
-def backends() -> list:
-    """The backends this module provides: ``[module]`` (it satisfies the ``Backend`` protocol)."""
-    return [sys.modules[__name__]]
-
-
-# --------------------------------------------------------------------------- helpers
-
-
-def natural_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray, w: np.ndarray) -> float:
-    r"""Relative natural residual of a candidate solution of LCP(M, q), with ``w = M z + q``.
-
-    .. math::
-
-        r = \frac{\max_i |\min(d_i z_i,\ w_i)|}{\max(\|w\|_\infty, \|q\|_\infty)},
-        \qquad d = \mathrm{diag}(M).
-
-    Zero exactly at a solution; it sees a negative ``z_i`` or ``w_i`` and a
-    violated complementarity alike. ``z`` is weighted by the diagonal so that
-    both terms are in the units of ``w`` (for the condensed plate problem:
-    force, like the natural residual of :mod:`plateqp.contact.kkt`) and the measure
-    does not change when a row and its column are scaled. The scale is that of
-    ``w`` and ``q`` (forces), never that of ``z``: an iterate that runs away
-    (no solution) must not make its own residual look small. Shared by
-    :mod:`~plateqp.backends.pgs` as its stopping test.
-    """
-    if z.size == 0:
-        return 0.0
-    dz = np.abs(np.diagonal(M)) * z
-    num = np.abs(np.minimum(dz, w)).max()
-    scale = max(np.abs(w).max(), np.abs(q).max())
-    if scale == 0.0:
-        return 0.0 if num == 0.0 else float("inf")
-    return float(num / scale)
-
-
-def _check_accuracy(accuracy: str | float) -> dict:
-    return preset(ACCURACY, accuracy, scale=("feas_tol", "accept_tol"))
-
 
 class _Block:
     """A factorised principal block ``M_FF``: Cholesky, LU, or (singular) eigen-decomposition."""
@@ -245,9 +184,9 @@ class _Block:
         diag = np.diagonal(A)
         if symmetric:
             # Cholesky of the equilibrated block D A D (D = diag(A)^-½), judged by its pivots:
-            # a block whose diagonal spans 1e-2 … 1e8 (rigid supports next to soft springs in
-            # the dual) is not near-singular, but a pivot test against max diag(A) said so and
-            # sent it to the eigen path, which lost 1e-8 relative in the soft rows' reactions.
+            # a block whose diagonal spans 1e-2 … 1e8 (a plate's dual: rigid supports next to
+            # soft springs) is not near-singular, but a pivot test against max diag(A) said so
+            # and sent it to the eigen path, which lost 1e-8 relative in the small rows' z.
             d = np.where(diag > 0, 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0)), 1.0)
             try:
                 c = sla.cho_factor(d[:, None] * A * d[None, :], lower=True, check_finite=False)
@@ -303,7 +242,7 @@ class _Step:
         idx = np.flatnonzero(F)
         self.idx = idx
         self.block = _Block(M[np.ix_(idx, idx)], symmetric, sing_tol)
-        self.drift = None  # descent direction of a mechanism (inconsistent singular block)
+        self.drift = None  # descent direction along a null space (inconsistent singular block)
         self.certificate = None  # y ≥ 0, M y = 0, qᵀy < 0, if this split exposed one
         n = q.shape[0]
         z = np.zeros(n)
@@ -319,8 +258,8 @@ class _Step:
         H = np.zeros(n, bool)
         Pb = self.block.null_part(b)
         if np.abs(Pb).max(initial=0.0) > feas_tol * wscale:
-            # inconsistent: the plate is a mechanism under this split; it falls along the null
-            # space of M_FF, and the gaps that close first are the infeasible ones of F
+            # inconsistent: the objective falls without bound along the null space of M_FF, and
+            # the z_i that reach zero first are the infeasible ones of F
             y = _null_certificate(self.block.null, q[idx], feas_tol)
             if y is not None:
                 self.certificate = np.zeros(n)
@@ -381,18 +320,6 @@ def _full_null_space(M: np.ndarray, sing_tol: float) -> np.ndarray:
     return V[:, lam <= sing_tol * lmax]
 
 
-def _verified(M: np.ndarray, q: np.ndarray, y: np.ndarray | None, sing_tol: float) -> bool:
-    """``y ≥ 0``, ``M y ≈ 0`` and ``qᵀy < 0``, checked on the full ``M``: a proof of no solution."""
-    if y is None:
-        return False
-    ny = np.abs(y).max()
-    if ny == 0 or y.min() < 0:
-        return False
-    My = M @ y
-    return bool(np.abs(My).max() <= SING_TRIGGER * sing_tol * np.abs(M).max() * ny * np.sqrt(q.shape[0])
-                and q @ y < 0)
-
-
 # --------------------------------------------------------------------------- the method
 
 
@@ -404,18 +331,24 @@ class _Failure(Exception):
 class _Run:
     """What one pivoting run ends with."""
 
-    ending: str  # "solved" | "cycle" | "max_iter"
+    ending: str  # "solved" | "infeasible" | "cycle" | "max_iter"
     best: _Step
     splits: int = 0
     block: int = 0
     single: int = 0
     singular: int = 0
+    certificate: np.ndarray | None = None  # y ≥ 0, Mᵀy ≤ 0, qᵀy < 0 (ending "infeasible")
+
+    def infeasible(self, step: _Step, y: np.ndarray) -> _Run:
+        self.ending, self.best, self.certificate = "infeasible", step, y
+        return self
 
 
 def _pivoting(M, q, F, max_iter, p, symmetric, sing_tol, feas_tol, steps=None) -> _Run:
     """The block principal pivoting loop from split ``F`` (Júdice & Pires, with Murty's backup).
 
-    Raises NoEquilibriumError on a verified certificate, _Failure on a block it cannot handle.
+    Ends "infeasible" on a checked certificate that LCP(M, q) has no solution; raises _Failure
+    on a block it cannot handle.
     """
     n = q.shape[0]
     Mmax = np.abs(M).max(initial=0.0)
@@ -431,18 +364,18 @@ def _pivoting(M, q, F, max_iter, p, symmetric, sing_tol, feas_tol, steps=None) -
         if step.block.negative < -SING_TRIGGER * sing_tol:
             raise _Failure(f"M is not positive semidefinite (a principal block has eigenvalue "
                            f"{step.block.negative:.1e} λ_max)")
-        if step.certificate is not None and _verified(M, q, step.certificate, sing_tol):
-            raise NoEquilibriumError(f"{_NO_SOLUTION} (after {run.splits} splits)")
+        if step.certificate is not None and is_certificate(M, q, step.certificate, SING_TRIGGER * sing_tol):
+            return run.infeasible(step, step.certificate)
         if run.best is None or step.violation < run.best.violation:
             run.best = step
         H = step.infeasible
         nV = int(H.sum())
         if nV == 0:
-            if step.drift is not None:  # the plate falls and nothing stops it: y = P b ≥ 0
+            if step.drift is not None:  # the descent meets no bound: y = P b ≥ 0
                 y = np.zeros(n)
                 y[step.idx] = np.maximum(step.drift, 0.0)
-                if _verified(M, q, y, sing_tol):
-                    raise NoEquilibriumError(f"{_NO_SOLUTION} (after {run.splits} splits)")
+                if is_certificate(M, q, y, SING_TRIGGER * sing_tol):
+                    return run.infeasible(step, y)
                 raise _Failure("singular principal block with no certificate of infeasibility")
             run.best, run.ending = step, "solved"
             _record(steps, run.splits, step, nV, None)
@@ -497,7 +430,7 @@ def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default
     q : array_like, shape (n,)
     active : array_like of bool, shape (n,), optional
         Warm start: ``True`` where ``z_i = 0`` is held at the start (the set
-        ``T``). Default ``q ≥ 0``. Pass ``extras["active"]`` of an earlier
+        ``T``). Default: ``q ≥ 0`` up to rounding. Pass ``extras["active"]`` of an earlier
         solve of a neighbouring problem.
     max_iter : int, optional
         Maximum number of splits tried by the pivoting (default ``2 n + 50``;
@@ -527,6 +460,8 @@ def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default
     RawSolution
         ``status``: ``OPTIMAL`` when the natural residual of the cleaned-up
         answer is at most ``accept_tol``, whatever route led to it; else
+        ``INFEASIBLE`` (no ``x``: a certificate ``y ≥ 0``, ``Mᵀy ≤ 0``,
+        ``qᵀy < 0`` that no solution exists, in ``extras["certificate"]``),
         ``INACCURATE`` (a feasible split was found but rounding spoiled it),
         ``MAX_ITER`` (``x`` is the best split seen) or ``ERROR`` (no ``x``: the
         pivoting cycled or met a block it cannot handle; ``M`` is then neither
@@ -540,36 +475,19 @@ def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default
 
     Raises
     ------
-    NoEquilibriumError
-        A certificate ``y ≥ 0, M y = 0, qᵀy < 0`` was found: no solution exists.
     ProblemError
         Malformed data or a bad option value.
     """
     t0 = time.perf_counter()
     prob = LCP(M, q)
     M, q, n = prob.M, prob.q, prob.n
-
-    tol = _check_accuracy(accuracy)
-    for key, val in (("feas_tol", feas_tol), ("accept_tol", accept_tol)):
-        if val is not None:
-            tol[key] = val
-    if sing_tol is None:
-        sing_tol = max(1e-12, 10 * n * np.finfo(float).eps)
-    tol["sing_tol"] = sing_tol
-    for key in ("feas_tol", "accept_tol", "sing_tol"):
-        v = tol[key]
-        if isinstance(v, bool) or not (np.isscalar(v) and np.isfinite(v) and 0 <= v < 1):
-            raise ProblemError(f"option {key} must be a number in [0, 1), got {v!r}")
-    feas_tol, accept_tol, sing_tol = float(tol["feas_tol"]), float(tol["accept_tol"]), float(sing_tol)
-    if max_iter is None:
-        max_iter = 2 * n + 50
-    for key, val, low in (("max_iter", max_iter, 1), ("p", p, 0)):
-        if isinstance(val, bool) or not isinstance(val, (int, np.integer)) or val < low:
-            raise ProblemError(f"option {key} must be an integer ≥ {low}, got {val!r}")
-    if not isinstance(trace, (bool, np.bool_)):
-        raise ProblemError(f"option trace must be True or False, got {trace!r}")
-    if active is None:
-        F = q < 0
+    tol = settings(ACCURACY, accuracy, ("feas_tol", "accept_tol"), feas_tol=feas_tol, accept_tol=accept_tol,
+                   sing_tol=max(1e-12, 10 * n * np.finfo(float).eps) if sing_tol is None else sing_tol)
+    feas_tol, accept_tol, sing_tol = tol["feas_tol"], tol["accept_tol"], tol["sing_tol"]
+    max_iter = check_int("max_iter", 2 * n + 50 if max_iter is None else max_iter, 1)
+    p, trace = check_int("p", p, 0), check_flag("trace", trace)
+    if active is None:  # z_i = 0 held where q_i ≥ 0 up to rounding (w's own infeasibility test)
+        F = q < -feas_tol * np.abs(q).max(initial=0.0)
     else:
         a = np.asarray(active)
         if a.dtype != bool or a.shape != (n,):
@@ -588,6 +506,9 @@ def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default
         return RawSolution(status=Status.ERROR, solve_time=time.perf_counter() - t0, extras=extras,
                            solver_status=f"{exn}: block principal pivoting needs a P-matrix or a "
                                          "symmetric positive semidefinite M")
+    if run.ending == "infeasible":
+        return infeasible(run.certificate, t0, run.splits, f"block principal pivoting, after {run.splits} splits",
+                          extras)
     runs = [run]
     z, w, res = _finish(M, q, run.best, feas_tol)
     final, how = run, run.ending
@@ -598,9 +519,9 @@ def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default
         # First, does the LCP have a solution at all? For symmetric PSD M it has none iff
         # some y ≥ 0 has M y = 0 and qᵀy < 0: a small LP on the null space of M.
         y = _null_certificate(_full_null_space(M, sing_tol), q, feas_tol)
-        if _verified(M, q, y, sing_tol):
-            raise NoEquilibriumError(f"{_NO_SOLUTION} (found after the pivoting had failed, "
-                                     f"{run.splits} splits)")
+        if is_certificate(M, q, y, SING_TRIGGER * sing_tol):
+            return infeasible(y, t0, run.splits, f"the null space of M, after the pivoting had failed "
+                                                 f"({run.splits} splits)", extras)
         # It has one: proximal-point steps z ← LCP(M + εD, q − εD z), each with a positive
         # definite matrix (finite pivoting), each split tried on the original problem.
         d = np.diagonal(M).copy()
@@ -616,6 +537,8 @@ def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default
                 zk = _finish(Mp, q - PROX_EPS * d * zk, sub.best, feas_tol)[0]
                 act = zk <= 0
                 test = _pivoting(M, q, ~act, 1, *args)
+                if test.ending == "infeasible":
+                    return infeasible(test.certificate, t0, run.splits, "a proximal step's split", extras)
                 runs += [sub, test]
                 zt, wt, rt = _finish(M, q, test.best, feas_tol)
                 if rt <= accept_tol:
@@ -624,7 +547,6 @@ def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default
         except _Failure:
             pass
     splits = sum(r.splits for r in runs)
-    x = z
     if res <= accept_tol:
         status = Status.OPTIMAL
     elif run.ending == "solved":
@@ -641,16 +563,15 @@ def bpp(M, q, active=None, max_iter=None, p=3, trace=False, *, accuracy="default
         "max_iter": (f"iteration limit {max_iter} reached, {n_prox} proximal steps; best split: "
                      f"natural residual {res:.1e}"),
     }[how]
-    if status is Status.ERROR:
-        x = None
-        extras.update(z=z, w=w)
     extras.update(active=~final.best.F, block_pivots=sum(r.block for r in runs),
                   single_pivots=sum(r.single for r in runs),
                   singular_blocks=sum(r.singular for r in runs), proximal_steps=n_prox,
                   natural_residual=res, factor=final.best.block.kind)
-    return RawSolution(status=status, x=x, w=None if x is None else w,
-                       obj=float(0.5 * z @ M @ z + q @ z), iterations=splits,
-                       solve_time=time.perf_counter() - t0, solver_status=message, extras=extras)
+    out = answer(q, z, w, status, t0, splits, message, extras)
+    if status is Status.ERROR:  # no answer: the best split's z and w stay in extras
+        extras.update(z=z, w=w)
+        out.x = out.w = None
+    return out
 
 
 def _record(steps: list | None, it: int, step: _Step, nV: int, rule: str | None,
@@ -661,37 +582,13 @@ def _record(steps: list | None, it: int, step: _Step, nV: int, rule: str | None,
                       "singular": bool(step.block.singular)})
 
 
-def solve(problem, accuracy: str = "default", options: dict | None = None) -> RawSolution:
-    """Solve an :class:`~plateqp.backends.base.LCP` by block principal pivoting (Backend protocol).
+#: Keys accepted in the ``options`` dict of the backend's ``solve``.
+OPTIONS = ("active", "max_iter", "p", "sing_tol", "trace") + tuple(ACCURACY["default"])
 
-    Parameters
-    ----------
-    problem : LCP
-        The problem; a :class:`~plateqp.backends.base.QP` is rejected.
-    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
-        Preset of :data:`ACCURACY`.
-    options : dict, optional
-        Overrides, keys among :data:`OPTIONS`: ``active`` (warm start),
-        ``max_iter``, ``p``, ``sing_tol``, ``trace``, ``feas_tol``,
-        ``accept_tol`` (see :func:`bpp`).
+#: The ``bpp`` backend: exact, warm-started by ``options["active"]``.
+BACKEND = LCPBackend("bpp", bpp, OPTIONS, exact=True, warm_start=True)
 
-    Returns
-    -------
-    RawSolution
-        See :func:`bpp`.
 
-    Raises
-    ------
-    ProblemError
-        Not an LCP, unknown accuracy or option.
-    NoEquilibriumError
-        A certificate that no solution exists (the supports cannot carry the load).
-    """
-    if isinstance(problem, QP) or not isinstance(problem, LCP):
-        raise ProblemError(f"the bpp backend solves LCPs only, got {type(problem).__name__}")
-    _check_accuracy(accuracy)
-    options = dict(options or {})
-    unknown = sorted(set(options) - set(OPTIONS))
-    if unknown:
-        raise ProblemError(f"unknown option(s) {unknown} for backend bpp; known: {list(OPTIONS)}")
-    return bpp(problem.M, problem.q, accuracy=accuracy, **options)
+def backends() -> list[LCPBackend]:
+    """The backends this module provides: ``[BACKEND]``."""
+    return [BACKEND]

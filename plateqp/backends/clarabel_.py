@@ -27,8 +27,8 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import SolverError
-from .base import LCP, QP, RawSolution, Status, preset, via_qp
+from ..errors import ProblemError, SolverError
+from .base import LCP, QP, Backend, RawSolution, Status, preset, via_qp
 
 try:
     import clarabel
@@ -76,7 +76,9 @@ def _settings(accuracy: str | float, options: dict | None):
     for key, value in chosen.items():
         try:
             setattr(settings, key, value)
-        except (AttributeError, TypeError) as exn:
+        except (AttributeError, TypeError) as exn:  # an unknown setting, a wrong type
+            if key in (options or {}):
+                raise ProblemError(f"backend {NAME} rejected option {key}={value!r}: {exn}") from exn
             raise SolverError(f"Clarabel rejected setting {key}={value!r}: {exn}") from exn
     return settings, chosen
 
@@ -169,8 +171,8 @@ def solve(problem: QP | LCP, accuracy: str = "default", options: dict | None = N
     return via_qp(problem, lambda qp: solve_qp(qp, accuracy, options))
 
 
-class ClarabelBackend:
-    """The ``clarabel`` backend (see :class:`plateqp.backends.base.Backend`)."""
+class ClarabelBackend(Backend):
+    """The ``clarabel`` backend (see :class:`plateqp.backends.base.Backend`): interior point."""
 
     name = NAME
     accepts = frozenset({"qp", "lcp"})
@@ -179,7 +181,7 @@ class ClarabelBackend:
         return clarabel is not None
 
     def version(self) -> str | None:
-        return getattr(clarabel, "__version__", None)
+        return getattr(clarabel, "__version__", None) if clarabel is not None else None
 
     def solve(self, problem: QP | LCP, accuracy: str = "default", options: dict | None = None) -> RawSolution:
         return solve(problem, accuracy, options)

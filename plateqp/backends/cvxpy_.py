@@ -25,7 +25,7 @@ import scipy.sparse as sp
 
 from ..errors import SolverError
 from . import clarabel_, osqp_
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, accuracy_tol, via_qp
+from .base import ACCURACIES, LCP, QP, Backend, RawSolution, Status, accuracy_tol, one_line, rejected_option, via_qp
 from .base import preset as preset_for
 
 try:
@@ -169,6 +169,7 @@ def solve_qp(
     if cp is None:
         raise SolverError("cvxpy backends are not installed (pip install cvxpy)")
     accuracy_tol(accuracy)  # a clear error for a bad accuracy
+    name = PREFIX if solver is None else f"{PREFIX}:{solver}"
     prob, x, cons, ilb, iub = _build(qp)
     try:
         used = solver if solver is not None else prob.get_problem_data(solver=None)[1].solver.name()
@@ -176,11 +177,14 @@ def solve_qp(
         preset = preset_for(table, accuracy) if table else {}
         opts = {**preset, **(options or {})}
         # some interfaces read the options again when unpacking: compile with them
-        data, chain, inverse_data = prob.get_problem_data(solver=used, solver_opts=dict(opts))
-    except cp.error.SolverError as exn:
-        raise SolverError(
-            f"cvxpy cannot pass this problem to {solver or 'its default solver'}: {exn}"
-        ) from exn
+        with warnings.catch_warnings():  # an indefinite P is said by the error below, not twice
+            warnings.filterwarnings("ignore", message="Forming a nonconvex expression")
+            data, chain, inverse_data = prob.get_problem_data(solver=used, solver_opts=dict(opts))
+    except (cp.error.SolverError, ValueError, TypeError, AttributeError, KeyError) as exn:
+        # e.g. ECOS and CVXOPT take P through a factorisation of it (a cone program), and
+        # cvxpy raises ValueError("... indefinite ...") when P is indefinite by rounding
+        raise rejected_option(name, options, exn) or SolverError(
+            f"cvxpy cannot pass this problem to {solver or 'its default solver'}: {one_line(exn)}") from exn
     except (MemoryError, OverflowError) as exn:  # e.g. CVXOPT's index overflow at 128² (n = 49k)
         raise SolverError(f"cvxpy/{solver or 'default'} cannot hold this problem (n = {qp.n}): {exn}; "
                           "use a sparse backend (osqp, clarabel, pdas) or the condensed formulation") from exn
@@ -190,13 +194,16 @@ def solve_qp(
         raw = chain.solve_via_data(prob, data, False, False, dict(opts))
         solve_time = time.perf_counter() - t0
     except cp.error.SolverError as exn:
+        if (bad := rejected_option(name, options, exn)) is not None:
+            raise bad from exn
         return RawSolution(
             status=Status.ERROR,
             solver_status=f"solver_error: {exn}",
             extras={"solver": used, "preset": preset if table else "defaults", "options": opts},
         )
     except (ValueError, TypeError, AttributeError, KeyError) as exn:  # bad option, wrong types
-        raise SolverError(f"cvxpy/{used} failed: {exn}") from exn
+        raise rejected_option(name, options, exn) or SolverError(
+            f"cvxpy/{used} failed: {one_line(exn)}") from exn
     except (MemoryError, OverflowError) as exn:  # DAQP and PROXQP densify P: 286 GiB at 256²
         raise SolverError(f"cvxpy/{used} cannot hold this problem (n = {qp.n}): {exn}; "
                           "use a sparse backend (osqp, clarabel, pdas) or the condensed formulation") from exn
@@ -253,7 +260,7 @@ def solve(
     return via_qp(problem, lambda qp: solve_qp(qp, solver, accuracy, options))
 
 
-class CvxpyBackend:
+class CvxpyBackend(Backend):
     """``cvxpy`` (solver None: cvxpy's choice) or ``cvxpy:NAME``."""
 
     accepts = frozenset({"qp", "lcp"})

@@ -51,10 +51,17 @@ The steps
 4. *Termination.* When ``z0`` leaves the basis, ``z0 = 0`` and the basic
    solution is a complementary solution of LCP(M, q). If no row blocks (the
    entering column has no positive entry) the method has found a *secondary
-   ray*: for a copositive-plus ``M`` — in particular any positive
-   semidefinite ``M``, the case of plates on one-sided supports — this proves
-   that the LCP has no solution, and :class:`~plateqp.errors.NoEquilibriumError`
-   is raised. ``M`` is never regularised.
+   ray*. For a copositive-plus ``M`` — in particular any positive
+   semidefinite ``M`` — the ``z`` part ``y`` of the ray's direction is then
+   a certificate that the LCP has no solution: ``y ≥ 0``, ``Mᵀy ≤ 0``,
+   ``qᵀy < 0`` (Cottle, Pang & Stone, Thm 4.4.13; see
+   :mod:`~plateqp.backends.lcp`). It is checked on ``M``, and the status is
+   ``INFEASIBLE`` with ``y`` in ``extras["certificate"]``; a ray whose ``y``
+   fails the check proves nothing (``M`` is not copositive-plus) and the
+   status is ``ERROR``. ``M`` is never regularised. (On a plate on one-sided
+   supports, whose condensed stiffness or flexibility is positive
+   semidefinite, a ray means the supports cannot carry the load: net uplift,
+   or a load outside their reach.)
 
 Lexicographic rule
 ------------------
@@ -96,19 +103,16 @@ array([4., 7.])
 
 from __future__ import annotations
 
-import sys
 import time
 from itertools import chain
 
 import numpy as np
 
-from ..errors import NoEquilibriumError, ProblemError
-from .base import LCP, QP, RawSolution, Status, plateqp_version, preset
+from ..errors import ProblemError
+from .base import LCP, RawSolution, Status
+from .lcp import LCPBackend, answer, certificate_tol, check_flag, check_int, infeasible, is_certificate, settings
 
-__all__ = ["name", "accepts", "ACCURACY", "available", "version", "solve", "lemke", "backends"]
-
-name = "lemke"
-accepts = frozenset({"lcp"})
+__all__ = ["ACCURACY", "OPTIONS", "BACKEND", "lemke", "backends"]
 
 #: Tolerances of each accuracy preset.
 #:
@@ -132,37 +136,8 @@ ACCURACY: dict[str, dict[str, float | int]] = {
     "high": {"pivot_tol": 1e-12, "zero_tol": 1e-12, "refactor_every": 100, "accept_tol": 1e-10},
 }
 
-#: Keys accepted in the ``options`` dict of :func:`solve`.
-OPTIONS = ("covering", "max_iter", "trace") + tuple(ACCURACY["default"])
-
 #: Negative entries of the cleaned-up ``z`` down to ``-CLIP_TOL · scale`` are set to zero.
 CLIP_TOL = 1e-12
-
-_RAY_MESSAGE = (
-    "Lemke's method ended on a secondary ray: the one-sided supports cannot carry this load "
-    "(net uplift, or the load resultant lies outside the supports' reach). "
-    "For a positive semidefinite M this proves that the LCP has no solution."
-)
-
-
-def available() -> bool:
-    """Lemke's method needs NumPy only: always available."""
-    return True
-
-
-version = plateqp_version  # the backend is part of plateqp
-
-
-def backends() -> list:
-    """The backends this module provides: the module itself.
-
-    Returns
-    -------
-    list
-        ``[module]``; the module has ``name``, ``accepts``, ``available``,
-        ``version`` and ``solve``, i.e. it satisfies the ``Backend`` protocol.
-    """
-    return [sys.modules[__name__]]
 
 
 # --------------------------------------------------------------------------- helpers
@@ -254,8 +229,13 @@ def _basis_matrix(M: np.ndarray, d: np.ndarray, basis: np.ndarray) -> np.ndarray
     return B
 
 
-def _check_accuracy(accuracy: str | float) -> dict:
-    return preset(ACCURACY, accuracy, scale=("accept_tol",))
+def _ray_direction(T: np.ndarray, basis: np.ndarray, entering: int, n: int) -> np.ndarray:
+    """The ``z`` part of the direction of a secondary ray: the entering variable grows by ``t``,
+    the basic ones change by ``−a t`` (``a`` its column, with no positive entry)."""
+    d = np.zeros(2 * n + 1)
+    d[basis] = -T[:, entering]
+    d[entering] = 1.0
+    return np.maximum(d[n:2 * n], 0.0)  # entries below the pivot tolerance are rounding
 
 
 # --------------------------------------------------------------------------- the method
@@ -275,9 +255,9 @@ def lemke(M, q, covering=None, max_iter=None, trace=False, *, accuracy="default"
     q : array_like, shape (n,)
         The LCP vector.
     covering : array_like or float, optional
-        Covering vector ``d`` ("pre-compression parameter"), strictly
-        positive; a scalar is broadcast. Default all ones, a uniform
-        pre-compression of all supports.
+        Covering vector ``d`` (the source paper's "pre-compression
+        parameter", see the module docstring), strictly positive; a scalar
+        is broadcast. Default all ones.
     max_iter : int, optional
         Maximum number of pivots (default ``50 n + 100``). Reaching it gives
         ``Status.MAX_ITER``, not an exception.
@@ -295,16 +275,17 @@ def lemke(M, q, covering=None, max_iter=None, trace=False, *, accuracy="default"
     -------
     RawSolution
         ``status`` (``OPTIMAL``; ``INACCURATE`` if the cleaned-up residual
-        exceeds ``accept_tol``; ``MAX_ITER``), ``x = z``, ``w = M z + q``,
-        ``obj = ½ zᵀMz + qᵀz``, ``iterations`` (number of pivots, the initial
-        ``z0`` pivot included), ``solve_time`` (seconds). On ``MAX_ITER``,
-        ``x`` and ``w`` are ``None`` and ``extras`` holds the last iterate
-        ``"z"``, ``"w"`` and ``"z0"``.
+        exceeds ``accept_tol``; ``MAX_ITER``; ``INFEASIBLE`` on a secondary
+        ray with a checked certificate, ``ERROR`` on one without), ``x = z``,
+        ``w = M z + q``, ``obj = ½ zᵀMz + qᵀz``, ``iterations`` (number of
+        pivots, the initial ``z0`` pivot included), ``solve_time`` (seconds).
+        On ``MAX_ITER``, ``x`` and ``w`` are ``None`` and ``extras`` holds the
+        last iterate ``"z"``, ``"w"`` and ``"z0"``. On ``INFEASIBLE``,
+        ``extras["certificate"]`` holds ``y ≥ 0`` with ``Mᵀy ≤ 0``,
+        ``qᵀy < 0``; on a ray without one, ``extras["ray"]`` its ``z`` part.
 
     Raises
     ------
-    NoEquilibriumError
-        Ray termination: the one-sided supports cannot carry the load.
     ProblemError
         Malformed data, a non-positive covering vector, a bad option value.
     """
@@ -312,17 +293,9 @@ def lemke(M, q, covering=None, max_iter=None, trace=False, *, accuracy="default"
     prob = LCP(M, q)  # validates shapes, densifies, checks finiteness
     M, q, n = prob.M, prob.q, prob.n
 
-    tol = _check_accuracy(accuracy)
-    for key, val in (("pivot_tol", pivot_tol), ("zero_tol", zero_tol),
-                     ("refactor_every", refactor_every), ("accept_tol", accept_tol)):
-        if val is not None:
-            tol[key] = val
-    for key in ("pivot_tol", "zero_tol", "accept_tol"):
-        if not (np.isscalar(tol[key]) and np.isfinite(tol[key]) and 0 <= tol[key] < 1):
-            raise ProblemError(f"option {key} must be a number in [0, 1), got {tol[key]!r}")
-    refac = tol["refactor_every"]
-    if isinstance(refac, bool) or not isinstance(refac, (int, np.integer)) or refac < 0:
-        raise ProblemError(f"option refactor_every must be an integer ≥ 0, got {refac!r}")
+    tol = settings(ACCURACY, accuracy, ("accept_tol",), pivot_tol=pivot_tol, zero_tol=zero_tol,
+                   refactor_every=refactor_every, accept_tol=accept_tol)
+    refac = check_int("refactor_every", tol["refactor_every"], 0)
 
     if covering is None:
         d = np.ones(n)
@@ -336,21 +309,17 @@ def lemke(M, q, covering=None, max_iter=None, trace=False, *, accuracy="default"
         if not (np.all(np.isfinite(d)) and np.all(d > 0)):
             raise ProblemError("the covering vector must be finite and strictly positive")
 
-    if max_iter is None:
-        max_iter = 50 * n + 100
-    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
-        raise ProblemError(f"option max_iter must be a positive integer, got {max_iter!r}")
-    if not isinstance(trace, (bool, np.bool_)):
-        raise ProblemError(f"option trace must be True or False, got {trace!r}")
+    max_iter = check_int("max_iter", 50 * n + 100 if max_iter is None else max_iter, 1)
+    trace = check_flag("trace", trace)
 
     steps: list[dict] = []
     extras: dict = {"trace": steps} if trace else {}
 
-    if n == 0 or np.all(q >= 0):
-        z = np.zeros(n)
-        return RawSolution(status=Status.OPTIMAL, x=z, w=q.copy(), obj=0.0, iterations=0,
-                           solve_time=time.perf_counter() - t0, solver_status="q >= 0: z = 0",
-                           extras=extras)
+    if n == 0 or q.min() >= -CLIP_TOL * np.abs(q).max():
+        # z = 0 solves it: q ≥ 0 up to rounding. A q_i of −1e-16 beside entries of 10 is a zero
+        # (on a plate: a support exactly at lift-off); pivoting on its row would chase rounding,
+        # and where its column of M is zero up to rounding too, end on a ray that proves nothing.
+        return _accepted(M, q, np.zeros(n), tol, t0, 0, "q >= 0 (up to rounding): z = 0", extras)
 
     Z0, RHS = 2 * n, 2 * n + 1
     T = _original_tableau(M, q, d)
@@ -387,8 +356,15 @@ def lemke(M, q, covering=None, max_iter=None, trace=False, *, accuracy="default"
         amax = np.abs(a).max()
         rows = np.flatnonzero(a > tol["pivot_tol"] * amax) if amax > 0 else np.array([], int)
         if rows.size == 0:
-            raise NoEquilibriumError(_RAY_MESSAGE + f" (ray after {it} pivots, entering "
-                                     f"{_label(entering, n)[0]}[{_label(entering, n)[1]}])")
+            kind, i = _label(entering, n)
+            how = f"Lemke's method ended on a secondary ray after {it} pivots (entering {kind}[{i}])"
+            y = _ray_direction(T, basis, entering, n)
+            if is_certificate(M, q, y, certificate_tol(n)):
+                return infeasible(y, t0, it, how, extras)
+            extras["ray"] = y
+            return RawSolution(status=Status.ERROR, iterations=it, solve_time=time.perf_counter() - t0,
+                               solver_status=f"{how}, whose direction is no certificate of infeasibility "
+                                             "(M is not copositive-plus): nothing is proved", extras=extras)
         z0row = int(np.flatnonzero(basis == Z0)[0])
         r = _lexmin_row(T, rows, a[rows], n, tol["zero_tol"], prefer=z0row)
         _pivot(T, r, entering, buf)
@@ -414,52 +390,34 @@ def lemke(M, q, covering=None, max_iter=None, trace=False, *, accuracy="default"
         xB = T[:, RHS].copy()
         cleanup = "tableau (basis matrix singular)"
     z[basis[zrows] - n] = xB[zrows]
-    Mmax = np.abs(M).max()
-    zscale = max(np.abs(z).max(), np.abs(q).max() / Mmax if Mmax > 0 else 0.0, np.finfo(float).tiny)
+    extras.update(refactorisations=n_refactor, cleanup=cleanup)
+    return _accepted(M, q, z, tol, t0, it, "z0 left the basis", extras)
+
+
+def _accepted(M: np.ndarray, q: np.ndarray, z: np.ndarray, tol: dict, t0: float, it: int, message: str,
+              extras: dict) -> RawSolution:
+    """The answer ``z``: negatives down to ``CLIP_TOL`` of its scale clipped, ``w = M z + q``, and
+    ``OPTIMAL`` if its relative KKT residual (``extras["kkt_residual"]``) is at most ``accept_tol``."""
+    Mmax = np.abs(M).max(initial=0.0)
+    zscale = max(np.abs(z).max(initial=0.0), np.abs(q).max(initial=0.0) / Mmax if Mmax > 0 else 0.0,
+                 np.finfo(float).tiny)
     z[(z < 0) & (z >= -CLIP_TOL * zscale)] = 0.0
-    Mz = M @ z
-    w = Mz + q
-    wscale = max(np.abs(q).max(), Mmax * np.abs(z).max(), np.finfo(float).tiny)
-    residual = max(max(0.0, -z.min()) / zscale, max(0.0, -w.min()) / wscale,
-                   np.abs(z * w).max() / (zscale * wscale))
+    w = M @ z + q
+    wscale = max(np.abs(q).max(initial=0.0), Mmax * np.abs(z).max(initial=0.0), np.finfo(float).tiny)
+    residual = max(max(0.0, -z.min(initial=0.0)) / zscale, max(0.0, -w.min(initial=0.0)) / wscale,
+                   np.abs(z * w).max(initial=0.0) / zscale / wscale)
     status = Status.OPTIMAL if residual <= tol["accept_tol"] else Status.INACCURATE
-    extras.update(kkt_residual=float(residual), refactorisations=n_refactor, cleanup=cleanup)
-    return RawSolution(status=status, x=z, w=w, obj=float(0.5 * z @ Mz + q @ z), iterations=it,
-                       solve_time=time.perf_counter() - t0,
-                       solver_status="z0 left the basis", extras=extras)
+    extras["kkt_residual"] = float(residual)
+    return answer(q, z, w, status, t0, it, message, extras)
 
 
-def solve(problem, accuracy: str = "default", options: dict | None = None) -> RawSolution:
-    """Solve an :class:`~plateqp.backends.base.LCP` by Lemke's method (Backend protocol).
+#: Keys accepted in the ``options`` dict of the backend's ``solve``.
+OPTIONS = ("covering", "max_iter", "trace") + tuple(ACCURACY["default"])
 
-    Parameters
-    ----------
-    problem : LCP
-        The problem; a :class:`~plateqp.backends.base.QP` is rejected.
-    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
-        Preset of :data:`ACCURACY`.
-    options : dict, optional
-        Overrides, keys among :data:`OPTIONS`: ``covering``, ``max_iter``,
-        ``trace``, ``pivot_tol``, ``zero_tol``, ``refactor_every``,
-        ``accept_tol`` (see :func:`lemke`).
+#: The ``lemke`` backend: exact, no warm start (its start is the covering vector).
+BACKEND = LCPBackend("lemke", lemke, OPTIONS, exact=True)
 
-    Returns
-    -------
-    RawSolution
-        See :func:`lemke`.
 
-    Raises
-    ------
-    ProblemError
-        Not an LCP, unknown accuracy or option.
-    NoEquilibriumError
-        Ray termination: the one-sided supports cannot carry this load.
-    """
-    if isinstance(problem, QP) or not isinstance(problem, LCP):
-        raise ProblemError(f"the lemke backend solves LCPs only, got {type(problem).__name__}")
-    _check_accuracy(accuracy)
-    options = dict(options or {})
-    unknown = sorted(set(options) - set(OPTIONS))
-    if unknown:
-        raise ProblemError(f"unknown option(s) {unknown} for backend lemke; known: {list(OPTIONS)}")
-    return lemke(problem.M, problem.q, accuracy=accuracy, **options)
+def backends() -> list[LCPBackend]:
+    """The backends this module provides: ``[BACKEND]``."""
+    return [BACKEND]

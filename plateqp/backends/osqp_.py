@@ -21,8 +21,8 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import SolverError
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, preset, via_qp
+from ..errors import ProblemError, SolverError
+from .base import ACCURACIES, LCP, QP, Backend, RawSolution, Status, preset, rejected_option, via_qp
 
 try:
     import osqp
@@ -113,9 +113,11 @@ def solve_qp(qp: QP, accuracy: str = "default", options: dict | None = None) -> 
     except osqp.OSQPException as exn:  # carries an osqp error code, e.g. 1 = data validation
         code = exn.args[0] if exn.args else None
         what = osqp.SolverError(code).name if code in set(osqp.SolverError) else repr(exn)
+        if what == "OSQP_SETTINGS_VALIDATION_ERROR" and options:
+            raise ProblemError(f"OSQP rejected its settings (options given: {sorted(options)}): {what}") from exn
         raise SolverError(f"OSQP rejected the problem or settings: {what}") from exn
-    except (ValueError, TypeError) as exn:  # unknown setting, wrong types
-        raise SolverError(f"OSQP failed: {exn}") from exn
+    except (ValueError, TypeError) as exn:  # an unknown setting, a wrong type
+        raise rejected_option(NAME, options, exn) or SolverError(f"OSQP failed: {exn}") from exn
 
     info = res.info
     name = osqp.SolverStatus(info.status_val).name
@@ -158,8 +160,8 @@ def solve(problem: QP | LCP, accuracy: str = "default", options: dict | None = N
     return via_qp(problem, lambda qp: solve_qp(qp, accuracy, options))
 
 
-class OSQPBackend:
-    """The ``osqp`` backend (see :class:`plateqp.backends.base.Backend`)."""
+class OSQPBackend(Backend):
+    """The ``osqp`` backend (see :class:`plateqp.backends.base.Backend`): iterative (ADMM)."""
 
     name = NAME
     accepts = frozenset({"qp", "lcp"})
@@ -168,7 +170,7 @@ class OSQPBackend:
         return osqp is not None
 
     def version(self) -> str | None:
-        return getattr(osqp, "__version__", None)
+        return getattr(osqp, "__version__", None) if osqp is not None else None
 
     def solve(self, problem: QP | LCP, accuracy: str = "default", options: dict | None = None) -> RawSolution:
         return solve(problem, accuracy, options)

@@ -3,9 +3,9 @@ r"""Projected Gauss–Seidel (PGS, with over-relaxation: PSOR) for LCP(M, q), in
 The problem
 -----------
 Find ``z ≥ 0`` such that ``w = M z + q ≥ 0`` and ``zᵀ w = 0``; ``M`` symmetric
-positive semidefinite, with a positive diagonal (the condensed stiffness of a
-plate on one-sided supports, or its flexibility), so that the LCP is the
-optimality condition of  min ½ zᵀMz + qᵀz,  z ≥ 0.
+positive semidefinite, with a positive diagonal, so that the LCP is the
+optimality condition of  min ½ zᵀMz + qᵀz,  z ≥ 0. (On a plate on one-sided
+supports, ``M`` is the condensed stiffness or the flexibility.)
 
 The method
 ----------
@@ -22,8 +22,8 @@ projection onto ``z_i ≥ 0`` (``ω = 1``: projected Gauss–Seidel), or a step
 ``ω ∈ (0, 2)`` times as long (projected SOR). For symmetric PSD ``M`` with a
 positive diagonal and ``0 < ω < 2`` the objective decreases monotonically and,
 when the LCP has a solution, ``w`` converges to its (unique) value; the rate
-is linear and governed by the conditioning of ``M``: slow on plates, whose
-condensed stiffness has condition numbers of 10⁴–10⁶.
+is linear and governed by the conditioning of ``M``: slow for condition numbers
+of 10⁴–10⁶ (those of a plate's condensed stiffness).
 
 Cost and implementation
 -----------------------
@@ -32,8 +32,8 @@ Python loop over ``i``; what can be precomputed is. ``w = M z + q`` is kept
 up to date instead of recomputing ``M_i z`` (``O(n)``) for every ``i``: a change
 ``δ`` of ``z_i`` is one BLAS ``daxpy``, ``w ← w + δ M_{:,i}`` (row ``i`` of ``M``,
 as ``M`` is symmetric, so the access is contiguous). A component that does not
-change — a support in contact that stays in contact, ``z_i = 0`` with
-``w_i ≥ 0``, the majority on a plate — costs a few scalar operations and no
+change — ``z_i = 0`` that stays there with ``w_i ≥ 0``, the majority on a
+plate (supports that stay in contact) — costs a few scalar operations and no
 ``daxpy``. A sweep thus costs ``O(n)`` interpreter work plus ``O(n · k)`` flops,
 ``k`` the number of components that moved (at most ``n``: ``O(n²)``). The
 stopping test after each sweep is ``O(n)`` on the running ``w``; every
@@ -44,25 +44,24 @@ per sweep at ``n = 900`` with about 730 moving components (a pure-Python inner
 product per component would cost ~100 ms per sweep).
 
 Stopping test: the relative natural residual
-(:func:`plateqp.backends.bpp.natural_residual`)
+(:func:`plateqp.backends.lcp.natural_residual`)
 
 .. math::
 
     r = \frac{\max_i |\min(M_{ii} z_i,\ w_i)|}{\max(\|w\|_\infty, \|q\|_\infty)}
 
-(the gap weighted by the diagonal so that both terms are forces, like the
-natural residual of :mod:`plateqp.contact.kkt`; scaled by forces only, so that a
-runaway ``z`` cannot shrink it), checked after every sweep.
+(``z`` weighted by the diagonal so that both terms are in the units of ``w``;
+scaled by ``w`` and ``q`` only, so that a runaway ``z`` cannot shrink it), checked
+after every sweep.
 
 Accuracy
 --------
 ``tol`` of each preset in :data:`ACCURACY`: the sweeps stop as soon as
 ``r ≤ tol`` (status ``OPTIMAL``). If ``max_iter`` sweeps or ``time_limit``
 seconds run out first, the status is ``MAX_ITER`` and the last iterate is
-returned in ``x``, ``w`` so that the KKT check of :mod:`plateqp.contact.kkt` can show how
-far it is; ``solver_status`` says which limit ended it. An LCP without a
-solution (net uplift) makes ``z`` grow without bound: it ends on a limit, never
-``OPTIMAL``.
+returned in ``x``, ``w`` so that the caller's own check can show how far it is;
+``solver_status`` says which limit ended it. An LCP without a solution makes
+``z`` grow without bound: it ends on a limit, never ``OPTIMAL``.
 
 Examples
 --------
@@ -75,20 +74,16 @@ Examples
 
 from __future__ import annotations
 
-import sys
 import time
 
 import numpy as np
 from scipy.linalg.blas import daxpy
 
 from ..errors import ProblemError
-from .base import LCP, QP, RawSolution, Status, plateqp_version, preset
-from .bpp import natural_residual
+from .base import LCP, RawSolution, Status
+from .lcp import LCPBackend, answer, check_int, natural_residual, settings
 
-__all__ = ["name", "accepts", "ACCURACY", "OPTIONS", "available", "version", "solve", "pgs", "backends"]
-
-name = "pgs"
-accepts = frozenset({"lcp"})
+__all__ = ["ACCURACY", "OPTIONS", "BACKEND", "pgs", "backends"]
 
 #: Stopping tolerance of each accuracy preset: the sweeps stop when the relative natural
 #: residual ``r`` (module docstring) is at most ``tol``.
@@ -98,32 +93,12 @@ ACCURACY: dict[str, dict[str, float]] = {
     "high": {"tol": 1e-11},
 }
 
-#: Keys accepted in the ``options`` dict of :func:`solve`.
-OPTIONS = ("omega", "max_iter", "time_limit", "z0") + tuple(ACCURACY["default"])
-
 #: Defaults of the limits: sweeps, and seconds of wall-clock time.
 MAX_ITER = 100_000
 TIME_LIMIT = 60.0
 
 #: ``w`` is recomputed as ``M z + q`` every ``RESYNC`` sweeps (and before stopping).
 RESYNC = 10
-
-
-def available() -> bool:
-    """PGS needs NumPy and SciPy only: always available."""
-    return True
-
-
-version = plateqp_version  # the backend is part of plateqp
-
-
-def backends() -> list:
-    """The backends this module provides: ``[module]`` (it satisfies the ``Backend`` protocol)."""
-    return [sys.modules[__name__]]
-
-
-def _check_accuracy(accuracy: str | float) -> dict:
-    return preset(ACCURACY, accuracy, scale=("tol",))
 
 
 def _sweep(rows: list, step: list, z: list, w: np.ndarray) -> None:
@@ -183,26 +158,18 @@ def pgs(M, q, omega=1.0, max_iter=None, time_limit=None, z0=None, *, accuracy="d
     Notes
     -----
     A component with ``M_ii ≤ 0`` cannot be updated (the step divides by
-    ``M_ii``); for a PSD ``M`` its row is zero (up to rounding: three
-    supports under a floating plate give ``M ≈ 0``), so ``z_i`` does not act
+    ``M_ii``); for a PSD ``M`` its row is zero (up to rounding: a plate
+    floating on three supports gives ``M ≈ 0``), so ``z_i`` does not act
     on ``w`` and is held at its start value (0 unless ``z0`` says otherwise).
     If that prevents convergence the sweeps end on a limit, ``MAX_ITER``.
     """
     t0 = time.perf_counter()
     prob = LCP(M, q)
     M, q, n = prob.M, prob.q, prob.n
-    opts = _check_accuracy(accuracy)
-    if tol is not None:
-        opts["tol"] = tol
-    tol = opts["tol"]
-    if isinstance(tol, bool) or not (np.isscalar(tol) and np.isfinite(tol) and 0 <= tol < 1):
-        raise ProblemError(f"option tol must be a number in [0, 1), got {tol!r}")
+    tol = settings(ACCURACY, accuracy, ("tol",), tol=tol)["tol"]
     if isinstance(omega, bool) or not (np.isscalar(omega) and np.isfinite(omega) and 0 < omega < 2):
         raise ProblemError(f"option omega must be a number in (0, 2), got {omega!r}")
-    if max_iter is None:
-        max_iter = MAX_ITER
-    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
-        raise ProblemError(f"option max_iter must be a positive integer, got {max_iter!r}")
+    max_iter = check_int("max_iter", MAX_ITER if max_iter is None else max_iter, 1)
     if time_limit is None:
         time_limit = TIME_LIMIT
     if isinstance(time_limit, bool) or not (np.isscalar(time_limit) and time_limit > 0):
@@ -254,39 +221,18 @@ def pgs(M, q, omega=1.0, max_iter=None, time_limit=None, z0=None, *, accuracy="d
                else f"{ended}; natural residual {res:.1e} > {tol:.0e}")
     if held.any():
         message += f" ({int(held.sum())} components with M_ii ≤ 0 held at their start value)"
-    return RawSolution(status=status, x=z, w=w, obj=float(0.5 * z @ (w + q)), iterations=sweeps,
-                       solve_time=time.perf_counter() - t0, solver_status=message,
-                       extras={"natural_residual": res, "active": z == 0, "omega": float(omega)})
+    return answer(q, z, w, status, t0, sweeps, message,
+                  {"natural_residual": res, "active": z == 0, "omega": float(omega)})
 
 
-def solve(problem, accuracy: str = "default", options: dict | None = None) -> RawSolution:
-    """Solve an :class:`~plateqp.backends.base.LCP` by projected Gauss–Seidel (Backend protocol).
+#: Keys accepted in the ``options`` dict of the backend's ``solve``.
+OPTIONS = ("omega", "max_iter", "time_limit", "z0") + tuple(ACCURACY["default"])
 
-    Parameters
-    ----------
-    problem : LCP
-        The problem; a :class:`~plateqp.backends.base.QP` is rejected.
-    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
-        Preset of :data:`ACCURACY`.
-    options : dict, optional
-        Overrides, keys among :data:`OPTIONS`: ``omega``, ``max_iter``,
-        ``time_limit``, ``z0``, ``tol`` (see :func:`pgs`).
+#: The ``pgs`` backend: iterative (its answer is as accurate as asked), warm-started only by
+#: ``options["z0"]``, an iterate, not by an active set.
+BACKEND = LCPBackend("pgs", pgs, OPTIONS, exact=False)
 
-    Returns
-    -------
-    RawSolution
-        See :func:`pgs`.
 
-    Raises
-    ------
-    ProblemError
-        Not an LCP, unknown accuracy or option.
-    """
-    if isinstance(problem, QP) or not isinstance(problem, LCP):
-        raise ProblemError(f"the pgs backend solves LCPs only, got {type(problem).__name__}")
-    _check_accuracy(accuracy)
-    options = dict(options or {})
-    unknown = sorted(set(options) - set(OPTIONS))
-    if unknown:
-        raise ProblemError(f"unknown option(s) {unknown} for backend pgs; known: {list(OPTIONS)}")
-    return pgs(problem.M, problem.q, accuracy=accuracy, **options)
+def backends() -> list[LCPBackend]:
+    """The backends this module provides: ``[BACKEND]``."""
+    return [BACKEND]

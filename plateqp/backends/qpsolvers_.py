@@ -19,9 +19,9 @@ import warnings
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import SolverError
+from ..errors import ProblemError, SolverError
 from . import clarabel_, osqp_
-from .base import ACCURACIES, LCP, QP, RawSolution, Status, accuracy_tol, via_qp
+from .base import ACCURACIES, LCP, QP, Backend, RawSolution, Status, accuracy_tol, one_line, rejected_option, via_qp
 from .base import preset as preset_for
 
 try:
@@ -181,6 +181,24 @@ def _name(v) -> str:
     return getattr(v, "name", None) or str(v).rsplit(".", 1)[-1]
 
 
+#: Keywords qpsolvers itself takes besides the solver's settings (``solve_problem`` and, per
+#: solver, its wrapper's own arguments).
+_WRAPPER_KEYWORDS = {"initvals", "verbose"}
+_SOLVER_KEYWORDS = {"piqp": {"backend"}}
+
+
+def _dropped_settings(solver: str, options: dict | None) -> list[str]:
+    """The options that qpsolvers would drop without a word: its piqp and qpalm wrappers set
+    each keyword on the solver's settings object and skip those it lacks (a warning only when
+    verbose). Their settings objects list what they take; other solvers complain themselves."""
+    if not options or solver not in ("piqp", "qpalm"):
+        return []
+    module = importlib.import_module(solver)
+    settings = module.SparseSolver().settings if solver == "piqp" else module.Settings()
+    known = {a for a in dir(settings) if not a.startswith("_")} | _WRAPPER_KEYWORDS | _SOLVER_KEYWORDS.get(solver, set())
+    return sorted(set(options) - known)
+
+
 def _solver_status(solver: str, sol, caught: list[str]) -> tuple[str, int | None]:
     """The solver's own status and iteration count, as far as qpsolvers kept them."""
     e = sol.extras if isinstance(sol.extras, dict) else {}
@@ -270,6 +288,8 @@ def solve_qp(qp: QP, solver: str, accuracy: str = "default", options: dict | Non
     if solver not in qpsolvers.available_solvers:
         raise SolverError(f"qpsolvers has no solver {solver!r} here; it has {qpsolvers.available_solvers}")
     accuracy_tol(accuracy)  # a clear error for a bad accuracy
+    if dropped := _dropped_settings(solver, options):
+        raise ProblemError(f"unknown option(s) {dropped} for backend {PREFIX}:{solver} (not settings of {solver})")
     table = ACCURACY.get(solver)
     preset = preset_for(table, accuracy) if table else {}
     opts = {**preset, **(options or {})}
@@ -287,6 +307,8 @@ def solve_qp(qp: QP, solver: str, accuracy: str = "default", options: dict | Non
             sol = qpsolvers.solve_problem(problem, solver=solver, **opts)
             wall = time.perf_counter() - t0
         except qpsolvers.SolverError as exn:  # the solver failed on this problem
+            if (bad := rejected_option(f"{PREFIX}:{solver}", options, exn)) is not None:
+                raise bad from exn
             return RawSolution(
                 status=Status.ERROR,
                 solver_status=f"SolverError: {exn}",
@@ -295,7 +317,8 @@ def solve_qp(qp: QP, solver: str, accuracy: str = "default", options: dict | Non
         except qpsolvers.ProblemError as exn:  # e.g. quadprog and ecos need P positive definite
             raise SolverError(f"qpsolvers/{solver} rejected the problem: {exn}") from exn
         except (qpsolvers.ParamError, TypeError, ValueError, AttributeError) as exn:
-            raise SolverError(f"qpsolvers/{solver} failed: {exn}") from exn
+            raise rejected_option(f"{PREFIX}:{solver}", options, exn) or SolverError(
+                f"qpsolvers/{solver} failed: {one_line(exn)}") from exn
         except (MemoryError, OverflowError) as exn:
             raise SolverError(f"qpsolvers/{solver} cannot hold this problem (n = {qp.n}): {exn}") from exn
     caught = [str(w.message) for w in caught_w]
@@ -348,7 +371,7 @@ def solve(
     return via_qp(problem, lambda qp: solve_qp(qp, solver, accuracy, options))
 
 
-class QpsolversBackend:
+class QpsolversBackend(Backend):
     """``qpsolvers:NAME``."""
 
     accepts = frozenset({"qp", "lcp"})

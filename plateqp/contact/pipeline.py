@@ -32,8 +32,9 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
 
     ``check_statics``: before solving, check by statics that the supports can carry the load
     at all (:func:`plateqp.contact.statics.equilibrium_possible`) and raise NoEquilibriumError at once
-    if not. Whatever it is set to, a backend's claim of "no equilibrium" is checked against
-    the same statics, and a false claim is a SolverError, never a NoEquilibriumError.
+    if not. Whatever it is set to, a backend's claim of "no equilibrium" (status INFEASIBLE or
+    UNBOUNDED, with its certificate) is checked against the same statics, and a false claim is a
+    SolverError, never a NoEquilibriumError.
     """
     acc = Accuracy.parse(accuracy)  # ProblemError for a bad one, before any work
     t0 = time.perf_counter()
@@ -60,21 +61,13 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         form = formulate(data, formulation)
     problem = form.problem(b.accepts)
     t1 = time.perf_counter()
-    try:
-        raw = b.solve(problem, accuracy=acc, options=options or {})
-    except NoEquilibriumError as exn:
-        if possible:
-            raise SolverError(f"{backend} on the {formulation} problem claimed no equilibrium ({exn}), "
-                              "but statics says the supports can carry the load: the solver failed") from exn
-        raise NoEquilibriumError(f"{backend} on the {formulation} problem: {NO_EQUILIBRIUM} ({why})") from exn
+    raw = b.solve(problem, accuracy=acc, options=options or {})
     t2 = time.perf_counter()
-    if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED) and possible:
-        raise SolverError(f"{backend} on the {formulation} problem ended {raw.status.value} "
-                          f"({raw.solver_status}), but statics says the supports can carry the load: "
-                          "the solver failed")
-    if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED):
-        raise NoEquilibriumError(f"{backend} on the {formulation} problem ended {raw.status.value} "
-                                 f"({raw.solver_status}): {NO_EQUILIBRIUM}")
+    if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED):  # the backend's certificate, in QP/LCP terms
+        verdict = f"{backend} on the {formulation} problem ended {raw.status.value} ({raw.solver_status})"
+        if possible:
+            raise SolverError(f"{verdict}, but statics says the supports can carry the load: the solver failed")
+        raise NoEquilibriumError(f"{verdict}: {NO_EQUILIBRIUM} ({why})")
     if raw.x is None:
         raise SolverError(f"{backend} on the {formulation} problem returned no solution: "
                           f"{raw.status.value} ({raw.solver_status})")

@@ -19,9 +19,14 @@ from .scaling import Scaled
 #   condensation is cached and re-used by every solve that shares the model (sweeps, gap
 #   regulation: a dense m × m solve per value instead of a factorisation), and BPP's answer
 #   did not depend on its warm start (bit-identical serial and parallel sweeps in
-#   tests/test_studies.py, where warm-started PDAS differed at 1e-13). Condensed and dual
-#   problems go to the first of AUTO_LCP_BACKENDS (BPP: 7–10× faster than Lemke from m = 225
-#   on, as exact), primal ones to the first of AUTO_QP_BACKENDS.
+#   tests/test_studies.py, where warm-started PDAS differed at 1e-13).
+# * which backend, read from the declared capabilities (plateqp.backends.base.Backend): an
+#   exact one that takes the formulation (answers exact to rounding at any tolerance), the
+#   warm-startable ones first (sweeps re-use their final active set; of the exact LCP solvers
+#   that is BPP, also measured 7–10× faster than Lemke from m = 225 on). An exact QP solver
+#   (PDAS) is offered at most as many contact rows as dofs (it refuses more). With no exact
+#   backend for the formulation, the first installed of AUTO_QP_BACKENDS, the external QP
+#   solvers in the order measured.
 # * a named QP backend (osqp, clarabel, qpsolvers:*, …): the condensed problem paid while
 #   m ≤ AUTO_CONDENSED_FRACTION × free dofs: the break-even of OSQP, Clarabel and ProxQP was
 #   m ≈ 25–50 at 3 k dofs, ≈ 100 at 12 k, ≈ 225–960 at 49 k; never beyond AUTO_CONDENSED_MAX
@@ -30,8 +35,7 @@ from .scaling import Scaled
 AUTO_LCP_MAX = 100
 AUTO_CONDENSED_FRACTION = 0.01
 AUTO_CONDENSED_MAX = 1000
-AUTO_QP_BACKENDS = ("pdas", "clarabel", "qpsolvers:clarabel", "osqp", "cvxpy")
-AUTO_LCP_BACKENDS = ("bpp", "lemke")
+AUTO_QP_BACKENDS = ("clarabel", "qpsolvers:clarabel", "osqp", "cvxpy")
 
 
 def condensed_pays(data: Scaled, backend: str = "auto") -> bool:
@@ -49,6 +53,16 @@ def _first_installed(names: tuple[str, ...]) -> str | None:
     return next((b for b in names if b in registry() and registry()[b].available()), None)
 
 
+def exact_backends(formulation: str, data: Scaled | None = None) -> list[str]:
+    """The installed backends declared ``exact`` that take ``formulation``, the warm-startable
+    first (then in registry order); with ``data``, an exact QP backend only while the contact
+    rows are at most the dofs."""
+    found = [b for b in registry().values() if getattr(b, "exact", False) and b.available()
+             and formulation in formulations_for(b)
+             and (data is None or "lcp" in b.accepts or data.m <= data.n)]
+    return [b.name for b in sorted(found, key=lambda b: not getattr(b, "warm_start", False))]
+
+
 def choose(data: Scaled, backend: str, formulation: str) -> tuple[str, str]:
     if formulation == "auto":
         takes = list(FORMULATIONS) if backend == "auto" else formulations_for(backend)
@@ -61,14 +75,10 @@ def choose(data: Scaled, backend: str, formulation: str) -> tuple[str, str]:
     if formulation not in FORMULATIONS:
         raise ProblemError(f"unknown formulation {formulation!r}; choose one of {FORMULATIONS}")
     if backend == "auto":
-        if formulation in ("condensed", "dual"):
-            backend = _first_installed(AUTO_LCP_BACKENDS) or "lemke"
-        else:
-            # pdas takes at most as many contact rows as dofs (a coarse mesh under many supports)
-            backend = _first_installed(tuple(b for b in AUTO_QP_BACKENDS if b != "pdas" or data.m <= data.n))
-            if backend is None:
-                raise SolverError("the primal formulation needs a QP backend; none is installed "
-                                  "(pip install 'plateqp[solvers]')")
+        backend = next(iter(exact_backends(formulation, data)), None) or _first_installed(AUTO_QP_BACKENDS)
+        if backend is None:
+            raise SolverError(f"the {formulation} formulation needs a QP backend; none is installed "
+                              "(pip install 'plateqp[solvers]')")
     return backend, formulation
 
 

@@ -1,0 +1,255 @@
+"""The plan view: the mesh with its two-sided edges and pins, the one-sided supports (filled in
+contact, hollow lifted off, shaped and coloured by the sign of their gap), the bed's contact
+nodes, point loads, reactions and the section lines drawn on the plate.
+
+Also the helpers every plan-view map shares (:func:`_draw_supports`, :func:`_plan_axes`,
+:func:`_legend_handles`) and the choice of section lines (:func:`default_sections`).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .data import _bed, _point_loads, _supports, support_spacing
+from .style import _figure, _fmt, _gap_style, _lab, _units
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+    from ..results import Result
+
+
+# -- markers and axes shared by the plan-view maps --------------------------------------------
+def _draw_supports(ax, result: Result, *, all_active: bool = False, size: float = 42):
+    """Support markers on a plan view: filled in contact, hollow lifted off, shaped by gap sign."""
+    sup = _supports(result)
+    on = np.ones(sup.n, dtype=bool) if all_active else sup.active
+    kind = np.sign(sup.g0)
+    for k in (-1.0, 0.0, 1.0):
+        col, mk, _ = _gap_style(k)
+        for filled in (True, False):
+            sel = (kind == k) & (on == filled)
+            if sel.any():
+                ax.scatter(sup.xy[sel, 0], sup.xy[sel, 1], s=size, marker=mk, edgecolors=col,
+                           facecolors=(col if filled else "white"), linewidths=1.2, zorder=5, clip_on=False)
+    bxy, bon = _bed(result)
+    if bxy.size:
+        on = np.ones_like(bon) if all_active else bon
+        ax.scatter(bxy[on, 0], bxy[on, 1], s=6, c="k", marker=".", zorder=4, clip_on=False)
+        ax.scatter(bxy[~on, 0], bxy[~on, 1], s=6, facecolors="none", edgecolors="0.4", marker="o",
+                   linewidths=0.5, zorder=4, clip_on=False)
+    for ld in _point_loads(result.scene):
+        ax.scatter(ld.x, ld.y, s=90, marker="X", c="tab:orange", edgecolors="k", linewidths=0.8, zorder=6)
+
+
+def _plan_axes(ax, result: Result, units, title: str | None = None):
+    g = result.model.grid
+    L = _units(units)[0]
+    ax.set_aspect("equal")
+    ax.set_xlim(0.0, g.a)
+    ax.set_ylim(0.0, g.b)
+    ax.set_xlabel(_lab("x", L))
+    ax.set_ylabel(_lab("y", L))
+    if title:
+        ax.set_title(title)
+
+
+def _legend_handles(result: Result, *, all_active: bool = False):
+    """Legend entries for the support markers present in a figure."""
+    from matplotlib.lines import Line2D
+
+    sup = _supports(result)
+    hs = []
+    kinds = {_gap_style(g)[2] for g in sup.g0}
+    txt = {"level": "support, level (g0 = 0)", "heaved": "support, heaved (g0 < 0)",
+           "settled": "support, settled (g0 > 0)"}
+    for g0 in (0.0, -1.0, 1.0):
+        col, mk, kind = _gap_style(g0)
+        if kind in kinds:
+            hs.append(Line2D([], [], ls="none", marker=mk, mec=col, mfc=col, label=txt[kind]))
+    if sup.n:
+        hs.append(Line2D([], [], ls="none", marker="s", mec="0.45", mfc="0.45", label="filled: in contact"))
+        if not all_active and not sup.active.all():
+            hs.append(Line2D([], [], ls="none", marker="s", mec="0.45", mfc="white", label="hollow: lifted off"))
+    bxy, _ = _bed(result)
+    if bxy.size:
+        hs.append(Line2D([], [], ls="none", marker=".", color="k", label="bed node"))
+    if _point_loads(result.scene):
+        hs.append(Line2D([], [], ls="none", marker="X", mfc="tab:orange", mec="k", ms=9, label="point load"))
+    return hs
+
+
+# -- the mesh, the supports, their reactions --------------------------------------------------
+def plot_mesh(result: Result, units=None, *, sections=None, annotate: bool = True,
+              numbers: bool | None = None) -> Figure:
+    """The mesh with the supports: filled in contact, hollow lifted off, heave/settlement marked.
+
+    ``annotate``: write each in-contact support's reaction beside it (force units).
+    ``numbers``: write the support numbers (1-based, scene order); default when ≤ 64 supports.
+    ``sections``: section lines to draw and number (as for :func:`plot_sections`).
+    """
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Rectangle
+
+    L, F = _units(units)
+    sc = result.scene
+    g = result.model.grid
+    fig = _figure((8.6, 7.0))
+    fig._plateqp_tight = True  # constrained layout misjudges this equal-aspect axes beside an outside legend
+    ax = fig.add_subplot()
+    # mesh lines and removed cells
+    from matplotlib.collections import LineCollection
+
+    segs = [[(i * g.hx, 0.0), (i * g.hx, g.b)] for i in range(g.nx + 1)]
+    segs += [[(0.0, j * g.hy), (g.a, j * g.hy)] for j in range(g.ny + 1)]
+    ax.add_collection(LineCollection(segs, colors="0.8", linewidths=0.5, zorder=1))
+    for c in np.flatnonzero(~g.cell_mask):
+        ax.add_patch(Rectangle(((c % g.nx) * g.hx, (c // g.nx) * g.hy), g.hx, g.hy, facecolor="0.92",
+                               hatch="///", edgecolor="0.7", lw=0.0, zorder=1))
+    handles = [Line2D([], [], color="0.8", lw=0.8, label=f"mesh {g.nx} × {g.ny} ({sc.mesh.element.upper()})")]
+    # two-sided edges and pins
+    edge_lines = {"left": ([0, 0], [0, g.b]), "right": ([g.a, g.a], [0, g.b]),
+                  "bottom": ([0, g.a], [0, 0]), "top": ([0, g.a], [g.b, g.b])}
+    seen = set()
+    for name, e in sc.edges.items():
+        if e.kind == "free":
+            continue
+        style = {"simple": {"color": "tab:green", "lw": 4}, "clamped": {"color": "tab:purple", "lw": 6}}[e.kind]
+        ax.plot(*edge_lines[name], solid_capstyle="butt", zorder=3, clip_on=False, **style)
+        if e.kind not in seen:
+            handles.append(Line2D([], [], label=f"{e.kind} edge (two-sided)", **style))
+            seen.add(e.kind)
+    if sc.pins:
+        ax.scatter([p.x for p in sc.pins], [p.y for p in sc.pins], marker="s", s=50, c="tab:green",
+                   edgecolors="k", zorder=5, clip_on=False)
+        handles.append(Line2D([], [], ls="none", marker="s", mfc="tab:green", mec="k", label="pin (two-sided)"))
+    # supports
+    sup = _supports(result)
+    _draw_supports(ax, result, size=60 if sup.n <= 40 else 34)
+    handles += _legend_handles(result)
+    if sup.n and not sup.rigid.all():
+        cs = np.unique(sup.stiffness[~sup.rigid])
+        what = f"c = {cs[0]:.4g}" if cs.size == 1 else f"c = {cs.min():.3g} … {cs.max():.3g}"
+        unit = f" {F}/{L}" if L and F else ""
+        label = ("elastic supports, " if sup.rigid.sum() == 0 else f"{(~sup.rigid).sum()} elastic, ") + what + unit
+        handles.append(Line2D([], [], ls="none", label=label))
+    if numbers is None:
+        numbers = 0 < sup.n <= 64
+    span = max(g.a, g.b)
+    dense = sup.n > 1 and support_spacing(sup.xy) < 0.1 * span
+    if annotate or numbers:
+        for i in range(sup.n):
+            d = _outward(sup.xy[i], g.a, g.b)
+            on_tb = d[1] != 0 and d[0] == 0  # on the bottom or top edge (not a corner)
+            rot = 90 if (dense and on_tb) else 0
+            if annotate and sup.active[i]:
+                ax.annotate(_fmt(sup.R[i]), sup.xy[i], xytext=(8 * d[0], 8 * d[1]), textcoords="offset points",
+                            fontsize=7 if dense else 8, color="tab:brown", rotation=rot, zorder=7,
+                            ha=_ha(d[0]) if not rot else "center", va=_va(d[1]), annotation_clip=False)
+            if numbers:
+                ax.annotate(str(i + 1), sup.xy[i], xytext=(-7 * d[0] if d.any() else -6, -7 * d[1] if d.any() else -6),
+                            textcoords="offset points", fontsize=6 if dense else 7, color="0.35",
+                            ha=_ha(-d[0] if d.any() else -1), va=_va(-d[1] if d.any() else -1), zorder=7)
+        if annotate and sup.active.any():
+            handles.append(Line2D([], [], ls="none", marker="$R$", color="tab:brown",
+                                  label="reaction R" + (f" ({F})" if F else "")))
+        if numbers:
+            handles.append(Line2D([], [], ls="none", marker="$7$", color="0.35", label="support number"))
+    # point loads
+    for ld in _point_loads(sc):
+        ax.annotate(f"P = {_fmt(ld.P)}" + (f" {F}" if F else ""), (ld.x, ld.y), xytext=(9, -12),
+                    textcoords="offset points", fontsize=8, color="tab:orange", fontweight="bold", zorder=7)
+    # sections: numbered beyond the plate's edge (past the reactions), at the start of the line,
+    # or at its end when another section's number is already there
+    placed: list[np.ndarray] = []
+    for k, (_label, p0, p1) in enumerate(_norm_sections(sections, result), 1):
+        ax.plot([p0[0], p1[0]], [p0[1], p1[1]], color="tab:purple", lw=1.0, ls=(0, (6, 3)), zorder=2)
+        for a0, a1 in ((p0, p1), (p1, p0)):
+            at = np.array(a0) + 0.13 * span * _unit(np.array(a0) - np.array(a1))
+            if all(np.hypot(*(at - q)) > 0.06 * span for q in placed):
+                break
+        placed.append(at)
+        ax.plot([a0[0], at[0]], [a0[1], at[1]], color="tab:purple", lw=0.6, ls=":", zorder=2)
+        ax.annotate(str(k), at, fontsize=8, color="tab:purple", ha="center", va="center", annotation_clip=False,
+                    bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "tab:purple", "lw": 0.8}, zorder=8)
+    if sections is not None and len(sections):
+        handles.append(Line2D([], [], color="tab:purple", lw=1.0, ls=(0, (6, 3)), label="section line (numbered)"))
+    m = 0.17 * span
+    ax.set_aspect("equal")
+    ax.set_xlim(-m, g.a + m)
+    ax.set_ylim(-m, g.b + m)
+    ax.add_patch(Rectangle((0, 0), g.a, g.b, fill=False, ec="k", lw=1.2, zorder=2))
+    ax.set_xlabel(_lab("x", L))
+    ax.set_ylabel(_lab("y", L))
+    n_on = int(sup.active.sum())
+    title = f"{sc.name}: mesh and supports"
+    if sup.n:
+        title += f", {n_on} of {sup.n} in contact"
+    ax.set_title(title)
+    fig.legend(handles=handles, loc="outside right upper", fontsize=8)
+    return fig
+
+
+def _outward(p, a: float, b: float) -> np.ndarray:
+    """Unit-ish direction away from the plate at a boundary point; (1, 1)/√2 inside."""
+    tol = 1e-9 * max(a, b)
+    dx = -1.0 if p[0] <= tol else (1.0 if p[0] >= a - tol else 0.0)
+    dy = -1.0 if p[1] <= tol else (1.0 if p[1] >= b - tol else 0.0)
+    if dx == 0 and dy == 0:
+        dx = dy = 1.0
+    d = np.array([dx, dy])
+    return d / np.hypot(*d)
+
+
+def _ha(dx: float) -> str:
+    return "left" if dx > 1e-9 else ("right" if dx < -1e-9 else "center")
+
+
+def _va(dy: float) -> str:
+    return "bottom" if dy > 1e-9 else ("top" if dy < -1e-9 else "center")
+
+
+def _unit(d: np.ndarray) -> np.ndarray:
+    n = float(np.hypot(*d))
+    return d / n if n > 0 else np.array([0.0, 1.0])
+
+
+# -- section lines ----------------------------------------------------------------------------
+def default_sections(result: Result) -> list[tuple[str, tuple[float, float], tuple[float, float]]]:
+    """Section lines for a scene: the rows of supports (up to six), else lines through the load.
+
+    Rows: the distinct y of the supports when there are 2 to 6 of them with at least two
+    supports each (the source paper's sections 1–5 through a grid of supports). Otherwise the
+    horizontal and vertical lines through the largest point load (or the centre), the bottom
+    edge if supports stand on it, and the diagonal.
+    """
+    sc = result.scene
+    a, b = sc.plate.a, sc.plate.b
+    sup = _supports(result)
+    if sup.n:
+        ys, counts = np.unique(np.round(sup.xy[:, 1], 9), return_counts=True)
+        if 2 <= ys.size <= 6 and np.all(counts >= 2):
+            return [(f"y = {y:g}", (0.0, float(y)), (a, float(y))) for y in ys]
+    pl = _point_loads(sc)
+    xl, yl = ((max(pl, key=lambda ld: abs(ld.P)).x, max(pl, key=lambda ld: abs(ld.P)).y) if pl else (a / 2, b / 2))
+    out = [(f"y = {yl:g}", (0.0, yl), (a, yl)), (f"x = {xl:g}", (xl, 0.0), (xl, b))]
+    if sup.n and np.any(np.abs(sup.xy[:, 1]) <= 1e-9 * max(a, b)):
+        out.append(("y = 0 (edge)", (0.0, 0.0), (a, 0.0)))
+    out.append(("diagonal", (0.0, 0.0), (a, b)))
+    return out
+
+
+def _norm_sections(sections, result):
+    if sections is None:
+        return []
+    out = []
+    for sec in sections:
+        if len(sec) == 3:
+            lab, p0, p1 = sec
+        else:
+            p0, p1 = sec
+            lab = f"({p0[0]:g}, {p0[1]:g}) – ({p1[0]:g}, {p1[1]:g})"
+        out.append((str(lab), (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))))
+    return out

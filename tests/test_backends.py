@@ -1,0 +1,116 @@
+"""The backend registry and the one shape of a backend (plateqp.backends, plateqp.backends.base).
+
+Every registered backend is a :class:`~plateqp.backends.base.Backend` with declared capabilities,
+and every one turns an option it does not know into a ProblemError (exit code 2 on the command
+line), never a solver failure (exit 4) and never a silent success, except where the solver's own
+wrapper drops unknown keys without a word: those are declared below as data, and each must still
+do so (a declared failure that stops failing fails the test, so the list stays true).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import plateqp as pq
+from plateqp.backends import _DECLARED_HERE, get_backend, registry
+from plateqp.backends.base import LCP, QP, Backend, ModuleBackend, RawSolution, Status
+from plateqp.contact.formulations import FORMULATIONS
+from plateqp.errors import ProblemError
+
+#: Backends whose solver (or its wrapper) drops an unknown option silently, and why; each must
+#: still solve with one (strict), so an entry that starts complaining must be removed.
+SILENT_ABOUT_UNKNOWN_OPTIONS: dict[str, str] = {
+    "cvxpy:CVXOPT": "cvxpy copies every option into cvxopt.solvers.options, a plain dict CVXOPT reads known keys from",
+    "cvxpy:DAQP": "cvxpy passes DAQP only the option names it lists itself",
+    "cvxpy:PROXQP": "cvxpy passes ProxQP only eps_abs, eps_rel, max_iter, rho, mu_eq, mu_in, backend",
+    "qpsolvers:cvxopt": "qpsolvers passes the options as cvxopt.solvers.options, a plain dict",
+    "qpsolvers:highs": "qpsolvers ignores the status HiGHS's setOptionValue returns for an unknown name",
+}
+
+INSTALLED = [n for n, b in sorted(registry().items()) if b.available()]
+
+
+def problem_for(b: Backend):
+    """A small problem the backend takes: an LCP, or a QP with sparse P and G (the primal's shape)."""
+    if b.accepts == frozenset({"lcp"}):
+        return LCP(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-1.0, 2.0]))
+    return QP(P=sp.csc_matrix(np.diag([2.0, 1.0])), q=np.array([-2.0, -1.0]),
+              G=sp.csc_matrix(np.array([[1.0, 1.0], [-1.0, 0.0]])), h=np.array([1.0, 10.0]))
+
+
+def test_every_backend_has_the_one_shape():
+    for name, b in registry().items():
+        assert isinstance(b, Backend), name
+        assert b.name == name and b.accepts and b.accepts <= {"qp", "lcp"}
+        assert b.formulations is None or set(b.formulations) <= set(FORMULATIONS)
+        assert isinstance(b.exact, bool) and isinstance(b.warm_start, bool)
+        assert isinstance(b.available(), bool)
+        if b.available():
+            assert isinstance(b.version(), str)
+
+
+def test_declared_capabilities():
+    """Exact to rounding at every accuracy: the direct methods; warm start from an active set:
+    the two that take options["active"]."""
+    reg = registry()
+    assert {n for n, b in reg.items() if b.exact} == {"lemke", "bpp", "pdas"}
+    assert {n for n, b in reg.items() if b.warm_start} == {"bpp", "pdas"}
+    assert reg["pdas"].formulations == ("primal",)
+
+
+@pytest.mark.parametrize("name", INSTALLED)
+def test_unknown_option_is_a_problem_error(name):
+    b = get_backend(name)
+    if name in SILENT_ABOUT_UNKNOWN_OPTIONS:
+        sol = b.solve(problem_for(b), accuracy="default", options={"no_such_setting": 1})
+        assert sol.status is Status.OPTIMAL, "declared silent, but it no longer is: remove it from the list"
+        return
+    with pytest.raises(ProblemError, match="no_such_setting"):
+        b.solve(problem_for(b), accuracy="default", options={"no_such_setting": 1})
+
+
+@pytest.mark.parametrize("name", ["osqp", "clarabel", "lemke"])
+def test_unknown_option_is_exit_code_2(name, capsys):
+    """The command line: a bad option is bad input (2), not a solver failure (4)."""
+    if name not in INSTALLED:
+        pytest.skip(f"{name} not installed")
+    from plateqp import scenes
+    from plateqp.cli import main
+
+    code = main(["solve", str(scenes.path("heave")), "--backend", name, "--options", '{"no_such_setting": 1}'])
+    err = capsys.readouterr().err
+    assert code == 2 and "no_such_setting" in err and len(err.strip().splitlines()) == 1
+
+
+class _OldShape:
+    """A backend module of the earlier shape: module-level attributes, no capabilities."""
+
+    name, accepts, formulations = "old", frozenset({"qp"}), ("primal",)
+
+    @staticmethod
+    def available():
+        return True
+
+    @staticmethod
+    def version():
+        return "1"
+
+    @staticmethod
+    def solve(problem, accuracy="default", options=None):
+        return RawSolution(status=Status.OPTIMAL, extras={"accuracy": accuracy, "options": options})
+
+
+def test_module_backend_adapts_the_earlier_shape():
+    b = ModuleBackend(_OldShape, exact=True)
+    assert (b.name, b.accepts, b.formulations, b.exact, b.warm_start) == ("old", {"qp"}, ("primal",), True, False)
+    assert b.available() and b.version() == "1"
+    assert b.solve(None, "high", {"k": 1}).extras == {"accuracy": "high", "options": {"k": 1}}
+    assert _DECLARED_HERE == {"pdas": {"exact": True, "warm_start": True}}, \
+        "capabilities given at registration are for modules of the earlier shape only"
+
+
+def test_unknown_backend_names_the_installed_ones():
+    with pytest.raises(pq.SolverError, match="unknown backend 'nope'.*lemke"):
+        get_backend("nope")
