@@ -154,65 +154,72 @@ Layout
 :mod:`.reduced` (the QP read back as a contact problem, :class:`~.reduced.ReducedQP`; the
 exchange rule), :mod:`.dense` (``method="condensed"``), :mod:`.sparse` (``method="sparse"``),
 :mod:`.driver` (the :func:`pdas` function), :mod:`.options` (presets and settings); this file
-holds the Backend protocol.
+holds the backend, :class:`PDAS`.
 """
 
 from __future__ import annotations
 
-import sys
-
-from ...errors import ProblemError, SolverError
-from ..base import QP, RawSolution, plateqp_version
+from ...errors import SolverError
+from ..base import QP, Backend, RawSolution, check_options, plateqp_version
 from .driver import pdas
 from .options import ACCURACY, OPTIONS, SETTINGS
 
-__all__ = ["ACCURACY", "OPTIONS", "SETTINGS", "accepts", "available", "backends", "formulations", "name", "pdas",
-           "solve", "version"]
-
-# ----------------------------------------------------------------- the Backend protocol, all of it
-
-name = "pdas"
-accepts = frozenset({"qp"})
-#: The QP of the primal formulation only (see :func:`plateqp.contact.formulations_for`).
-formulations = ("primal",)
-version = plateqp_version  # the backend is part of plateqp
+__all__ = ["ACCURACY", "OPTIONS", "PDAS", "SETTINGS", "backends", "pdas", "solve"]
 
 
-def available() -> bool:
-    """PDAS needs NumPy and SciPy only (CHOLMOD makes it faster): always available."""
-    return True
+class PDAS(Backend):
+    """The pdas backend (the shape of :class:`~plateqp.backends.base.Backend`): the primal
+    formulation's QP only; a direct method (``exact``) that takes a first active set
+    (``warm_start``: option ``active``, and ``extras["active"]`` in the answer)."""
+
+    name = "pdas"
+    accepts = frozenset({"qp"})
+    #: The QP of the primal formulation only (see :func:`plateqp.contact.formulations_for`).
+    formulations = ("primal",)
+    exact = True
+    warm_start = True
+
+    def available(self) -> bool:
+        """PDAS needs NumPy and SciPy only (CHOLMOD makes it faster): always available."""
+        return True
+
+    def version(self) -> str | None:
+        return plateqp_version()  # the backend is part of plateqp
+
+    def solve(self, problem, accuracy="default", options: dict | None = None) -> RawSolution:
+        """Solve the primal formulation's :class:`~plateqp.backends.base.QP`.
+
+        Parameters
+        ----------
+        problem : QP
+            Sparse ``P``, ``G`` with ``m ≤ min(n, max_rows)`` rows, ``h``; nothing else.
+        accuracy : {"low", "default", "high"}, a float (a KKT tolerance; see base.preset) or an Accuracy
+            Preset of :data:`ACCURACY`.
+        options : dict, optional
+            Keys among :data:`OPTIONS` (see :func:`pdas`).
+
+        Raises
+        ------
+        SolverError
+            Not a QP of the primal formulation's shape (an LCP, equalities, bounds, dense or too
+            many rows).
+        ProblemError
+            Unknown accuracy or option.
+        """
+        if not isinstance(problem, QP):
+            raise SolverError(f"the pdas backend solves the primal formulation's QP only, got "
+                              f"{type(problem).__name__}; use formulation='primal'")
+        return pdas(problem, accuracy=accuracy, **check_options(self.name, options, OPTIONS))
 
 
-def backends() -> list:
-    """The backends this module provides: ``[module]`` (it satisfies the ``Backend`` protocol)."""
-    return [sys.modules[__name__]]
+_BACKEND = PDAS()
 
 
-def solve(problem, accuracy: str = "default", options: dict | None = None) -> RawSolution:
-    """Solve the primal formulation's :class:`~plateqp.backends.base.QP` (Backend protocol).
+def backends() -> list[Backend]:
+    """The backends this module provides: ``[PDAS()]``."""
+    return [_BACKEND]
 
-    Parameters
-    ----------
-    problem : QP
-        Sparse ``P``, ``G`` with ``m ≤ min(n, max_rows)`` rows, ``h``; nothing else.
-    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
-        Preset of :data:`ACCURACY`.
-    options : dict, optional
-        Keys among :data:`OPTIONS` (see :func:`pdas`).
 
-    Raises
-    ------
-    SolverError
-        Not a QP of the primal formulation's shape (an LCP, equalities, bounds, dense or too
-        many rows).
-    ProblemError
-        Unknown accuracy or option.
-    """
-    if not isinstance(problem, QP):
-        raise SolverError(f"the pdas backend solves the primal formulation's QP only, got "
-                          f"{type(problem).__name__}; use formulation='primal'")
-    options = dict(options or {})
-    unknown = sorted(set(options) - set(OPTIONS))
-    if unknown:
-        raise ProblemError(f"unknown option(s) {unknown} for backend pdas; known: {list(OPTIONS)}")
-    return pdas(problem, accuracy=accuracy, **options)
+def solve(problem, accuracy="default", options: dict | None = None) -> RawSolution:
+    """``PDAS().solve``: the module-level call kept for scripts that import the module."""
+    return _BACKEND.solve(problem, accuracy, options)

@@ -50,7 +50,7 @@ class DenseDual:
         try:
             self.fac = SchurFactor(pb.K, c, pivot_tol=PIVOT_TOL, method=libs[0])
         except SingularMatrixError as exn:
-            raise NotApplicable(f"K is singular ({exn}): a floating plate") from exn
+            raise NotApplicable(f"K is singular ({exn})") from exn
         t0 = time.perf_counter()
         M = self.fac.flexibility(B)
         M[np.diag_indices(pb.m)] += pb.rho

@@ -49,8 +49,8 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     -------
     RawSolution
         ``x``, ``z`` (reactions ``λ ≥ 0``), ``status`` (``OPTIMAL``; ``INACCURATE`` if the
-        residuals exceed ``accept_tol``; ``UNBOUNDED`` with ``extras["ray"]`` when the plate
-        cannot be held; ``MAX_ITER`` with the last iterate), ``iterations``, ``solve_time``,
+        residuals exceed ``accept_tol``; ``UNBOUNDED`` with ``extras["ray"]`` when the QP is
+        unbounded below; ``MAX_ITER`` with the last iterate), ``iterations``, ``solve_time``,
         ``extras["active"]``, ``extras["method"]`` and the counts of the linear algebra.
 
     Raises

@@ -60,6 +60,5 @@ ALPHA_MAX = 1e3
 #: singular to working precision (a floating plate): the sparse method takes over.
 PIVOT_TOL = 1e-13
 
-RAY_MESSAGE = ("the active rows cannot hold the plate and no inactive row is pressed along the rigid motion "
-                "d it falls along: K d = 0, G d ≤ 0, qᵀd < 0 (the QP is unbounded below; the one-sided "
-                "supports cannot carry the load)")
+RAY_MESSAGE = ("the active rows leave a null direction d of K that no inactive row is pressed along: "
+               "K d = 0, G d ≤ 0, qᵀd < 0 (the QP is unbounded below)")

@@ -64,7 +64,7 @@ class ReducedQP:
         Kd = self.K.diagonal()
         if np.any(Kd <= 0):
             raise SolverError("the pdas backend needs P with a positive diagonal on the coupled variables "
-                              "(a variable with no stiffness is a mechanism of the plate)")
+                              "(a coupled variable with no curvature makes the QP unbounded or degenerate)")
         empty = np.flatnonzero(np.diff(self.B.indptr) == 0)
         if empty.size:
             raise SolverError(f"row {empty[0]} of G acts on no coupled variable: not a contact row")

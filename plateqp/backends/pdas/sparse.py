@@ -337,8 +337,8 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
                 ray = np.zeros(pb.n)
                 ray[pb.keep] = d  # (d, 0): P (d, 0) = 0, G (d, 0) = B d ≤ 0, qᵀ(d, 0) = −fᵀd < 0
                 return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
-            return Outcome(Status.ERROR, "the active rows do not hold the plate, no row stops its rigid motion, "
-                            "yet the load does no work along it: cannot go on", A, it=newton + it)
+            return Outcome(Status.ERROR, "the active rows leave a null direction of K, no row bounds it, "
+                            "yet q does no work along it (qᵀd ≥ 0): cannot go on", A, it=newton + it)
         u, lam = step.u, step.lam
         gap = pb.g + pb.rho * lam - pb.B @ u
         bad = infeasible(pb, A, lam, gap, feas_tol)
