@@ -25,6 +25,18 @@ class MechanismError(PlateQPError):
     """The plate is a mechanism: its supports cannot prevent a rigid motion."""
 
 
+class SingularMatrixError(MechanismError):
+    """A matrix that must be positive definite (or a saddle-point system that must be
+    nonsingular) is singular to working precision: :mod:`plateqp.linalg`'s error, in matrix
+    words. A caller that knows what the matrix stands for adds that (a plate that is a
+    mechanism); it derives from :class:`MechanismError` so that such callers catch it as one.
+    ``column``: where the factorisation stopped, when known (in the order it factorised)."""
+
+    def __init__(self, message: str, column: int | None = None) -> None:
+        super().__init__(message)
+        self.column = column
+
+
 class ProblemError(PlateQPError, ValueError):
     """A QP or LCP is malformed, or a formulation cannot be built for a scene."""
 

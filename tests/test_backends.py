@@ -14,8 +14,8 @@ import pytest
 import scipy.sparse as sp
 
 import plateqp as pq
-from plateqp.backends import _DECLARED_HERE, get_backend, registry
-from plateqp.backends.base import LCP, QP, Backend, ModuleBackend, RawSolution, Status
+from plateqp.backends import get_backend, registry
+from plateqp.backends.base import LCP, QP, Backend, RawSolution, Status
 from plateqp.contact.formulations import FORMULATIONS
 from plateqp.errors import ProblemError
 
@@ -84,31 +84,18 @@ def test_unknown_option_is_exit_code_2(name, capsys):
     assert code == 2 and "no_such_setting" in err and len(err.strip().splitlines()) == 1
 
 
-class _OldShape:
-    """A backend module of the earlier shape: module-level attributes, no capabilities."""
+def test_a_module_giving_something_else_is_refused(monkeypatch):
+    """No adapter for the earlier module shape is left: a module whose backends() gives anything
+    but Backend instances is a TypeError at registration, not a backend without capabilities."""
+    import plateqp.backends as B
+    from plateqp.backends import pdas
 
-    name, accepts, formulations = "old", frozenset({"qp"}), ("primal",)
-
-    @staticmethod
-    def available():
-        return True
-
-    @staticmethod
-    def version():
-        return "1"
-
-    @staticmethod
-    def solve(problem, accuracy="default", options=None):
-        return RawSolution(status=Status.OPTIMAL, extras={"accuracy": accuracy, "options": options})
-
-
-def test_module_backend_adapts_the_earlier_shape():
-    b = ModuleBackend(_OldShape, exact=True)
-    assert (b.name, b.accepts, b.formulations, b.exact, b.warm_start) == ("old", {"qp"}, ("primal",), True, False)
-    assert b.available() and b.version() == "1"
-    assert b.solve(None, "high", {"k": 1}).extras == {"accuracy": "high", "options": {"k": 1}}
-    assert _DECLARED_HERE == {"pdas": {"exact": True, "warm_start": True}}, \
-        "capabilities given at registration are for modules of the earlier shape only"
+    monkeypatch.setattr(pdas, "backends", lambda: [pdas])
+    monkeypatch.setattr(B, "_registry", None)
+    with pytest.raises(TypeError, match="Backend instances"):
+        B.registry()
+    monkeypatch.undo()
+    assert isinstance(B.registry()["pdas"], Backend)
 
 
 def test_unknown_backend_names_the_installed_ones():

@@ -11,15 +11,10 @@ from __future__ import annotations
 import importlib
 
 from ..errors import SolverError
-from .base import (ACCURACIES, LCP, PRESET_TOL, QP, Backend, ModuleBackend, RawSolution, Status,
-                   accuracy_tol)
+from .base import ACCURACIES, LCP, PRESET_TOL, QP, Backend, RawSolution, Status, accuracy_tol
 
 # module name -> the backends it provides (a family such as qpsolvers provides many)
 _MODULES = ("lemke", "bpp", "pgs", "pdas", "osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
-
-#: Capabilities of backends still written in the earlier module shape (a module that is its own
-#: backend), given here until the module declares them itself: then delete its entry.
-_DECLARED_HERE: dict[str, dict] = {"pdas": {"exact": True, "warm_start": True}}
 
 _registry: dict[str, Backend] | None = None
 
@@ -36,7 +31,8 @@ def registry() -> dict[str, Backend]:
                 continue
             for b in mod.backends():
                 if not isinstance(b, Backend):
-                    b = ModuleBackend(b, **_DECLARED_HERE.get(b.name, {}))
+                    raise TypeError(f"plateqp.backends.{mod_name}.backends() must give Backend instances, "
+                                    f"got {type(b).__name__}")
                 reg[b.name] = b
         _registry = reg
     return _registry

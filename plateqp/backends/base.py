@@ -31,7 +31,7 @@ from ..errors import ProblemError, SolverError
 
 # the shared words, re-exported here for the backends' convenience (they live in plateqp.accuracy)
 __all__ = ["ACCURACIES", "PRESET_TOL", "TOL_RANGE", "Accuracy", "Status", "accuracy_tol", "nearest_preset",
-           "LCP", "QP", "Backend", "ModuleBackend", "RawSolution", "check_options", "rejected_option", "one_line",
+           "LCP", "QP", "Backend", "RawSolution", "check_options", "rejected_option", "one_line",
            "preset", "via_qp", "plateqp_version"]
 
 
@@ -214,28 +214,6 @@ class Backend:
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.name!r})"
-
-
-class ModuleBackend(Backend):
-    """A backend module of the earlier shape (module-level ``name``, ``accepts``,
-    ``available``, ``version``, ``solve``, optional ``formulations``) seen as a :class:`Backend`;
-    the capabilities it does not declare itself are given here, where it is registered."""
-
-    def __init__(self, module, **capabilities) -> None:
-        self.module = module
-        self.name, self.accepts = module.name, frozenset(module.accepts)
-        for key in ("formulations", "exact", "warm_start"):
-            value = capabilities.get(key, getattr(module, key, getattr(Backend, key)))
-            setattr(self, key, tuple(value) if key == "formulations" and value is not None else value)
-
-    def available(self) -> bool:
-        return self.module.available()
-
-    def version(self) -> str | None:
-        return self.module.version()
-
-    def solve(self, problem, accuracy="default", options=None) -> RawSolution:
-        return self.module.solve(problem, accuracy, options)
 
 
 def check_options(backend: str, options: dict | None, known) -> dict:

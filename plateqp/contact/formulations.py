@@ -16,8 +16,9 @@ The spring compression is s = √ρ t, so the spring energy ½ c s² = ½ t²: s
 the constraints are the reactions R; stationarity in t gives t = √ρ R.
 
 **Condensed** (the source paper's route): every dof other than the contact deflections
-w_c = B u is eliminated by static condensation (one sparse factorisation of the non-contact
-block, right-hand sides solved together in blocks). With the condensed stiffness S and load r,
+w_c = B u is eliminated by static condensation (one sparse factorisation with the contact
+deflections ordered last, whose trailing block is S: :class:`plateqp.linalg.SchurFactor`; no
+column solves). With the condensed stiffness S and load r,
 the gaps z = g0 + ρR − w_c and the reactions satisfy the LCP
 
 .. math::
@@ -36,7 +37,9 @@ with the flexibility G = B K⁻¹ Bᵀ and F = G + diag(ρ),
 
     \min_{R \ge 0}\ \tfrac12 R^T F R + d^T R,\qquad d = g_0 - B K^{-1} f,
 
-whose KKT conditions are the LCP gap = F R + d ≥ 0, R ≥ 0, Rᵀgap = 0.
+whose KKT conditions are the LCP gap = F R + d ≥ 0, R ≥ 0, Rᵀgap = 0. G comes from one
+factorisation of K with the contact dofs last, like S, by refined solves (its trailing block
+alone would give G to cond·ε only: :meth:`plateqp.linalg.SchurFactor.flexibility`).
 """
 
 from __future__ import annotations
@@ -47,12 +50,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..backends.base import LCP, QP, RawSolution
-from ..errors import MechanismError, ProblemError
-from ..linalg import Factor
+from ..errors import MechanismError, ProblemError, SingularMatrixError
+from ..linalg import SchurFactor
 from .scaling import Scaled
 
 FORMULATIONS = ("primal", "condensed", "dual")
-_BLOCK = 256  # right-hand sides solved together
 
 
 @dataclass
@@ -114,7 +116,7 @@ class Condensed(Formulation):
         m = data.m
         ft = T.T @ data.f
         fo = ft[m:]
-        y0 = fac.solve(fo)
+        y0 = fac.solve_others(fo)
         r = ft[:m] - Koc.T @ y0
         rho = data.rho
         # M = (I + Sρ)⁻¹S has rows of very different sizes when soft and rigid supports mix
@@ -145,7 +147,7 @@ class Condensed(Formulation):
         noise = 4 * d.m * np.finfo(float).eps * (np.abs(M) @ np.abs(z) + np.abs(q))
         R[np.abs(R) <= noise] = 0.0
         w_c = d.g0 + d.rho * R - z
-        u_o = self._fac.solve(self._fo - self._Koc @ w_c)
+        u_o = self._fac.solve_others(self._fo - self._Koc @ w_c)
         u = self._T @ np.concatenate([w_c, u_o])
         return ContactSolution(u, R, d.rho * R)
 
@@ -158,7 +160,7 @@ class Dual(Formulation):
                                "supports leave rigid motions free; use the primal or condensed formulation")
         fac, G = _cached(data, "dual", lambda: _flexibility(data))
         B = data.B.tocsr()
-        u0 = fac.solve(data.f)
+        u0 = fac.solve(data.f, refine=3)
         F = G + np.diag(data.rho)
         dvec = data.g0 - B @ u0
         self.lcp = LCP(F, dvec)
@@ -168,7 +170,7 @@ class Dual(Formulation):
     def recover(self, raw: RawSolution) -> ContactSolution:
         d = self.data
         R = raw.x
-        u = self._u0 - self._fac.solve(d.B.T @ R)
+        u = self._u0 - self._fac.solve(d.B.T @ R, refine=3)
         return ContactSolution(u, R, d.rho * R)
 
 
@@ -192,7 +194,8 @@ def _cached(data: Scaled, kind: str, build):
 
 
 def _condense(data: Scaled):
-    """Static condensation onto the contact deflections: (T, factor of K_oo, K_oc, S)."""
+    """Static condensation onto the contact deflections: (T, the factor of K̃ = Tᵀ K T with the
+    contact deflections last (it solves with K̃_oo), K̃_oc, S)."""
     B = data.B.tocsr()
     m, n = B.shape
     master = _masters(B)
@@ -223,35 +226,31 @@ def _condense(data: Scaled):
     P = sp.csr_matrix((np.ones(n), (np.concatenate([master, others]), np.arange(n))), shape=(n, n))
     T = (P @ sp.vstack([Tm, To])).tocsr()
     Kt = (T.T @ data.K @ T).tocsr()
-    Kcc = Kt[:m][:, :m].toarray()
     Koc = Kt[m:][:, :m].tocsc()
-    Koo = Kt[m:][:, m:]
+    # one factorisation of K̃ with the contact deflections last: its trailing block is S. A
+    # floating plate's K̃ is singular, its K̃_oo (every contact point held) is not: the trailing
+    # block is then factorised with a unit shift (K̃ equilibrated), which schur() takes off again
     try:
-        fac = Factor(Koo)
-    except MechanismError as exn:
+        fac = SchurFactor(Kt, np.arange(m), shift=1.0 if data.floating else 0.0)
+    except SingularMatrixError as exn:
         raise MechanismError("with every contact point held, the plate can still move: the "
                              "supports do not prevent rigid motion (fewer than three non-collinear "
                              "contact points and no two-sided supports); use the primal formulation, "
                              "which reports this as no equilibrium") from exn
-    S = Kcc.copy()
-    for j0 in range(0, m, _BLOCK):
-        cols = slice(j0, min(m, j0 + _BLOCK))
-        Y = fac.solve(Koc[:, cols].toarray())
-        S[:, cols] -= Koc.T @ Y
-    return T, fac, Koc, 0.5 * (S + S.T)
+    return T, fac, Koc, fac.schur()
 
 
 def _flexibility(data: Scaled):
-    """The factor of K and the flexibility G = B K⁻¹ Bᵀ (right-hand sides in blocks)."""
-    fac = Factor(data.K)
+    """The factor of K (the contact dofs last) and the flexibility G = B K⁻¹ Bᵀ."""
     B = data.B.tocsr()
-    m = B.shape[0]
-    BT = B.T.tocsc()
-    G = np.empty((m, m))
-    for j0 in range(0, m, _BLOCK):
-        cols = slice(j0, min(m, j0 + _BLOCK))
-        G[:, cols] = B @ fac.solve(BT[:, cols].toarray())
-    return fac, 0.5 * (G + G.T)
+    try:
+        fac = SchurFactor(data.K, np.unique(B.indices))
+    except SingularMatrixError as exn:
+        raise MechanismError(f"the plate's stiffness matrix is singular ({exn}): its two-sided supports "
+                             "do not hold it; use the primal or condensed formulation") from exn
+    # refined columns, not the trailing block alone: G is the dual's final data, and inverting S
+    # costs it cond(S)·ε (a random scene's KKT check failed at 1e-10 so; see SchurFactor)
+    return fac, fac.flexibility(B, refine=3)
 
 #: Condition number (1-norm, rows equilibrated) of the contact rows on their master dofs above
 #: which the condensed form refuses: its matrix grows like cond², so 1e5 leaves ~1e-6 of the

@@ -15,10 +15,12 @@ natural            max |min(R_i, k_i gap_i)| / ρ_R
 
 The last is the natural residual of the complementarity conditions in force units: a gap
 error counts as the force it would take to close it, with k_i the local stiffness at support
-i (Σ_j B_ij² K_jj, an upper bound of the condensed stiffness, in series with the support's
-own spring). Gap-unit residuals alone cannot see reaction errors where supports are close
-together: measured on a 64² plate on a 30×30 support grid, Clarabel ended with gap-unit
-residuals of 3e-12 and reactions 1e-7 off; the natural residual sees that.
+i (:func:`local_stiffness`: the Rayleigh bound b K bᵀ / (b bᵀ)² of
+:func:`plateqp.linalg.row_stiffness`, an upper bound of the condensed stiffness, capped by the
+distance to the nearest held point, in series with the support's own spring). Gap-unit
+residuals alone cannot see reaction errors where supports are close together: measured on a
+64² plate on a 30×30 support grid, Clarabel ended with gap-unit residuals of 3e-12 and
+reactions 1e-7 off; the natural residual sees that.
 
 with the deflection scale δ = max(‖B u‖∞, ‖g0‖∞, max |w| of the plate) and the force scale
 ρ_R = max(‖R‖∞, 10⁻¹² ‖f‖₁).
@@ -45,7 +47,7 @@ import numpy as np
 
 from ..accuracy import PRESET_TOL, Accuracy
 from ..errors import MechanismError
-from ..linalg import solve_saddle
+from ..linalg import row_stiffness, solve_saddle
 from ..results import KKTReport
 from .formulations import ContactSolution
 from .scaling import Scaled
@@ -116,7 +118,7 @@ def close_pairs_error(data: Scaled, R, gap, rscale: float, delta: float, tol: fl
     B = data.B.tocsr()
     G = (B @ B.T).tocoo()
     nrm = np.sqrt(np.maximum(G.diagonal(), 1e-300))
-    kb = np.maximum(B.multiply(B) @ data.K.diagonal(), 1e-300)
+    kb = np.maximum(row_stiffness(data.K, B, "diagonal"), 1e-300)
     on = (R > tol * rscale) | (np.abs(gap) <= tol * delta)
     i, j = G.row, G.col
     cos = G.data / (nrm[i] * nrm[j])
@@ -149,14 +151,11 @@ def local_stiffness(data: Scaled) -> np.ndarray:
     conservative by a factor that grew with the mesh: measured on a floating slab on 5×5 posts
     at 64², Clarabel's reactions were 7e-7 off and the residual said 5e-4; with the bound by
     the distance to the nearest held point it says 5e-6 (benchmarks/README.md, Limitations)."""
-    B = data.B.tocsr()
-    bb = np.asarray(B.multiply(B).sum(axis=1)).ravel()
-    bKb = np.asarray((B @ data.K).multiply(B).sum(axis=1)).ravel()
     # Rayleigh: for u = b/(b·b), b·u = 1 and uᵀKu = bKbᵀ/(b·b)² bounds the condensed stiffness
     # 1/(b K⁻¹ bᵀ) from above, whatever K is. Σ b_j² K_jj is no bound where most of a support's
     # interpolation weight sits on prescribed dofs (a support beside a clamped edge: it said 11.9
     # where the plate's stiffness is about 8e4, and wrong reactions passed; issue 10).
-    kb = bKb / np.maximum(bb, 1e-300) ** 2
+    kb = row_stiffness(data.K, data.B, "rayleigh")
     if data.spacing is not None:
         kb = np.minimum(kb, CIRCLE / np.maximum(data.spacing, 1e-300) ** 2)
     return kb / (1.0 + data.rho * kb)

@@ -15,6 +15,7 @@ import scipy.sparse as sp
 
 from ..assembly import Model
 from ..errors import ProblemError
+from ..linalg import row_stiffness
 
 # A plate's deflection is about 0.004–0.012 × F L²/D (Timoshenko's coefficients for square
 # plates); scaling by F L²/D alone left deflections ~1e-3 and solvers' absolute tolerances
@@ -167,9 +168,8 @@ def check_distinct_contacts(data: Scaled, model: Model) -> None:
     if not len(pairs):
         return
     B = data.B.tocsr()
-    B2 = B.multiply(B).tocsr()
-    kb = np.maximum(B2 @ data.K.diagonal(), 1e-300)  # local stiffness, as in kkt.local_stiffness
-    nb = np.maximum(np.asarray(B2.sum(axis=1)).ravel(), 1e-300)
+    kb = np.maximum(row_stiffness(data.K, B, "diagonal"), 1e-300)  # Σ B² diag K, as in kkt.close_pairs_error
+    nb = np.maximum(np.asarray(B.multiply(B).sum(axis=1)).ravel(), 1e-300)
     for i, j in pairs:
         e = B[i] - B[j]
         rel = float(e.multiply(e).sum()) / max(nb[i], nb[j])

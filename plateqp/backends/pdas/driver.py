@@ -1,0 +1,136 @@
+"""The pdas function: options read, the method chosen (dense where it applies, else sparse),
+the answer checked and returned as a RawSolution (see the package docstring: "Warm start and
+output", "Accuracy")."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ...errors import ProblemError, SolverError
+from ..base import QP, RawSolution, Status, preset
+from .dense import DenseDual, NotApplicable, run_dense
+from .options import ACCURACY, OPTIONS, SETTINGS
+from .reduced import ReducedQP, force_scale, natural_residuals
+from .sparse import SpringFactor, run_sparse
+
+__all__ = ["pdas"]
+
+
+def _option(settings: dict, key: str, ok, what: str):
+    val = settings[key]
+    if not ok(val):
+        raise ProblemError(f"option {key} must be {what}, got {val!r}")
+    return val
+
+
+def _is_int(v, lo):
+    return not isinstance(v, bool) and isinstance(v, (int, np.integer)) and v >= lo
+
+
+def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> RawSolution:
+    """Solve the primal contact QP by the primal–dual active set method.
+
+    Parameters
+    ----------
+    qp : QP
+        ``min ½ xᵀPx + qᵀx  s.t.  G x ≤ h`` with sparse ``P``, ``G`` (few rows), nothing else.
+    active : array_like of bool, optional
+        First active set, one entry per row of ``G`` (defaults: see the module docstring).
+    trace : bool
+        Record each step in ``extras["trace"]``: ``{"step", "active", "infeasible", "solve", "exchange"}``.
+    accuracy : {"low", "default", "high"} or float (a KKT tolerance; see base.preset)
+        Preset of :data:`ACCURACY`; ``feas_tol`` and ``accept_tol`` override it.
+    **options
+        ``feas_tol``, ``accept_tol`` and the keys of :data:`SETTINGS`.
+
+    Returns
+    -------
+    RawSolution
+        ``x``, ``z`` (reactions ``λ ≥ 0``), ``status`` (``OPTIMAL``; ``INACCURATE`` if the
+        residuals exceed ``accept_tol``; ``UNBOUNDED`` with ``extras["ray"]`` when the QP is
+        unbounded below; ``MAX_ITER`` with the last iterate), ``iterations``, ``solve_time``,
+        ``extras["active"]``, ``extras["method"]`` and the counts of the linear algebra.
+
+    Raises
+    ------
+    SolverError
+        The QP is not of the primal formulation's shape; ``method="condensed"`` where it
+        does not apply.
+    ProblemError
+        A bad option value.
+    """
+    t0 = time.perf_counter()
+    tol = preset(ACCURACY, accuracy, scale=("feas_tol", "accept_tol"))
+    settings = dict(SETTINGS)
+    for key, val in options.items():
+        if key in tol:
+            tol[key] = val
+        elif key in settings:
+            settings[key] = val
+        else:
+            raise ProblemError(f"unknown option {key!r} for backend pdas; known: {list(OPTIONS)}")
+    for key in ("feas_tol", "accept_tol"):
+        if not (np.isscalar(tol[key]) and np.isfinite(tol[key]) and 0 <= tol[key] < 1):
+            raise ProblemError(f"option {key} must be a number in [0, 1), got {tol[key]!r}")
+    number = (lambda lo: lambda v: np.isscalar(v) and not isinstance(v, (bool, str)) and np.isfinite(v) and v > lo)
+    method = _option(settings, "method", lambda v: v in ("auto", "condensed", "sparse"),
+                     "'auto', 'condensed' or 'sparse'")
+    kappa = _option(settings, "penalty", number(1.0), "a number > 1")
+    sigma = _option(settings, "prox", number(0.0), "a number > 0")
+    p = _option(settings, "p", lambda v: _is_int(v, 0), "an integer ≥ 0")
+    max_dense = _option(settings, "max_dense", lambda v: _is_int(v, 0), "an integer ≥ 0")
+    max_rows = _option(settings, "max_rows", lambda v: _is_int(v, 1), "a positive integer")
+    if not isinstance(trace, (bool, np.bool_)):
+        raise ProblemError(f"option trace must be True or False, got {trace!r}")
+
+    pb = ReducedQP(qp, max_rows)
+    m = pb.m
+    max_iter = settings["max_iter"] if settings["max_iter"] is not None else 50 + 2 * m
+    if not _is_int(max_iter, 1):
+        raise ProblemError(f"option max_iter must be a positive integer, got {max_iter!r}")
+    A = None
+    if active is not None:
+        A = np.asarray(active)
+        if A.shape != (m,) or A.dtype != bool:
+            raise ProblemError(f"option active must be a bool array with one entry per row of G ({m})")
+    steps: list[dict] | None = [] if trace else None
+
+    out = None
+    extras: dict = {}
+    if method in ("auto", "condensed"):
+        try:
+            cond = DenseDual(pb, max_dense)
+        except NotApplicable as why:
+            if method == "condensed":
+                raise SolverError(f"pdas: the condensed method does not apply here: {why}") from None
+            extras["condensed_skipped"] = str(why)
+        else:
+            out = run_dense(pb, cond, A, tol["feas_tol"], max_iter, p, steps)
+            extras.update(method="condensed", **cond.stats)
+    if out is None:
+        W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k))
+        fac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
+        out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps)
+        extras.update(method="sparse", factor=fac.method, **fac.stats)
+
+    extras["active"] = out.A.copy()
+    if steps is not None:
+        extras["trace"] = steps
+    if out.u is None:  # UNBOUNDED or ERROR: no answer
+        if out.ray is not None:
+            extras["ray"] = out.ray
+        return RawSolution(status=out.status, iterations=out.it, solve_time=time.perf_counter() - t0,
+                           solver_status=out.message, extras=extras)
+    lam = out.lam.copy()
+    lam[(lam < 0) & (lam >= -tol["feas_tol"] * force_scale(pb, lam))] = 0.0
+    nat, st = natural_residuals(pb, out.u, lam)
+    extras.update(natural_residual=nat, stationarity=st)
+    status = out.status
+    if status is Status.OPTIMAL and max(nat, st) > tol["accept_tol"]:
+        status = Status.INACCURATE
+    x = pb.x(out.u, lam)
+    obj = float(0.5 * x @ (pb.P @ x) + pb.q @ x)
+    return RawSolution(status=status, x=x, z=lam, obj=obj, iterations=out.it,
+                       solve_time=time.perf_counter() - t0, solver_status=out.message, extras=extras)

@@ -1,0 +1,64 @@
+"""The settings of the pdas backend: accuracy presets, method options and tuning constants."""
+
+from __future__ import annotations
+
+#: Tolerances of each accuracy preset (a direct method: exact up to rounding at every preset).
+#:
+#: ``feas_tol``
+#:     a reaction ``λ_i`` (a gap, as the force ``c_i gap_i``) counts as negative only below
+#:     ``−feas_tol`` times the force scale ``max(‖λ‖∞, 10⁻¹² ‖f‖₁)``; smaller negatives are
+#:     rounding (and such reactions are clipped to zero in the answer).
+#: ``accept_tol``
+#:     relative natural and stationarity residuals of the answer above which the status is
+#:     ``INACCURATE`` instead of ``OPTIMAL``.
+ACCURACY: dict[str, dict[str, float]] = {
+    "low": {"feas_tol": 1e-8, "accept_tol": 1e-6},
+    "default": {"feas_tol": 1e-11, "accept_tol": 1e-8},
+    "high": {"feas_tol": 1e-13, "accept_tol": 1e-10},
+}
+
+#: Method settings (not accuracy: the answer is exact at every value); options override them.
+#:
+#: ``method``     "auto" (condensed where it applies, else sparse), "condensed", "sparse".
+#: ``max_dense``  the condensed method only if the rows touch at most this many dofs.
+#: ``penalty``    κ (sparse): a rigid row's spring in ``H_A`` is κ times its local stiffness.
+#: ``prox``       σ (sparse): ``H_A`` includes σ diag(K) (definite for a floating plate).
+#: ``factor``     (sparse) "cholmod" (scikit-sparse: analysis re-used, rank-k updates),
+#:                "cvxopt" (CHOLMOD in cvxopt's wheels: analysis re-used, a numeric
+#:                refactorisation at every change), "linalg" (:class:`plateqp.linalg.Factor`'s
+#:                own choice, a new factorisation at every change), "superlu" (Factor's SuperLU,
+#:                likewise); "auto": the first of these that is installed.
+#: ``p``          block exchanges allowed without progress before Murty's single exchange.
+#: ``max_rows``   refuse a ``G`` with more rows than ``min(n, max_rows)``.
+#: ``max_iter``   active sets solved before ``Status.MAX_ITER``; default 50 + 2 m.
+SETTINGS: dict = {"method": "auto", "max_dense": 2000, "penalty": 1e8, "prox": 1e-12, "factor": "auto",
+                  "p": 3, "max_rows": 100_000, "max_iter": None}
+
+#: Keys accepted in the ``options`` dict of :func:`solve`.
+OPTIONS = ("active", "trace") + tuple(SETTINGS) + tuple(ACCURACY["default"])
+
+#: (sparse) A first correction with Rayleigh quotient δuᵀ(H − σD)δu / (σ δuᵀDδu) below this is
+#: a rigid motion the active rows do not hold.
+SINGULAR_QUOTIENT = 1.0
+#: Refinement: at most this many solves per active set while it changes, and for the final set.
+INNER_LOOSE, INNER_EXACT = 2, 12
+#: (sparse) While the active set changes, refinement stops at this relative residual.
+LOOSE_TOL = 1e-7
+#: (sparse) Rebuild the factor rather than downdate when the digits lost to downdates
+#: (Σ ε·ΔW_i/c_i) would pass this: a soft spring's downdate loses ~ε, a rigid row's penalty
+#: ~ε·κ = 2e-8, which would hide the σ-sized modes of a plate the active rows do not hold.
+DOWNDATE_LOSS = 1e-10
+#: (sparse, soft rows) Phase 1: at most this many Newton steps, PCG to this relative tolerance
+#: (at most PCG_MAX iterations each); it ends when a step changes at most
+#: max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION · m) rows, or when its solves have cost
+#: NEWTON_BUDGET factorisations.
+NEWTON_STEPS, PCG_TOL, PCG_MAX = 8, 5e-2, 30
+NEWTON_SETTLED, NEWTON_SETTLED_FRACTION, NEWTON_BUDGET = 10, 2e-3, 3.0
+#: The line search looks for the minimum up to this step length.
+ALPHA_MAX = 1e3
+#: (condensed) A trailing pivot L_ii² below this (K equilibrated to a unit diagonal) means K is
+#: singular to working precision (a floating plate): the sparse method takes over.
+PIVOT_TOL = 1e-13
+
+RAY_MESSAGE = ("the active rows leave a null direction d of K that no inactive row is pressed along: "
+               "K d = 0, G d ≤ 0, qᵀd < 0 (the QP is unbounded below)")

@@ -1,0 +1,133 @@
+"""The QP read back as a contact problem, and what both methods share: the exchange rule,
+the infeasible rows, the residuals of an answer (see the package docstring: "The problem",
+"The method")."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ...errors import SolverError
+from ...linalg import row_stiffness
+from ..base import QP
+
+__all__ = ["Exchange", "Outcome", "ReducedQP", "force_scale", "infeasible", "natural_residuals"]
+
+
+class ReducedQP:
+    """The QP read back as a contact problem ``(K, f, B, ρ, g)``: separable variables eliminated
+    (see the package docstring, "The problem")."""
+
+    def __init__(self, qp: QP, max_rows: int) -> None:
+        if not isinstance(qp, QP):
+            raise SolverError(f"the pdas backend solves QPs only (the primal formulation), got {type(qp).__name__}")
+        if qp.A is not None or qp.lb is not None or qp.ub is not None:
+            raise SolverError("the pdas backend takes a QP with inequalities G x ≤ h only, no equality rows "
+                              "and no bounds: use formulation='primal' (the condensed and dual formulations "
+                              "are bound-constrained; give them to lemke or bpp)")
+        if qp.G is None or qp.G.shape[0] == 0:
+            raise SolverError("the pdas backend needs inequality rows G x ≤ h; this QP has none")
+        if not (sp.issparse(qp.P) and sp.issparse(qp.G)):
+            raise SolverError("the pdas backend takes sparse P and G (the primal formulation); for a dense "
+                              "problem use the condensed formulation with lemke or bpp")
+        m, n = qp.G.shape
+        if m > min(n, max_rows):
+            raise SolverError(f"the pdas backend takes few constraint rows (m ≤ min(n, {max_rows})), "
+                              f"got m = {m}, n = {n}")
+        P = sp.csc_matrix(qp.P, dtype=float)
+        P.eliminate_zeros()
+        G = sp.csc_matrix(qp.G, dtype=float)
+        G.eliminate_zeros()
+        v, w = np.random.default_rng(0).standard_normal((2, n))
+        if abs(v @ (P @ w) - w @ (P @ v)) > 1e-10 * np.sqrt((P @ v) @ (P @ v) * (w @ w)) + 1e-300:
+            raise SolverError("the pdas backend needs a symmetric P")  # a randomised check, O(nnz)
+        d = P.diagonal()
+        sep = (np.diff(P.indptr) == 1) & (d > 0) & (np.diff(G.indptr) == 1)
+        # a row left with no coupled variable keeps its separable ones (as plain variables)
+        coupled = np.bincount(G.indices, weights=~sep[np.repeat(np.arange(n), np.diff(G.indptr))], minlength=m)
+        lone = coupled[G.indices] == 0
+        sep[np.repeat(np.arange(n), np.diff(G.indptr))[lone]] = False
+        keep = ~sep
+        self.n, self.m = n, m
+        self.sep, self.keep = np.flatnonzero(sep), np.flatnonzero(keep)
+        Gs = G[:, self.sep].tocoo()  # one entry per column
+        self.sep_row = np.empty(self.sep.size, dtype=int)
+        self.sep_gamma = np.empty(self.sep.size)
+        self.sep_row[Gs.col], self.sep_gamma[Gs.col] = Gs.row, Gs.data
+        self.sep_p = d[self.sep]
+        self.sep_q = qp.q[self.sep]
+        self.K = P[self.keep][:, self.keep].tocsc() if self.sep.size else P
+        self.f = -qp.q[self.keep]
+        self.B = (G[:, self.keep] if self.sep.size else G).tocsr()
+        self.rho = np.bincount(self.sep_row, weights=self.sep_gamma**2 / self.sep_p, minlength=m)
+        self.g = qp.h + np.bincount(self.sep_row, weights=self.sep_gamma * self.sep_q / self.sep_p, minlength=m)
+        Kd = self.K.diagonal()
+        if np.any(Kd <= 0):
+            raise SolverError("the pdas backend needs P with a positive diagonal on the coupled variables "
+                              "(a coupled variable with no curvature makes the QP unbounded or degenerate)")
+        empty = np.flatnonzero(np.diff(self.B.indptr) == 0)
+        if empty.size:
+            raise SolverError(f"row {empty[0]} of G acts on no coupled variable: not a contact row")
+        self.Kd = Kd
+        self.k = row_stiffness(self.K, self.B, "diagonal")  # local stiffness of each row: Σ_j B_ij² K_jj
+        self.c = self.k / (1.0 + self.rho * self.k)  # in series with the row's spring
+        self.P, self.q = P, qp.q
+
+    def x(self, u: np.ndarray, lam: np.ndarray) -> np.ndarray:
+        x = np.empty(self.n)
+        x[self.keep] = u
+        x[self.sep] = -(self.sep_q + self.sep_gamma * lam[self.sep_row]) / self.sep_p
+        return x
+
+
+
+class Exchange:
+    """Block exchange with Júdice–Pires' safeguard: Murty's single exchange when stuck or cycling."""
+
+    def __init__(self, p: int) -> None:
+        self.p, self.best, self.backups, self.seen = p, np.inf, p, set()
+
+    def next(self, A: np.ndarray, bad: np.ndarray) -> tuple[np.ndarray, str]:
+        count = int(bad.sum())
+        key = A.tobytes()
+        cycle = key in self.seen
+        self.seen.add(key)
+        if count < self.best:
+            self.best, self.backups = count, self.p
+            mode = "block"
+        elif self.backups > 0 and not cycle:
+            self.backups -= 1
+            mode = "block"
+        else:
+            mode = "single"
+        A = A.copy()
+        if mode == "block":
+            A ^= bad
+        else:
+            i = np.flatnonzero(bad)[-1]  # Murty: the infeasible row of largest index
+            A[i] = not A[i]
+        return A, mode
+
+
+def force_scale(pb: ReducedQP, lam: np.ndarray) -> float:
+    return max(np.abs(lam).max(initial=0.0), 1e-12 * np.abs(pb.f).sum(), np.finfo(float).tiny)
+
+
+def infeasible(pb: ReducedQP, A: np.ndarray, lam: np.ndarray, gap: np.ndarray, feas_tol: float) -> np.ndarray:
+    """Rows to exchange: active with a negative reaction, inactive with a negative gap."""
+    F = feas_tol * force_scale(pb, lam)
+    return (A & (lam < -F)) | (~A & (pb.c * gap < -F))
+
+
+class Outcome:
+    def __init__(self, status, message, A, u=None, lam=None, it=0, ray=None):
+        self.status, self.message, self.A, self.u, self.lam, self.it, self.ray = status, message, A, u, lam, it, ray
+
+
+def natural_residuals(pb: ReducedQP, u: np.ndarray, lam: np.ndarray) -> tuple[float, float]:
+    """Relative natural residual and relative stationarity residual of ``(u, λ)``."""
+    gap = pb.g + pb.rho * lam - pb.B @ u
+    nat = float(np.abs(np.minimum(lam, pb.c * gap)).max(initial=0.0) / force_scale(pb, lam))
+    BtL = pb.B.T @ lam
+    st = float(np.linalg.norm(pb.K @ u - pb.f + BtL) / max(np.linalg.norm(pb.f), np.linalg.norm(BtL), 1e-300))
+    return nat, st

@@ -1,0 +1,357 @@
+r"""The sparse method: a factor of ``K + σ diag(K) + B_Aᵀ W_A B_A`` kept current as the active
+set changes, exact steps by refinement, and (soft rows) a Newton–PCG first phase (see the
+package docstring: "Two ways to solve a step", "Singular steps and no equilibrium")."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from ...errors import ProblemError, SingularMatrixError, SolverError
+from ...linalg import Cholesky, Factor, bindings
+from ..base import Status
+from .options import (
+    ALPHA_MAX,
+    DOWNDATE_LOSS,
+    INNER_EXACT,
+    INNER_LOOSE,
+    LOOSE_TOL,
+    NEWTON_BUDGET,
+    NEWTON_SETTLED,
+    NEWTON_SETTLED_FRACTION,
+    NEWTON_STEPS,
+    PCG_MAX,
+    PCG_TOL,
+    RAY_MESSAGE,
+    SINGULAR_QUOTIENT,
+)
+from .reduced import Exchange, Outcome, ReducedQP, infeasible
+
+__all__ = ["SpringFactor", "run_sparse"]
+
+
+class SpringFactor:
+    """Factor of ``H(w) = K + σ diag(K) + Bᵀ diag(w) B``, kept current as ``w`` changes.
+
+    CHOLMOD: one symbolic analysis of the pattern of ``K + BᵀB`` (equilibrated by
+    ``diag(K)^(-1/2)``); changes by numeric refactorisation with that analysis or, with
+    scikit-sparse, by rank-k update/downdate, whichever the measured costs say is cheaper.
+    Otherwise :class:`plateqp.linalg.Factor` on every change.
+    """
+
+    def __init__(self, K: sp.csc_matrix, B: sp.csr_matrix, Kd: np.ndarray, c: np.ndarray,
+                 sigma: float, method: str) -> None:
+        libs = bindings()
+        if method == "auto":
+            method = ("cholmod" if "sksparse" in libs else "cvxopt" if "cvxopt" in libs else "linalg")
+        if method not in ("cholmod", "cvxopt", "linalg", "superlu"):
+            raise ProblemError("option factor must be 'auto', 'cholmod', 'cvxopt', 'linalg' or 'superlu', "
+                               f"got {method!r}")
+        lib = {"cholmod": "sksparse", "cvxopt": "cvxopt"}.get(method)
+        if lib is not None and lib not in libs:
+            raise SolverError(f"option factor={method!r}: that CHOLMOD binding is not in use here "
+                              f"(plateqp.linalg found: {libs or 'none'})")
+        self.method = method
+        self.chol = Cholesky(lib) if lib else None
+        n, m = K.shape[0], B.shape[0]
+        self.B, self.c = B, c
+        self.s = 1.0 / np.sqrt(Kd)
+        Babs = abs(B)
+        pat = sp.csc_matrix(abs(K) + Babs.T @ Babs)
+        pat.sort_indices()
+        self.indptr, self.indices = pat.indptr, pat.indices
+        cols = np.repeat(np.arange(n), np.diff(pat.indptr))
+        keys = cols.astype(np.int64) * n + pat.indices
+        nnz = keys.size
+
+        def pos(r, cc):
+            return np.searchsorted(keys, np.asarray(cc, np.int64) * n + r)
+
+        Ks = sp.csc_matrix(K)
+        Ks.sort_indices()
+        if Ks.nnz == nnz:  # B's pattern lies in K's (rows within one element): same structure
+            self.base = Ks.data.astype(float, copy=True)
+        else:
+            Kc = Ks.tocoo()
+            self.base = np.bincount(pos(Kc.row, Kc.col), weights=Kc.data, minlength=nnz)
+        self.base[pos(np.arange(n), np.arange(n))] += sigma * Kd
+        # all products B_ia B_ib of each row, and where they go in the pattern
+        L = np.diff(B.indptr)
+        L2 = L * L
+        pr = np.repeat(np.arange(m), L2)
+        within = np.arange(L2.sum()) - np.repeat(np.cumsum(L2) - L2, L2)
+        ia = B.indptr[pr] + within // L[pr]
+        ib = B.indptr[pr] + within % L[pr]
+        self.pair_row, self.pair_val = pr, B.data[ia] * B.data[ib]
+        self.pair_pos = pos(B.indices[ia], B.indices[ib])
+        self.scale = self.s[pat.indices] * self.s[cols]
+        self.nnz = nnz
+        # CHOLMOD reads the lower triangle only: hand it that (half the data)
+        self.low = np.flatnonzero(pat.indices >= cols)
+        self.low_indptr = np.concatenate([[0], np.cumsum(np.bincount(cols[self.low], minlength=n))])
+        self.w = None
+        self.fac = None  # a plateqp.linalg.Factor (linalg, superlu)
+        self.loss = 0.0
+        self.t_factor = None  # seconds per numeric factorisation (last measured)
+        self.t_row = None  # seconds per updated row (last measured)
+        self.stats = {"analyse_s": 0.0, "factorisations": 0, "factor_s": 0.0, "updates": 0, "updated_rows": 0,
+                      "update_s": 0.0, "solves": 0, "solve_s": 0.0}
+
+    def _matrix(self, w: np.ndarray, scaled: bool) -> sp.csc_matrix:
+        data = self.base + np.bincount(self.pair_pos, weights=w[self.pair_row] * self.pair_val,
+                                       minlength=self.nnz)
+        n = self.s.size
+        if scaled:  # the lower triangle, equilibrated, for CHOLMOD
+            low = self.low
+            return sp.csc_matrix((data[low] * self.scale[low], self.indices[low], self.low_indptr), shape=(n, n))
+        return sp.csc_matrix((data, self.indices, self.indptr), shape=(n, n))
+
+    def refactor(self, w: np.ndarray) -> None:
+        t0 = time.perf_counter()
+        if self.chol is not None:
+            H = self._matrix(w, scaled=True)
+            if self.chol.sym is None:
+                self.chol.analyse(H)
+                t1 = time.perf_counter()
+                self.stats["analyse_s"] += t1 - t0
+                t0 = t1
+            try:
+                self.chol.factor(H)
+            except SingularMatrixError as exn:
+                raise SolverError(f"pdas: the active-set matrix is not positive definite ({exn}); is P "
+                                  "positive semidefinite?") from exn
+        else:  # plateqp.linalg.Factor: its own choice of library, or SuperLU; analysis not re-used
+            try:
+                self.fac = Factor(self._matrix(w, scaled=False), method="auto" if self.method == "linalg" else "superlu")
+            except Exception as exn:
+                raise SolverError(f"pdas: the active-set matrix could not be factorised ({exn})") from exn
+        dt = time.perf_counter() - t0
+        self.t_factor = dt
+        self.stats["factorisations"] += 1
+        self.stats["factor_s"] += dt
+        self.w = w.copy()
+        self.loss = 0.0
+
+    def set(self, w: np.ndarray) -> None:
+        """Make the factor that of ``H(w)``."""
+        if self.w is None:
+            self.refactor(w)
+            return
+        dw = w - self.w
+        changed = np.flatnonzero(dw)
+        if changed.size == 0:
+            return
+        down = changed[dw[changed] < 0]
+        loss = self.loss + np.finfo(float).eps * np.sum(-dw[down] / self.c[down])
+        t_row = self.t_row if self.t_row is not None else self.t_factor / 400.0
+        if (self.chol is None or not self.chol.can_update or changed.size * t_row > 0.7 * self.t_factor
+                or loss > DOWNDATE_LOSS):
+            self.refactor(w)
+            return
+        t0 = time.perf_counter()
+        up = changed[dw[changed] > 0]
+        for rows, subtract in ((up, False), (down, True)):  # updates first: stays definite
+            if rows.size:
+                C = (self.B[rows].T.tocsc() @ sp.diags(np.sqrt(np.abs(dw[rows])))).tocsc()
+                C = sp.diags(self.s) @ C
+                self.chol.update(sp.csc_matrix(C), subtract)
+        dt = time.perf_counter() - t0
+        self.t_row = dt / changed.size
+        self.stats["updates"] += 1
+        self.stats["updated_rows"] += int(changed.size)
+        self.stats["update_s"] += dt
+        self.w = w.copy()
+        self.loss = loss
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        t0 = time.perf_counter()
+        if self.chol is not None:
+            x = self.s * self.chol.solve(self.s * b)
+        else:
+            x = self.fac.solve(b, refine=0)
+        self.stats["solves"] += 1
+        self.stats["solve_s"] += time.perf_counter() - t0
+        return x
+
+
+
+class Step:
+    """Outcome of one active set (sparse method): ``u``, ``λ`` (zero off the set), residual, ray."""
+
+    def __init__(self, u, lam, residual, solves, ray=None):
+        self.u, self.lam, self.residual, self.solves, self.ray = u, lam, residual, solves, ray
+
+
+def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray, u: np.ndarray,
+                  lam: np.ndarray, sigma: float, exact: bool) -> Step:
+    """Refine ``(u, λ_A)`` towards the exact step of active set ``A`` (see the module docstring)."""
+    idx = np.flatnonzero(A)
+    BA = pb.B[idx]
+    WA, gA, rhoA = W[idx], pb.g[idx], pb.rho[idx]
+    lamA = lam[idx].copy()
+    u = u.copy()
+    fnorm = max(np.abs(pb.f).max(initial=0.0), np.finfo(float).tiny)
+    gnorm = np.abs(pb.g).max(initial=0.0)
+    best = np.inf
+    tol = 0.0 if exact else LOOSE_TOL
+    n_max = INNER_EXACT if exact else INNER_LOOSE
+    solves = 0
+    res = np.inf
+    for k in range(n_max + 1):
+        BtL = BA.T @ lamA
+        r_u = pb.f - pb.K @ u - BtL
+        r_A = BA @ u - gA - rhoA * lamA
+        delta = max(np.abs(pb.B @ u).max(initial=0.0), gnorm, np.finfo(float).tiny)
+        res = max(np.abs(r_u).max() / max(fnorm, np.abs(BtL).max(initial=0.0)),
+                  np.abs(r_A).max(initial=0.0) / delta)
+        if res <= tol or k == n_max or (k >= 2 and res > 0.5 * best):
+            break
+        best = min(best, res)
+        du = fac.solve(r_u - BA.T @ (WA * r_A))
+        solves += 1
+        if k == 0:
+            Bdu = BA @ du
+            Ddu = float(du @ (pb.Kd * du))
+            energy = float(du @ (pb.K @ du)) + float(Bdu @ (WA * Bdu))
+            if Ddu > 0 and energy < SINGULAR_QUOTIENT * sigma * Ddu:
+                return Step(u, lam, np.inf, solves, ray=du / np.abs(du).max())
+        lamA += WA * (r_A + BA @ du)
+        u += du
+    out = np.zeros_like(lam)
+    out[idx] = lamA
+    return Step(u, out, res, solves)
+
+
+def line_search(pb: ReducedQP, W: np.ndarray, u: np.ndarray, du: np.ndarray) -> float:
+    """Exact minimiser ``α ∈ (0, ALPHA_MAX]`` of the (convex, piecewise quadratic) energy
+    ``½uᵀKu − fᵀu + Σ ½ W_i max(0, B_i u − g_i)²`` along ``u + α du`` (bisection on its slope)."""
+    r = pb.B @ u - pb.g
+    s = pb.B @ du
+    a2 = float(du @ (pb.K @ du))
+    b = float(du @ (pb.K @ u - pb.f))
+
+    def slope(al):
+        return al * a2 + b + float(np.sum(W * s * np.maximum(0.0, r + al * s)))
+
+    lo, hi = 0.0, 1.0
+    while slope(hi) < 0:
+        lo, hi = hi, 2 * hi
+        if hi > ALPHA_MAX:
+            return np.inf  # the energy falls without bound along du: left to the exact steps
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if slope(mid) < 0:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, steps) -> tuple:
+    """Phase 1 of the sparse method, for soft rows (springs no stiffer than the plate under them).
+
+    Semismooth Newton on the energy ``½uᵀKu − fᵀu + Σ ½ W_i max(0, B_i u − g_i)²`` (the exact
+    energy of a tensionless bed), each Newton system ``(K + σD + B_Aᵀ W_A B_A) δu = −∇`` solved
+    only roughly (PCG to ``PCG_TOL``) with the factor of the two-sided matrix (every row
+    active) as preconditioner, then an exact line search: no refactorisation until the active
+    set settles. Returns ``(u, A, solves)``.
+    """
+    B, K, f, g, D = pb.B, pb.K, pb.f, pb.g, pb.Kd
+    fac.set(W.copy())
+    u = fac.solve(f + B.T @ (W * g))  # the two-sided problem
+    A = B @ u - g > 0
+    for k in range(NEWTON_STEPS):
+        WA = np.where(A, W, 0.0)
+        grad = K @ u - f + B.T @ (WA * (B @ u - g))
+        du = np.zeros_like(u)
+        res = -grad
+        z = fac.solve(res)
+        d = z.copy()
+        rz = rz0 = float(res @ z)
+        for j in range(PCG_MAX):
+            Hd = K @ d + sigma * D * d + B.T @ (WA * (B @ d))
+            dHd = float(d @ Hd)
+            if dHd <= 0:
+                break
+            a = rz / dHd
+            du += a * d
+            res -= a * Hd
+            z = fac.solve(res)
+            rz_new = float(res @ z)
+            if rz_new <= PCG_TOL**2 * rz0:
+                break
+            d = z + (rz_new / rz) * d
+            rz = rz_new
+        alpha = line_search(pb, W, u, du)
+        if not np.isfinite(alpha):
+            break
+        u = u + alpha * du
+        A_new = B @ u - g > 0
+        changes = int((A_new ^ A).sum())
+        if steps is not None:
+            steps.append({"step": f"newton {k + 1}", "active": int(A.sum()), "infeasible": changes,
+                          "solve": f"pcg {j + 1}", "alpha": round(alpha, 3)})
+        A = A_new
+        if changes <= max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION * pb.m):
+            break
+        if fac.t_factor is not None and fac.stats["solve_s"] > NEWTON_BUDGET * fac.t_factor:
+            break
+    return u, A, k + 1
+
+
+def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter, p, steps) -> Outcome:
+    ex = Exchange(p)
+    u = np.zeros(pb.K.shape[0])
+    lam = np.zeros(pb.m)
+    exact = False
+    newton = 0
+    if A is None and np.all(pb.rho * pb.k >= 1.0):  # soft rows only, cold start: phase 1
+        u, A, newton = newton_pcg(pb, fac, W, sigma, steps)
+        lam = np.where(A, W * (pb.B @ u - pb.g), 0.0)
+        exact = True
+    elif A is not None:
+        exact = True  # a warm start is meant to be (nearly) right: solve it exactly at once
+    A = np.ones(pb.m, dtype=bool) if A is None else A.copy()
+    for it in range(1, max_iter + 1):
+        fac.set(np.where(A, W, 0.0))
+        step = solve_active(pb, fac, W, A, u, lam, sigma, exact)
+        if step.ray is not None and fac.loss > 0:  # judge a free rigid motion on a clean factor
+            fac.refactor(np.where(A, W, 0.0))
+            step = solve_active(pb, fac, W, A, u, lam, sigma, exact)
+        if step.ray is not None:  # the active rows do not hold the plate: it falls along d
+            d = step.ray
+            Bd = pb.B @ d
+            scale = np.abs(Bd).max(initial=0.0)
+            hit = ~A & (Bd > 1e-9 * scale)
+            if steps is not None:
+                steps.append({"step": it, "active": int(A.sum()), "infeasible": None, "solve": "singular",
+                              "solves": step.solves, "entering": int(hit.sum())})
+            if hit.any():
+                A = A | hit
+                exact = False
+                continue
+            Kd_rel = np.abs(pb.K @ d).max() / (pb.Kd.max() * np.abs(d).max())
+            if pb.f @ d > 0 and Kd_rel <= 1e-6 and np.all(Bd <= 1e-9 * scale):
+                ray = np.zeros(pb.n)
+                ray[pb.keep] = d  # (d, 0): P (d, 0) = 0, G (d, 0) = B d ≤ 0, qᵀ(d, 0) = −fᵀd < 0
+                return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
+            return Outcome(Status.ERROR, "the active rows leave a null direction of K, no row bounds it, "
+                            "yet q does no work along it (qᵀd ≥ 0): cannot go on", A, it=newton + it)
+        u, lam = step.u, step.lam
+        gap = pb.g + pb.rho * lam - pb.B @ u
+        bad = infeasible(pb, A, lam, gap, feas_tol)
+        if steps is not None:
+            steps.append({"step": it, "active": int(A.sum()), "infeasible": int(bad.sum()),
+                          "solve": "exact" if exact else "loose", "solves": step.solves})
+        if not bad.any():
+            if exact:
+                return Outcome(Status.OPTIMAL, "no infeasible row", A, u, lam, newton + it)
+            exact = True  # the set looks right: solve it to rounding and look again
+            continue
+        exact = exact and int(bad.sum()) <= NEWTON_SETTLED  # a few rows at the end: stay exact
+        A, mode = ex.next(A, bad)
+        if steps is not None:
+            steps[-1]["exchange"] = mode
+    return Outcome(Status.MAX_ITER, f"iteration limit {max_iter} reached", A, u, lam, newton + max_iter)

@@ -1,0 +1,52 @@
+"""Sparse linear algebra: the one place in plateqp that binds CHOLMOD (and SuperLU).
+
+=====================  ===========================================================
+:class:`Cholesky`      one CHOLMOD factor (scikit-sparse, or cvxopt's wheels): AMD order,
+                       symbolic analysis once (an order may be given), numeric
+                       (re)factorisation, solves with many right-hand sides, the trailing
+                       block of the factor, rank-k update/downdate (scikit-sparse)
+:class:`Factor`        equilibrated, refined factor of an SPD matrix; CHOLMOD or SuperLU;
+                       ``refactor`` re-uses the analysis
+:class:`SchurFactor`   one factor with chosen unknowns last: the Schur complement on them
+                       (static condensation) and ``B K⁻¹ Bᵀ`` from its trailing block
+:func:`row_stiffness`  the stiffness of a matrix along each row of an operator (no solves)
+:func:`solve_saddle`   the saddle-point system [K Bᵀ; B −diag(ρ)]
+=====================  ===========================================================
+
+Errors are :class:`~plateqp.errors.SingularMatrixError`, in matrix words; a caller that
+knows what the matrix stands for says so.
+
+Which CHOLMOD binding is used is read at every call from :data:`HAVE_CHOLMOD`
+(scikit-sparse) and :data:`HAVE_CVXOPT` (cvxopt's wheels): set one to False to switch that
+binding off (tests and benchmarks do, to run each path); with both off, SuperLU.
+"""
+
+from __future__ import annotations
+
+from ..errors import SingularMatrixError
+from . import cholmod as _cholmod
+from .cholmod import Cholesky
+from .factor import METHODS, Factor
+from .rows import row_stiffness
+from .saddle import solve_saddle
+from .schur import SchurFactor
+
+#: scikit-sparse's CHOLMOD imported (set False to switch it off)
+HAVE_CHOLMOD = _cholmod.HAVE_SKSPARSE
+#: cvxopt's CHOLMOD imported (set False to switch it off)
+HAVE_CVXOPT = _cholmod.HAVE_CVXOPT
+
+
+def bindings() -> list[str]:
+    """The CHOLMOD bindings in use, best first: "sksparse" (analysis re-use, rank-k updates),
+    "cvxopt" (analysis re-use). Empty: SuperLU only."""
+    out = []
+    if HAVE_CHOLMOD:
+        out.append("sksparse")
+    if HAVE_CVXOPT:
+        out.append("cvxopt")
+    return out
+
+
+__all__ = ["HAVE_CHOLMOD", "HAVE_CVXOPT", "METHODS", "Cholesky", "Factor", "SchurFactor", "SingularMatrixError",
+           "bindings", "row_stiffness", "solve_saddle"]

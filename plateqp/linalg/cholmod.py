@@ -1,0 +1,306 @@
+"""CHOLMOD through the bindings that install: scikit-sparse, or the copy inside cvxopt's wheels.
+
+The one module of plateqp that imports them. :class:`Cholesky` is one sparse Cholesky factor
+``A = L Lᵀ`` with the calls the rest of :mod:`plateqp.linalg` needs: a fill-reducing (AMD)
+order, the symbolic analysis (once; every numeric factorisation of the same pattern re-uses
+it), the numeric factorisation, solves with many right-hand sides, the trailing block
+``L[k:, k:]`` of the factor, and (scikit-sparse only) rank-k update and downdate. Matrices are
+SciPy CSC holding the lower triangle, all CHOLMOD reads.
+
+Reading the factor: cvxopt's only call for it, ``cholmod.getfactor``, hands the numeric factor
+over to the matrix it returns and leaves a symbolic one that no longer solves. So the trailing
+block is copied straight out of CHOLMOD's factor structure instead (:func:`_cvx_trailing`,
+through ``ctypes``; the fields of ``cholmod_factor`` have kept their order since CHOLMOD 1.0)
+and checked against a solve with the factor; if that check fails (another build, another
+layout), ``getfactor`` is the fallback and the factor is spent (:attr:`Cholesky.spent`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import warnings
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import SingularMatrixError
+
+try:  # optional, faster where it installs
+    import sksparse.cholmod as _sk  # type: ignore
+
+    HAVE_SKSPARSE = True
+except Exception:  # pragma: no cover - depends on the machine
+    HAVE_SKSPARSE = False
+
+try:  # optional: CHOLMOD as shipped inside cvxopt's wheels (plateqp[solvers] installs it)
+    from cvxopt import amd as _cvx_amd  # type: ignore
+    from cvxopt import cholmod as _cvx_cholmod
+    from cvxopt import matrix as _cvx_matrix
+    from cvxopt import spmatrix as _cvx_spmatrix
+
+    HAVE_CVXOPT = True
+except Exception:  # pragma: no cover - depends on the machine
+    HAVE_CVXOPT = False
+
+LIBS = ("sksparse", "cvxopt")
+
+
+@contextlib.contextmanager
+def _cvx_options(**kw):
+    """cvxopt's CHOLMOD options are one global dict: set them for one call, then restore."""
+    old = dict(_cvx_cholmod.options)
+    _cvx_cholmod.options.update(kw)
+    try:
+        yield
+    finally:
+        _cvx_cholmod.options.clear()
+        _cvx_cholmod.options.update(old)
+
+
+@contextlib.contextmanager
+def _sk_quiet():
+    """scikit-sparse warns when it converts a matrix's index or value type: expected here."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", _sk.CholmodTypeConversionWarning)
+        yield
+
+
+def lower(K: sp.spmatrix, s: np.ndarray | None = None, perm: np.ndarray | None = None) -> sp.csc_matrix:
+    """Lower triangle of ``(S K S)[perm][:, perm]``, ``S = diag(s)``, in O(nnz) (CSC)."""
+    K = sp.csc_matrix(K)
+    n = K.shape[0]
+    col = np.repeat(np.arange(n), np.diff(K.indptr))
+    row = K.indices
+    if perm is not None:
+        inv = np.empty(n, dtype=np.int64)
+        inv[perm] = np.arange(n)
+        r, c = inv[row], inv[col]
+    else:
+        r, c = row, col
+    keep = r >= c
+    data = K.data[keep]
+    if s is not None:
+        data = data * s[row[keep]] * s[col[keep]]
+    return sp.csc_matrix((data, (r[keep], c[keep])), shape=(n, n))
+
+
+class Cholesky:
+    """One sparse Cholesky factor through a CHOLMOD binding.
+
+    Parameters
+    ----------
+    lib : "sksparse" or "cvxopt"
+
+    ``analyse`` once, then ``factor`` any matrix of that pattern (or a sub-pattern) as often as
+    needed; ``solve``, ``trailing``, ``update`` act on the last numeric factor.
+    """
+
+    def __init__(self, lib: str) -> None:
+        if lib not in LIBS:
+            raise ValueError(f"unknown CHOLMOD binding {lib!r}; choose one of {LIBS}")
+        if not {"sksparse": HAVE_SKSPARSE, "cvxopt": HAVE_CVXOPT}[lib]:
+            raise ValueError(f"the CHOLMOD binding {lib!r} is not installed")
+        self.lib = lib
+        self.sym = None  # scikit-sparse: the analysis; cvxopt: the factor object itself
+        self.F = None
+        self.spent = False  # cvxopt: the numeric factor was handed to getfactor (no more solves)
+        self._last = (None, None)  # cvxopt: the last matrix converted, and its conversion
+
+    @property
+    def can_update(self) -> bool:
+        """Rank-k update/downdate in place (scikit-sparse only)."""
+        return self.lib == "sksparse" and self.F is not None
+
+    def _cvx(self, A: sp.csc_matrix):
+        if self._last[0] is A:
+            return self._last[1]
+        cols = np.repeat(np.arange(A.shape[0], dtype=np.int64), np.diff(A.indptr))
+        out = _cvx_spmatrix(_cvx_matrix(A.data.astype(float)), _cvx_matrix(A.indices.astype(np.int64)),
+                            _cvx_matrix(cols), A.shape)
+        self._last = (A, out)
+        return out
+
+    def order(self, A: sp.csc_matrix) -> np.ndarray:
+        """A fill-reducing (AMD) order of the pattern of ``A`` (lower triangle)."""
+        if self.lib == "sksparse":
+            with _sk_quiet():
+                return _sk.analyze(A, mode="supernodal", ordering_method="amd").P()
+        return np.array(_cvx_amd.order(self._cvx(A), uplo="L"), dtype=np.int64).ravel()
+
+    def analyse(self, A: sp.csc_matrix, natural: bool = False) -> None:
+        """Symbolic analysis of the pattern of ``A``: CHOLMOD's own ordering, or with
+        ``natural`` the order ``A`` comes in (for an order given by permuting ``A``)."""
+        n = A.shape[0]
+        self.F, self.spent = None, False
+        if self.lib == "sksparse":
+            with _sk_quiet():
+                self.sym = _sk.analyze(A, mode="supernodal", ordering_method="natural" if natural else "default")
+            return
+        if natural:  # CHOLMOD would postorder even a given order
+            with _cvx_options(nmethods=1, postorder=False):
+                self.sym = _cvx_cholmod.symbolic(self._cvx(A), p=_cvx_matrix(np.arange(n, dtype=np.int64)))
+        else:
+            self.sym = _cvx_cholmod.symbolic(self._cvx(A))
+
+    def factor(self, A: sp.csc_matrix) -> None:
+        """Numeric factorisation with the analysis; SingularMatrixError if ``A`` is not
+        positive definite (``column``: where it stopped, in the factor's order)."""
+        if self.sym is None:
+            self.analyse(A)
+        if self.lib == "sksparse":
+            try:
+                with _sk_quiet():
+                    self.F = self.sym.cholesky(A)
+            except _sk.CholmodNotPositiveDefiniteError as exn:
+                col = getattr(exn, "column", None)
+                raise SingularMatrixError(f"the matrix is not positive definite ({exn})", col) from exn
+            return
+        try:
+            _cvx_cholmod.numeric(self._cvx(A), self.sym)
+        except ArithmeticError as exn:
+            col = int(str(exn)) if str(exn).strip().isdigit() else None
+            raise SingularMatrixError(f"the matrix is not positive definite (CHOLMOD stopped at column {exn} "
+                                      "of its elimination order)", col) from exn
+        self.F, self.spent = self.sym, False
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """``A⁻¹ b`` for ``b`` of shape (n,) or (n, k) (the factor's permutation applied inside)."""
+        if self.spent:
+            raise RuntimeError("this cvxopt factor was read by getfactor and no longer solves")
+        if self.lib == "sksparse":
+            with _sk_quiet():
+                return self.F.solve_A(b)
+        b = np.asarray(b, dtype=float)
+        B = _cvx_matrix(b.reshape(b.shape[0], -1).copy())
+        _cvx_cholmod.solve(self.F, B)
+        return np.array(B).reshape(b.shape)
+
+    def trailing(self, no: int) -> np.ndarray:
+        """The trailing block ``L[no:, no:]`` of the factor ``A = L Lᵀ``, dense (only meaningful
+        after a natural-order analysis). With cvxopt it is copied out of the factor, which then
+        still solves; only if that copy fails its check is the factor read by ``getfactor``
+        and spent."""
+        if self.lib == "sksparse":
+            return self.F.L()[no:, no:].toarray()
+        try:
+            out = _cvx_trailing(self.F, no)
+        except (ValueError, OSError, AttributeError):
+            out = None
+        if out is not None and self._trailing_checks(out, no):
+            return out
+        G = _cvx_cholmod.getfactor(self.F)
+        self.spent = True
+        colptr, rowind, vals = (np.asarray(memoryview(v)).ravel() for v in G.CCS)  # no copies
+        n = G.size[0]
+        start = int(colptr[no])
+        cols = np.repeat(np.arange(n - no), np.diff(colptr[no:]))
+        out = np.zeros((n - no, n - no))
+        out[rowind[start:] - no, cols] = vals[start:]
+        return out
+
+    def _trailing_checks(self, T: np.ndarray, no: int) -> bool:
+        """A solve with the factor agrees with the block read: for ``x = A⁻¹ (0, v)``,
+        ``T Tᵀ x_trailing = v`` (the trailing block is the Schur complement's factor)."""
+        k = T.shape[0]
+        if k == 0:
+            return True
+        if not np.all(np.isfinite(T)) or np.any(np.diagonal(T) <= 0):
+            return False
+        n = no + k
+        v = np.random.default_rng(0).standard_normal(k)
+        x = self.solve(np.concatenate([np.zeros(no), v]))[no:]
+        r = T @ (T.T @ x) - v
+        scale = np.abs(T) @ (np.abs(T.T) @ np.abs(x)) + np.abs(v)
+        return n > 0 and bool(np.all(np.abs(r) <= 1e-8 * scale.max()))
+
+    def update(self, C: sp.csc_matrix, subtract: bool) -> None:
+        """``A ± C Cᵀ`` in place (scikit-sparse)."""
+        if not self.can_update:
+            raise RuntimeError(f"rank-k update needs scikit-sparse (this factor: {self.lib})")
+        with _sk_quiet():
+            self.F.update_inplace(C, subtract=subtract)
+
+    def nnz(self, A: sp.csc_matrix) -> int:
+        """Non-zeros of the factor of ``A`` (cvxopt: of a copy, since reading spends it)."""
+        if self.lib == "sksparse":
+            return int(self.F.L().nnz)
+        F = _cvx_cholmod.symbolic(self._cvx(A))
+        _cvx_cholmod.numeric(self._cvx(A), F)
+        return len(_cvx_cholmod.getfactor(F))
+
+
+# --------------------------------------------------------------------------- cvxopt's factor, read in place
+
+_api = ctypes.pythonapi
+_api.PyCapsule_GetName.restype = ctypes.c_char_p
+_api.PyCapsule_GetName.argtypes = [ctypes.py_object]
+_api.PyCapsule_GetPointer.restype = ctypes.c_void_p
+_api.PyCapsule_GetPointer.argtypes = [ctypes.py_object, ctypes.c_char_p]
+
+# cholmod_factor: 22 size_t/pointer fields (n, minor, Perm, ColCount, IPerm, nzmax, p, i, x, z,
+# nz, next, prev, nsuper, ssize, xsize, maxcsize, maxesize, super, pi, px, s), then the ints
+# ordering, is_ll, is_super, is_monotonic, itype, xtype, dtype
+_N, _MINOR, _NZMAX, _P, _I, _X, _NZ = 0, 1, 5, 6, 7, 8, 10
+_NSUPER, _SSIZE, _XSIZE, _SUPER, _PI, _PX, _S = 13, 14, 15, 18, 19, 20, 21
+_LONG, _REAL, _DOUBLE = 2, 1, 0
+
+
+def _view(addr: int, count: int, dtype) -> np.ndarray:
+    """``count`` items at ``addr`` (no copy; valid while the factor lives)."""
+    if count == 0:
+        return np.zeros(0, dtype=dtype)
+    if not addr:
+        raise ValueError("null pointer in the factor")
+    buf = (ctypes.c_char * (count * np.dtype(dtype).itemsize)).from_address(addr)
+    return np.frombuffer(buf, dtype=dtype, count=count)
+
+
+def _cvx_trailing(F, no: int) -> np.ndarray | None:
+    """``L[no:, no:]`` (of ``L Lᵀ``) copied from cvxopt's numeric factor without touching it;
+    None where the factor is not of the expected kind (64-bit indices, real, double)."""
+    ptr = _api.PyCapsule_GetPointer(F, _api.PyCapsule_GetName(F))
+    if not ptr:
+        return None
+    h = _view(ptr, 22, np.uint64)
+    _ordering, is_ll, is_super, _monotonic, itype, xtype, dtype = _view(ptr + 22 * 8, 7, np.int32)
+    n = int(h[_N])
+    if int(h[_MINOR]) != n or itype != _LONG or xtype != _REAL or dtype != _DOUBLE or not 0 <= no <= n:
+        return None
+    k = n - no
+    out = np.zeros((k, k))
+    if is_super:
+        if not is_ll:
+            return None
+        ns = int(h[_NSUPER])
+        sup = _view(int(h[_SUPER]), ns + 1, np.int64)
+        pi = _view(int(h[_PI]), ns + 1, np.int64)
+        px = _view(int(h[_PX]), ns + 1, np.int64)
+        s = _view(int(h[_S]), int(h[_SSIZE]), np.int64)
+        x = _view(int(h[_X]), int(h[_XSIZE]), np.float64)
+        if sup[ns] != n:
+            return None
+        for j in range(max(int(np.searchsorted(sup, no, side="right")) - 1, 0), ns):
+            c0, c1 = int(sup[j]), int(sup[j + 1])
+            if c1 <= no:
+                continue
+            rows = s[pi[j]:pi[j + 1]]
+            nr, nc = rows.size, c1 - c0
+            blk = x[px[j]:px[j] + nr * nc].reshape(nc, nr).T  # column-major, leading dimension nr
+            j0 = max(no - c0, 0)  # the supernode's first column in the trailing block
+            out[np.ix_(rows[j0:] - no, np.arange(c0 + j0, c1) - no)] = np.tril(blk[j0:, j0:])
+        return out
+    p = _view(int(h[_P]), n + 1, np.int64)
+    i = _view(int(h[_I]), int(h[_NZMAX]), np.int64)
+    x = _view(int(h[_X]), int(h[_NZMAX]), np.float64)
+    nz = _view(int(h[_NZ]), n, np.int64)
+    for j in range(no, n):
+        lo = int(p[j])
+        out[i[lo:lo + nz[j]] - no, j - no] = x[lo:lo + nz[j]]
+    if not is_ll:  # simplicial LDLᵀ: unit L with D stored on its diagonal
+        d = np.diagonal(out).copy()
+        if np.any(d <= 0):
+            return None
+        np.fill_diagonal(out, 1.0)
+        out *= np.sqrt(d)[None, :]
+    return out

@@ -1,0 +1,204 @@
+"""plateqp.linalg against independent references: SciPy's ``spsolve`` and dense NumPy.
+
+Each factorisation route runs with every CHOLMOD binding installed here (scikit-sparse,
+cvxopt's wheels) and with SuperLU, on small sparse symmetric positive definite matrices whose
+unknowns differ by orders of magnitude in scale (as a plate's deflections and rotations do),
+and on singular ones. The trailing block of a contacts-last factorisation is checked against
+the dense Schur complement ``K_ll − K_lo K_oo⁻¹ K_ol`` and ``B K⁻¹ Bᵀ`` against dense inverses;
+the saddle solve against a dense solve of the bordered matrix; the row stiffness against its
+closed forms and the exact condensed stiffness it bounds.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from plateqp import linalg
+from plateqp.errors import MechanismError, SingularMatrixError
+from plateqp.linalg import Factor, SchurFactor, row_stiffness, solve_saddle
+from plateqp.linalg.cholmod import Cholesky, lower
+
+LIBS = [lib for lib, have in (("sksparse", linalg.HAVE_CHOLMOD), ("cvxopt", linalg.HAVE_CVXOPT)) if have]
+FACTOR_METHODS = ["superlu", "superlu-default"] + [{"sksparse": "cholmod", "cvxopt": "cvxopt"}[x] for x in LIBS]
+SCHUR_METHODS = ["blocks"] + LIBS
+
+
+def laplacian(k: int, shift: float = 0.0) -> sp.csc_matrix:
+    """5-point Laplacian on a k × k grid with free (Neumann) edges: singular (constants) unless
+    ``shift`` > 0 is added to its diagonal."""
+    T = sp.diags([-np.ones(k - 1), np.r_[1.0, 2 * np.ones(k - 2), 1.0], -np.ones(k - 1)], [-1, 0, 1])
+    Id = sp.identity(k)
+    return sp.csc_matrix(sp.kron(T, Id) + sp.kron(Id, T) + shift * sp.identity(k * k))
+
+
+def spd(k: int = 7, seed: int = 0, shift: float = 0.05) -> sp.csc_matrix:
+    """A sparse SPD matrix D (L + shift I) D with D spanning six orders of magnitude."""
+    d = 10.0 ** np.random.default_rng(seed).uniform(-3, 3, k * k)
+    return sp.csc_matrix(sp.diags(d) @ laplacian(k, shift) @ sp.diags(d))
+
+
+def dense_schur(K, last):
+    Kd = K.toarray()
+    o = np.setdiff1d(np.arange(K.shape[0]), last)
+    return Kd[np.ix_(last, last)] - Kd[np.ix_(last, o)] @ np.linalg.solve(Kd[np.ix_(o, o)], Kd[np.ix_(o, last)])
+
+
+def rel(a, b) -> float:
+    return float(np.abs(a - b).max() / np.abs(b).max())
+
+
+# --------------------------------------------------------------------------- Factor
+
+
+@pytest.mark.parametrize("method", FACTOR_METHODS)
+def test_factor_solves_like_spsolve(method):
+    K = spd()
+    rng = np.random.default_rng(1)
+    b = rng.standard_normal(K.shape[0])
+    Bm = rng.standard_normal((K.shape[0], 3))
+    fac = Factor(K, method=method)
+    assert rel(fac.solve(b), spla.spsolve(K, b)) < 1e-10
+    assert rel(fac.solve(Bm), np.linalg.solve(K.toarray(), Bm)) < 1e-10
+    # a given order (reversed) gives the same answer
+    order = np.arange(K.shape[0])[::-1].copy()
+    assert rel(Factor(K, method=method, order=order).solve(b), spla.spsolve(K, b)) < 1e-10
+
+
+@pytest.mark.parametrize("method", FACTOR_METHODS)
+def test_refactor_takes_new_values_of_the_pattern(method):
+    K = spd()
+    fac = Factor(K, method=method)
+    K2 = spd(seed=5, shift=0.5)  # same pattern, other values (also once equilibrated)
+    fac.refactor(K2)
+    b = np.ones(K.shape[0])
+    assert rel(fac.solve(b, refine=0), spla.spsolve(K2, b)) < 1e-10  # the new factor itself, unrefined
+
+
+@pytest.mark.parametrize("method", FACTOR_METHODS)
+def test_factor_refuses_singular_matrices(method):
+    if method in ("cholmod", "cvxopt"):  # CHOLMOD sees the null space of constants
+        with pytest.raises(SingularMatrixError):
+            Factor(laplacian(6), method=method)
+    # SuperLU's pivots there are rounding, not zero (so callers look for rigid modes first);
+    # an exactly dependent pair it does see
+    P = sp.lil_matrix(laplacian(6, 1.0))
+    P[7, 7] = P[8, 8] = P[7, 8] = P[8, 7] = 1.0
+    P[7, [1, 6, 13]] = P[[1, 6, 13], 7] = 0.0
+    P[8, [2, 9, 14]] = P[[2, 9, 14], 8] = 0.0
+    with pytest.raises(SingularMatrixError):
+        Factor(P.tocsc(), method=method)
+    Z = laplacian(6, 1.0).tolil()
+    Z[3, 3] = 0.0
+    with pytest.raises(SingularMatrixError, match="row 3"):
+        Factor(Z.tocsc(), method=method)
+    assert issubclass(SingularMatrixError, MechanismError)  # callers that know the matrix catch it as one
+
+
+# --------------------------------------------------------------------------- CHOLMOD's trailing block
+
+
+@pytest.mark.parametrize("lib", LIBS)
+def test_trailing_block_is_the_dense_factors(lib):
+    """In the natural order, L[no:, no:] of CHOLMOD's factor is that of numpy's Cholesky, and
+    the factor still solves after it was read (cvxopt: not spent)."""
+    K = spd(6)
+    n, no = K.shape[0], 24
+    A = lower(K, 1.0 / np.sqrt(K.diagonal()))
+    chol = Cholesky(lib)
+    chol.analyse(A, natural=True)
+    chol.factor(A)
+    T = chol.trailing(no)
+    Ad = A.toarray() + np.tril(A.toarray(), -1).T
+    assert rel(T, np.linalg.cholesky(Ad)[no:, no:]) < 1e-12
+    assert not chol.spent
+    b = np.arange(1.0, n + 1)
+    assert rel(chol.solve(b), np.linalg.solve(Ad, b)) < 1e-10
+
+
+# --------------------------------------------------------------------------- SchurFactor
+
+
+@pytest.mark.parametrize("method", SCHUR_METHODS)
+def test_schur_complement_is_the_dense_one(method):
+    K = spd()
+    n = K.shape[0]
+    last = np.random.default_rng(2).permutation(n)[:9]  # any order: schur() rows follow it
+    fac = SchurFactor(K, last, method=method)
+    assert rel(fac.schur(), dense_schur(K, last)) < 1e-10
+    rng = np.random.default_rng(3)
+    b = rng.standard_normal(n)
+    assert rel(fac.solve(b, refine=2), spla.spsolve(K, b)) < 1e-10
+    o = fac.others
+    bo = rng.standard_normal(o.size)
+    assert rel(fac.solve_others(bo), np.linalg.solve(K.toarray()[np.ix_(o, o)], bo)) < 1e-10
+
+
+@pytest.mark.parametrize("method", SCHUR_METHODS)
+def test_flexibility_is_B_Kinv_Bt(method):
+    K = spd()
+    n = K.shape[0]
+    last = np.array([3, 10, 11, 17, 30, 40])
+    Kinv = np.linalg.inv(K.toarray())
+    fac = SchurFactor(K, last, method=method)
+    # rows on one unknown each (POTRI route), and rows mixing several (triangular solve route)
+    E = sp.csr_matrix((np.array([2.0, -1.0, 0.5, 3.0, 1.0, 1.0]), (np.arange(6), last[::-1])), shape=(6, n))
+    Bmix = sp.csr_matrix(np.array([[0.3, 0.7, 0, 0, 0, 0], [0, 0.5, 0.25, 0.25, 0, 0],
+                                   [0, 0, 0, 0, 1.0, -1.0]]) @ sp.csr_matrix(
+        (np.ones(6), (np.arange(6), last)), shape=(6, n)).toarray())
+    for B in (E, Bmix):
+        ref = B.toarray() @ Kinv @ B.toarray().T
+        assert rel(fac.flexibility(B), ref) < 1e-9
+        assert rel(fac.flexibility(B, refine=2), ref) < 1e-10
+    with pytest.raises(ValueError, match="not ordered last"):
+        fac.flexibility(sp.csr_matrix(np.eye(n)[[0]]))
+
+
+@pytest.mark.parametrize("method", SCHUR_METHODS)
+def test_shifted_schur_of_a_semidefinite_matrix(method):
+    """A singular K whose K_oo is definite (a floating plate's, contact points held): the shift
+    makes the trailing block definite and schur() takes it off again."""
+    K = laplacian(6)  # null space: constants
+    last = np.array([0, 5, 30, 35])
+    S = SchurFactor(K, last, shift=1.0, method=method).schur()
+    assert rel(S, dense_schur(K, last)) < 1e-10
+    assert abs(S.sum()) < 1e-10 * np.abs(S).max()  # constants still in its null space
+    with pytest.raises(SingularMatrixError):
+        SchurFactor(K, last, pivot_tol=1e-13, method=method)
+
+
+# --------------------------------------------------------------------------- saddle, row stiffness
+
+
+def test_solve_saddle_is_the_bordered_dense_solve():
+    K = laplacian(5)  # singular: the rows must hold it
+    n = K.shape[0]
+    B = sp.csr_matrix((np.array([1.0, 0.5, 0.5, 1.0]), ([0, 1, 1, 2], [0, 12, 13, 24])), shape=(3, n))
+    rho = np.array([0.0, 0.1, 0.0])
+    rng = np.random.default_rng(4)
+    f, g = rng.standard_normal(n), rng.standard_normal(3)
+    A = np.block([[K.toarray(), B.toarray().T], [B.toarray(), -np.diag(rho)]])
+    ref = np.linalg.solve(A, np.concatenate([f, g]))
+    u, R = solve_saddle(K, B, rho, f, g)
+    assert rel(np.concatenate([u, R]), ref) < 1e-10
+    with pytest.raises(SingularMatrixError):
+        solve_saddle(K, sp.csr_matrix((3, n)), np.zeros(3), f, g)
+
+
+def test_row_stiffness_closed_forms_and_bound():
+    K = spd()
+    n = K.shape[0]
+    B = sp.csr_matrix((np.array([1.0, 0.6, 0.4, 2.0]), ([0, 1, 1, 2], [4, 20, 21, 33])), shape=(3, n))
+    Bd, Kd = B.toarray(), K.toarray()
+    diag = (Bd**2) @ np.diag(Kd)
+    ray = np.einsum("ij,jk,ik->i", Bd, Kd, Bd) / (Bd**2).sum(axis=1) ** 2
+    assert np.allclose(row_stiffness(K, B, "diagonal"), diag, rtol=1e-14)
+    assert np.allclose(row_stiffness(K, B), ray, rtol=1e-14)
+    exact = 1.0 / np.diag(Bd @ np.linalg.inv(Kd) @ Bd.T)
+    assert np.all(row_stiffness(K, B) >= exact * (1 - 1e-12))  # Rayleigh: an upper bound
+    rho = np.array([0.0, 1e-3, 1.0])
+    assert np.allclose(row_stiffness(K, B, rho=rho), ray / (1 + rho * ray), rtol=1e-14)
+    with pytest.raises(ValueError):
+        row_stiffness(K, B, "trace")
