@@ -68,8 +68,12 @@ def _img(png: bytes, alt: str) -> str:
     return f'<img src="data:image/png;base64,{data}" alt="{html.escape(alt)}">'
 
 
-def report_html(runs: list, table: str) -> str:
-    """The self-contained HTML report (images embedded as base64 PNG)."""
+def report_html(runs: list, table: str, studies: list = ()) -> str:
+    """The self-contained HTML report (images embedded as base64 PNG).
+
+    ``studies``: the demo's study runs (:class:`plateqp.demo.paper.StudyRun`: ``name``,
+    ``title``, ``story``, ``lines``, ``figures``, ``captions``), each a section after the scenes.
+    """
     import plateqp as pq
 
     e = html.escape
@@ -83,11 +87,13 @@ def report_html(runs: list, table: str) -> str:
              "<p>Conventions: w is positive <b>downward</b> (the direction of the load), so every deflection axis "
              "points down; a gap g0 &lt; 0 is heave (the support pushed up into the plate), g0 &gt; 0 settlement; "
              "reactions R ≥ 0 push the plate up. Stresses are those of the bottom face (tension &gt; 0).</p>",
-             "<h2>Summary</h2>",
-             "<p>w: the signed deflection at the node of largest |w|; max sigma1: largest principal stress of the "
-             "one-sided solution; KKT: the one-sided result meets the 'high' accuracy; times in seconds "
-             "(one-sided solve, two-sided solve, figures).</p>",
-             _table_html(table)]
+             ]
+    if runs:
+        parts += ["<h2>Summary</h2>",
+                  "<p>w: the signed deflection at the node of largest |w|; max sigma1: largest principal stress of "
+                  "the one-sided solution; KKT: the one-sided result meets the 'high' accuracy; times in seconds "
+                  "(one-sided solve, two-sided solve, figures).</p>",
+                  _table_html(table)]
     statements = [r for r in runs if r.comparison is not None]
     if statements:
         parts.append("<h2>The source paper's statements, measured on our scenes</h2>")
@@ -131,6 +137,13 @@ def report_html(runs: list, table: str) -> str:
             parts.append("<ul>" + "".join(f"<li>{e(s)}</li>" for s in r.comparison.lines(r.units)) + "</ul>")
         for stem, png in r.figures.items():
             parts.append(f"<figure>{_img(png, stem)}<figcaption><b>{e(stem)}.png</b>: {e(r.captions[stem])}"
+                         "</figcaption></figure>")
+    for st in studies:
+        parts.append(f"<h2 id='{e(st.name)}'>Study “{e(st.name)}”: {e(st.title)}</h2>")
+        parts.append(f"<pre class='story'>{e(st.story)}</pre>")
+        parts.append("<ul>" + "".join(f"<li>{e(s)}</li>" for s in st.lines) + "</ul>")
+        for stem, png in st.figures.items():
+            parts.append(f"<figure>{_img(png, stem)}<figcaption><b>{e(stem)}.png</b>: {e(st.captions[stem])}"
                          "</figcaption></figure>")
     parts.append("</body></html>")
     return "\n".join(parts)

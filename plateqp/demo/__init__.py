@@ -42,10 +42,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import scenes
-from .errors import PlateQPWarning
-from .plotting.data import support_spacing
-from .report import format_table, report_html, summary_row
+from .. import scenes
+from ..errors import PlateQPWarning, SceneError
+from ..plotting.data import support_spacing
+from ..report import format_table, report_html, summary_row
+from .paper import STUDIES, TITLES, run_study
 
 DEFAULT_OUT = "plateqp-demo"
 DPI = 100
@@ -240,7 +241,7 @@ def run_scene(name: str, figures: bool = True) -> SceneRun:
     """Solve one built-in scene one-sided and two-sided, compare, draw the figures."""
     import plateqp as pq
 
-    from . import plotting as pl
+    from .. import plotting as pl
 
     story, units = scene_notes(name)
     scene = scenes.load(name)
@@ -332,14 +333,14 @@ def convergence_plot(scene, one):
     study raises a :class:`~plateqp.errors.PlateQPError`. Any other exception is a bug and
     propagates.
     """
-    from . import plotting as pl
-    from .errors import PlateQPError
+    from .. import plotting as pl
+    from ..errors import PlateQPError
 
     # Only what is expected is caught (a missing module, a scene the study cannot take); a
     # programming error (AttributeError, TypeError, KeyError, ...) must surface, not vanish
     # into a "skipped" note.
     try:
-        from .studies import convergence
+        from ..studies import convergence
     except ModuleNotFoundError as exn:  # plateqp.studies, or a package it needs, is not installed
         _progress(f"{scene.name}: convergence study skipped ({type(exn).__name__}: {exn})")
         return None
@@ -372,31 +373,49 @@ def convergence_plot(scene, one):
 
 
 # -- entry point -----------------------------------------------------------------------------------
+def names_all() -> list[str]:
+    """Every name ``plateqp demo`` takes: the built-in scenes, then the studies (:data:`STUDIES`)."""
+    return scenes.names() + list(STUDIES)
+
+
+def _split(names: list[str] | None) -> tuple[list[str], list[str]]:
+    """(scenes, studies) of ``names`` (all when None or empty); SceneError for an unknown name."""
+    names = list(names) if names else names_all()
+    for n in names:
+        if n not in STUDIES and n not in scenes.names():
+            raise SceneError(f"no built-in scene or study {n!r}; built-in scenes: {', '.join(scenes.names())}; "
+                             f"studies: {', '.join(STUDIES)}")
+    return [n for n in names if n not in STUDIES], [n for n in names if n in STUDIES]
+
+
 def output_files(names: list[str] | None = None) -> list[str]:
-    """Every file :func:`run` may write for the scenes ``names`` (all when None or empty):
-    ``report.html``, ``<scene>.json`` and ``<scene>-<figure>.png`` for each of :data:`FIGURES`
-    (whether or not the scene draws it), so that a folder can be checked before any work.
+    """Every file :func:`run` may write for the scenes and studies ``names`` (all when None or
+    empty): ``report.html``, ``<scene>.json`` and ``<scene>-<figure>.png`` for each of
+    :data:`FIGURES` (whether or not the scene draws it), ``<study>.json`` and
+    ``<study>-<figure>.png`` for each figure of :data:`STUDIES`, so that a folder can be
+    checked before any work.
 
-    Raises :class:`~plateqp.errors.SceneError` for an unknown scene name.
+    Raises :class:`~plateqp.errors.SceneError` for an unknown name.
     """
-    names = list(names) if names else scenes.names()
-    for n in names:
-        scenes.path(n)  # unknown name: SceneError
-    return ["report.html"] + [f for n in names for f in [f"{n}.json"] + [f"{n}-{stem}.png" for stem in FIGURES]]
+    sc_names, st_names = _split(names)
+    return (["report.html"] + [f for n in sc_names for f in [f"{n}.json"] + [f"{n}-{stem}.png" for stem in FIGURES]]
+            + [f for n in st_names for f in [f"{n}.json"] + [f"{n}-{stem}.png" for stem in STUDIES[n]]])
 
 
-def run(names: list[str] | None = None, out: Path | None = None) -> int:
-    """Solve the built-in scenes ``names`` (all when None or empty), print the summary, write the report.
+def run(names: list[str] | None = None, out: Path | None = None, *, study_mesh: int | None = None) -> int:
+    """Solve the built-in scenes and run the studies ``names`` (all when None or empty), print
+    the summary, write the report.
 
-    Writes ``<scene>-<figure>.png``, ``<scene>.json`` and ``report.html`` into ``out``
-    (default ``plateqp-demo`` in the current directory). Returns 0 when every one-sided result
-    met its accuracy, else 5 (the exit code of ``plateqp solve`` for a missed accuracy).
-    Raises :class:`~plateqp.errors.SceneError` for an unknown scene name, before any work.
+    Writes ``<name>-<figure>.png``, ``<name>.json`` and ``report.html`` into ``out``
+    (default ``plateqp-demo`` in the current directory). The studies "fig5" and "fig6"
+    (:mod:`plateqp.demo.paper`, the source paper's figures 5 and 6) run on their scenes' own
+    meshes, or on ``study_mesh`` cells per side (coarser for tests). Returns 0 when every
+    one-sided result met its accuracy, else 5 (the exit code of ``plateqp solve`` for a
+    missed accuracy). Raises :class:`~plateqp.errors.SceneError` for an unknown name, before
+    any work.
     """
 
-    names = list(names) if names else scenes.names()
-    for n in names:
-        scenes.path(n)  # unknown name: SceneError now, not after minutes of work
+    names, study_names = _split(names)  # unknown name: SceneError now, not after minutes of work
     out = Path(out) if out is not None else Path.cwd() / DEFAULT_OUT
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -404,8 +423,13 @@ def run(names: list[str] | None = None, out: Path | None = None) -> int:
     if not figures:
         _progress("matplotlib is not installed (pip install 'plateqp[plot]'): the report will have no figures")
     runs = [run_scene(n, figures=figures) for n in names]
-    table = format_table([summary_row(r) for r in runs])
-    print(table)
+    studies = []
+    for n in study_names:
+        _progress(f"{n}: {TITLES[n]}")
+        studies.append(run_study(n, figures=figures, mesh=study_mesh, dpi=DPI))
+    table = format_table([summary_row(r) for r in runs]) if runs else ""
+    if table:
+        print(table)
     if any(r.comparison is not None for r in runs):
         print("\ntwo-sided comparison (the source paper's statements, measured on these scenes):")
         for r in runs:
@@ -413,6 +437,10 @@ def run(names: list[str] | None = None, out: Path | None = None) -> int:
                 print(f"  {r.name}:")
                 for line in r.comparison.lines(r.units):
                     print(f"    {line}")
+    for st in studies:
+        print(f"\n{st.name}: {st.title}")
+        for line in st.lines:
+            print(f"  {line}")
     for r in runs:
         for stem, png in r.figures.items():
             (out / f"{stem}.png").write_bytes(png)
@@ -421,11 +449,15 @@ def run(names: list[str] | None = None, out: Path | None = None) -> int:
             rep["two_sided"] = r.two.to_dict()
             rep["comparison"] = _json_safe(asdict(r.comparison))
         (out / f"{r.name}.json").write_text(json.dumps(rep, indent=1))
-    (out / "report.html").write_text(report_html(runs, table), encoding="utf-8")
-    n_png = sum(len(r.figures) for r in runs)
-    print(f"\nwrote {n_png} figures, {len(runs)} JSON files and report.html to {out}"
+    for st in studies:
+        for stem, png in st.figures.items():
+            (out / f"{stem}.png").write_bytes(png)
+        (out / f"{st.name}.json").write_text(json.dumps(_json_safe({"lines": st.lines, **st.data}), indent=1))
+    (out / "report.html").write_text(report_html(runs, table, studies), encoding="utf-8")
+    n_png = sum(len(r.figures) for r in runs) + sum(len(st.figures) for st in studies)
+    print(f"\nwrote {n_png} figures, {len(runs) + len(studies)} JSON files and report.html to {out}"
           f" ({time.perf_counter() - t0:.1f} s)")
-    return 0 if all(r.ok for r in runs) else 5
+    return 0 if all(r.ok for r in runs) and all(st.ok for st in studies) else 5
 
 
 def _json_safe(d):
