@@ -140,7 +140,9 @@ def test_path_soft_limit(path):
     assert all(last.active)
     c = 1e-4 * path.unit
     res = pq.solve(set_param(path.scene, "supports.*.stiffness", c), accuracy="high")
-    np.testing.assert_allclose(res.reactions, rigid_body_reactions(path.scene, c), rtol=1e-3)
+    ref = rigid_body_reactions(path.scene, c)
+    np.testing.assert_allclose(res.reactions, ref, rtol=1e-3)
+    np.testing.assert_allclose(res.compressions, ref / c, rtol=1e-3)  # the springs: s = R / c
 
 
 def test_path_breakpoints_bracket_scheme_changes(path):
