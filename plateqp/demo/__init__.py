@@ -1,4 +1,5 @@
-"""``plateqp demo``: solve the built-in scenes, compare with two-sided support, write a report.
+"""``plateqp demo``: solve the built-in scenes, compare with two-sided support, run the source
+paper's figure 5 and 6 studies (:mod:`plateqp.demo.paper`: "fig5", "fig6"), write a report.
 
 For each scene: the one-sided solve (:func:`plateqp.solve`, accuracy "high") and, when the
 scene has one-sided supports, the source paper's comparison (:func:`plateqp.solve_bilateral`:
