@@ -20,7 +20,9 @@ Modules, by job: :mod:`.style` (figure creation, labels and units, colours, :fun
 :func:`png_bytes`), :mod:`.data` (what a figure reads from a result), :mod:`.plan` (the plan
 view: mesh, supports, contact state, section lines), :mod:`.fields` (deflection surface,
 contours, principal stresses, difference map), :mod:`.charts` (sections, reactions,
-convergence as line and bar charts).
+convergence as line and bar charts), :mod:`.studies` (the source paper's figures 5 and 6:
+working schemes, w along sections per scheme, contact pressure along a contour, uniformity
+against κ).
 """
 
 from __future__ import annotations
@@ -29,12 +31,14 @@ from .charts import plot_convergence, plot_reactions, plot_sections
 from .data import support_spacing
 from .fields import plot_deflection_contours, plot_deflection_surface, plot_difference, plot_principal_stress
 from .plan import default_sections, plot_mesh
+from .studies import plot_contour_pressure, plot_scheme_sections, plot_schemes, plot_uniformity
 from .style import (HEAVE_COLOR, LEVEL_BAR, LEVEL_COLOR, ONE_SIDED, SETTLE_COLOR, TWO_SIDED, png_bytes,
                     save)
 
 __all__ = [
     "HEAVE_COLOR", "LEVEL_BAR", "LEVEL_COLOR", "ONE_SIDED", "SETTLE_COLOR", "TWO_SIDED",
-    "default_sections", "plot_convergence", "plot_deflection_contours", "plot_deflection_surface",
-    "plot_difference", "plot_mesh", "plot_principal_stress", "plot_reactions", "plot_sections",
+    "default_sections", "plot_contour_pressure", "plot_convergence", "plot_deflection_contours",
+    "plot_deflection_surface", "plot_difference", "plot_mesh", "plot_principal_stress", "plot_reactions",
+    "plot_scheme_sections", "plot_schemes", "plot_sections", "plot_uniformity",
     "png_bytes", "save", "support_spacing",
 ]

@@ -25,8 +25,10 @@ chosen closest to the scene's own gaps.
 
 The most uniform pressure (:func:`most_uniform_stiffness`)
 ----------------------------------------------------------
-The stiffness c of every support that minimises the coefficient of variation of the chosen
-supports' reactions, on log c: a coarse scan, then a bounded scalar minimisation.
+The stiffness c of every support that minimises a uniformity measure of the chosen supports'
+reactions (:data:`UNIFORMITY_MEASURES`: "std/mean", the coefficient of variation, by default;
+"peak/mean"; "range/mean" = (max − min)/mean), on log c: a coarse scan, then a bounded scalar
+minimisation.
 """
 
 from __future__ import annotations
@@ -217,15 +219,42 @@ def _held_or_floating(model: Model, rhs: np.ndarray, V: np.ndarray) -> np.ndarra
 # The most uniform contact pressure
 # =============================================================================================
 
+#: The uniformity measures of :func:`most_uniform_stiffness` (each 0 for equal reactions).
+UNIFORMITY_MEASURES = ("std/mean", "peak/mean", "range/mean")
+
+
+def uniformity(reactions, measure: str = "std/mean") -> float:
+    """A measure of how far the reactions are from uniform (smaller is more uniform).
+
+    "std/mean": the coefficient of variation std(R)/mean(R) (population std); "peak/mean":
+    max(R)/mean(R) (1 for equal reactions); "range/mean": (max(R) − min(R))/mean(R). ``inf``
+    when mean(R) ≤ 0. Raises :class:`~plateqp.errors.ProblemError` for an unknown measure.
+    """
+    if measure not in UNIFORMITY_MEASURES:
+        raise ProblemError(f"measure must be one of {', '.join(map(repr, UNIFORMITY_MEASURES))} (got {measure!r})")
+    R = np.asarray(reactions, dtype=float).reshape(-1)
+    if R.size == 0:
+        raise ProblemError("uniformity: no reactions")
+    m = float(R.mean())
+    if not m > 0:
+        return math.inf
+    if measure == "std/mean":
+        return float(R.std() / m)
+    if measure == "peak/mean":
+        return float(R.max() / m)
+    return float((R.max() - R.min()) / m)
+
+
 @dataclass
 class UniformStiffness:
     """The stiffness that makes the reactions of the chosen supports most uniform.
 
-    ``c``: the stiffness; ``cv``: coefficient of variation std(R)/mean(R) there; ``reactions``:
-    of the chosen supports; ``evaluations``: every (c, cv) tried; ``at_bound``: the best c lies
-    within one scan step of an end of ``c_range`` (no interior optimum found: e.g. on a floating
-    plate on equal springs the pressure only gets more uniform as c falls towards the rigid-body
-    distribution).
+    ``c``: the stiffness; ``cv``: coefficient of variation std(R)/mean(R) there (whatever the
+    measure); ``reactions``: of the chosen supports; ``evaluations``: every (c, value of the
+    measure) tried; ``at_bound``: the best c lies within one scan step of an end of
+    ``c_range`` (no interior optimum found: e.g. on a floating plate on equal springs the
+    std/mean only falls as c falls towards the rigid-body distribution); ``measure``: the
+    measure minimised (:func:`uniformity`) and ``value`` its value at ``c``.
     """
 
     c: float
@@ -233,20 +262,24 @@ class UniformStiffness:
     reactions: np.ndarray
     evaluations: list[tuple[float, float]]
     at_bound: bool = False
+    measure: str = "std/mean"
+    value: float = float("nan")
 
 
 def most_uniform_stiffness(scene: Scene, c_range: tuple[float, float], supports: Sequence[int] | None = None,
                            backend: str = "auto", formulation: str = "auto", accuracy: str = "default",
-                           scan: int = 17, xatol: float = 1e-4) -> UniformStiffness:
+                           scan: int = 17, xatol: float = 1e-4, measure: str = "std/mean") -> UniformStiffness:
     """The support stiffness c (all supports) that makes the contact pressure most uniform.
 
-    Minimises the coefficient of variation of the reactions over ``supports`` (default: every
+    Minimises ``measure`` (:func:`uniformity`: "std/mean", the coefficient of variation, by
+    default; "peak/mean"; "range/mean") of the reactions over ``supports`` (default: every
     support, e.g. a contour) on log c: a coarse log scan of ``scan`` points first, then
     :func:`scipy.optimize.minimize_scalar` (bounded) around the best scan point. The model is
     built once; only the support flexibilities change.
     """
     from scipy.optimize import minimize_scalar
 
+    uniformity(np.ones(1), measure)  # an unknown measure fails here, before any work
     lo, hi = (float(v) for v in c_range)
     if not (0 < lo < hi):
         raise ProblemError(f"c_range must be (low, high) with 0 < low < high (got {c_range!r})")
@@ -261,9 +294,7 @@ def most_uniform_stiffness(scene: Scene, c_range: tuple[float, float], supports:
             warnings.simplefilter("ignore", PlateQPWarning)
             res = solve(sc, backend=backend, formulation=formulation, accuracy=accuracy,
                         model=adapt_model(base, sc))
-        R = res.reactions[sel]
-        m = R.mean()
-        v = float(R.std() / m) if m > 0 else math.inf
+        v = uniformity(res.reactions[sel], measure)
         evals.append((c, v))
         return v
 
@@ -279,7 +310,8 @@ def most_uniform_stiffness(scene: Scene, c_range: tuple[float, float], supports:
         res = solve(sc, backend=backend, formulation=formulation, accuracy=accuracy, model=adapt_model(base, sc))
     step = grid[1] - grid[0]
     at_bound = bool(min(np.log(best[0]) - grid[0], grid[-1] - np.log(best[0])) < step)
-    return UniformStiffness(best[0], best[1], res.reactions[sel].copy(), evals, at_bound)
+    R = res.reactions[sel].copy()
+    return UniformStiffness(best[0], uniformity(R, "std/mean"), R, evals, at_bound, measure, best[1])
 
 
-__all__ = ["GapRegulation", "UniformStiffness", "most_uniform_stiffness", "project_reactions", "regulate_gaps"]
+__all__ = ["UNIFORMITY_MEASURES", "GapRegulation", "UniformStiffness", "uniformity", "most_uniform_stiffness", "project_reactions", "regulate_gaps"]
