@@ -134,6 +134,9 @@ MEMORY_ENV = "PLATEQP_MAX_MEMORY"
 
 def estimate_memory(scene: Scene) -> int:
     """Bytes a build and solve of ``scene`` is expected to need at its peak (see BYTES_PER_DOF)."""
+    if scene.triangles:
+        from .triassembly import estimate_nodes
+        return int(BYTES_PER_DOF * 3 * estimate_nodes(scene))
     nd = len(ELEMENTS[scene.mesh.element].node_dofs)
     return int(BYTES_PER_DOF * (scene.mesh.nx + 1) * (scene.mesh.ny + 1) * nd)
 
@@ -181,7 +184,11 @@ def check_memory(scene: Scene) -> None:
 
 def build_model(scene: Scene) -> Model:
     """Assemble the stiffness, loads, two-sided constraints and contact operator of a scene
-    (after :func:`check_memory`: a mesh too large for the machine is refused before assembly)."""
+    (after :func:`check_memory`: a mesh too large for the machine is refused before assembly).
+    A triangle-meshed scene (``mesh.element = "dkt"``) is built by :mod:`plateqp.triassembly`."""
+    if scene.triangles:
+        from .triassembly import build_tri_model
+        return build_tri_model(scene)
     check_memory(scene)
     grid = Grid.from_scene(scene)
     el = ELEMENTS[scene.mesh.element]()

@@ -1,0 +1,184 @@
+"""From a triangle-meshed Scene to a Model: the DKT sibling of :mod:`plateqp.assembly`.
+
+The mesh (:mod:`plateqp.trimesh`) has a node at every support, point load and pin. Node n
+carries the dofs 3n, 3n + 1, 3n + 2 = (w, ∂w/∂x, ∂w/∂y), as on the ACM grid, so the contact
+code (scaling, rigid modes, formulations, KKT) reads a :class:`TriModel` as it reads a Model.
+
+Two-sided edges (``edges.all`` on a shape; ``left``/``right``/``bottom``/``top`` or ``all`` on a
+rectangle meshed with triangles): **simple** prescribes w = 0 at the edge's nodes and nothing
+else, the rotations stay free (imposing the tangential slope too would make a curved simple
+support converge to the clamped plate: Babuška's paradox); **clamped** also prescribes both
+slopes (w = 0 along the edge and ∂w/∂n = 0). Holes' edges take ``edges.all`` (free without it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from .assembly import BYTES_PER_DOF, Model, _contacts, human_bytes, memory_limit
+from .elements.dkt import DKT
+from .errors import ResourceError, SceneError
+from .geometry import RECT_SEGMENTS, mesh_size, scene_domain
+from .scene import PointLoad, Scene, UniformLoad
+from .trimesh import TriMesh, mesh_domain
+
+#: nodes of a gmsh mesh of area A at size h, about (measured 1.09 on the unit disc at h = 1/16)
+NODES_PER_AREA = 1.2
+
+
+def not_on_triangles(what: str) -> SceneError:
+    """The one-line error for a feature triangle meshes do not carry yet."""
+    return SceneError(f"{what} is not yet available on triangle meshes (mesh.element = \"dkt\")")
+
+
+@dataclass
+class TriModel(Model):
+    """A :class:`~plateqp.assembly.Model` on a triangle mesh (``grid`` is the :class:`TriMesh`,
+    ``cells`` the triangles, ``cell_dofs`` their 9 dofs)."""
+
+    def rigid_modes(self) -> np.ndarray:
+        return _rigid_modes(self)
+
+    def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
+        """(npts, n_full) sparse operator: w at points, from the full dofs (the node's w at a node,
+        the element's cubic inside). Derivatives of w: not yet available on triangles."""
+        if dx or dy:
+            raise not_on_triangles("slopes, curvatures, moments and stresses at points")
+        mesh: TriMesh = self.grid
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        y = np.atleast_1d(np.asarray(y, dtype=float))
+        tri, lam = mesh.locate(x, y)
+        if np.any(tri < 0):
+            bad = np.flatnonzero(tri < 0)[0]
+            raise SceneError(f"point ({x[bad]}, {y[bad]}) is not on the plate")
+        N = self.element.shape(mesh.nodes[mesh.triangles[tri]], lam[:, None, :])[:, 0]
+        dofs = self.cell_dofs[tri]
+        at_node = lam.max(axis=1) >= 1.0 - 1e-12  # a vertex: its w dof alone, no rounding noise
+        N[at_node] = 0.0
+        N[at_node, 3 * lam[at_node].argmax(axis=1)] = 1.0
+        rows = np.repeat(np.arange(len(tri)), 9)
+        A = sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(tri), self.n_full))
+        A.eliminate_zeros()
+        return A
+
+
+def estimate_nodes(scene: Scene) -> float:
+    """About how many nodes the scene's triangle mesh has (:data:`NODES_PER_AREA` area / h²)."""
+    return NODES_PER_AREA * scene_domain(scene).area / mesh_size(scene) ** 2
+
+
+def check_memory_tri(scene: Scene, h: float) -> None:
+    """ResourceError before meshing if the triangle mesh would need more memory than allowed."""
+    need = BYTES_PER_DOF * 3 * estimate_nodes(scene)
+    if need > memory_limit():
+        raise ResourceError(f"mesh.size: a triangle mesh of size {h:g} needs about {human_bytes(need)} to build "
+                            f"and solve, above the limit of {human_bytes(memory_limit())}; use a larger mesh.size")
+
+
+def build_tri_model(scene: Scene) -> TriModel:
+    """Mesh a triangle-meshed scene with gmsh and assemble its DKT stiffness, loads, two-sided
+    supports and contact operator."""
+    domain = scene_domain(scene)
+    h = mesh_size(scene)
+    check_memory_tri(scene, h)
+    points = [(s.x, s.y) for s in scene.supports] + [(ld.x, ld.y) for ld in scene.loads
+                                                     if isinstance(ld, PointLoad)] + [(p.x, p.y) for p in scene.pins]
+    mesh = mesh_domain(domain, h, points)
+    el = DKT()
+    p = scene.plate
+    n_full = 3 * mesh.n_nodes
+    xy = mesh.nodes[mesh.triangles]
+    cell_dofs = (mesh.triangles[:, :, None] * 3 + np.arange(3)).reshape(-1, 9)
+    Ke = el.stiffness(xy, p.D, p.nu)
+    rows = np.repeat(cell_dofs, 9, axis=1).ravel()
+    cols = np.tile(cell_dofs, (1, 9)).ravel()
+    K_full = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(n_full, n_full))
+    K_full.sum_duplicates()
+
+    f_full = np.zeros(n_full)
+    model = TriModel(scene, mesh, el, None, None, None, None, None, n_full, cell_dofs,
+                     np.arange(len(cell_dofs)), f_full, K_full)
+    for ld in scene.loads:
+        if isinstance(ld, UniformLoad):
+            f_full += np.bincount(cell_dofs.ravel(), weights=(ld.q * el.load(xy)).ravel(), minlength=n_full)
+        elif isinstance(ld, PointLoad):
+            f_full += ld.P * np.asarray(model.interpolation(ld.x, ld.y).todense()).ravel()
+    fixed, values = _prescribed(scene, mesh)
+    free = np.setdiff1d(np.arange(n_full), fixed)
+    u_c = np.zeros(n_full)
+    u_c[fixed] = values
+    model.K = K_full[free][:, free].tocsr()
+    model.f = f_full[free] - (K_full @ u_c)[free]
+    model.free, model.fixed, model.values = free, fixed, values
+    model.contacts = _contacts(scene, model)
+    return model
+
+
+def _edge_kind(scene: Scene, boundary: int, segment: int):
+    """The Edge that holds boundary edge (boundary, segment), or None if free."""
+    e = scene.edges.get("all")
+    if e is None and scene.plate.shape is None and boundary == 0:
+        e = scene.edges.get(RECT_SEGMENTS[segment])
+    return None if e is None or e.kind == "free" else e
+
+
+def _prescribed(scene: Scene, mesh: TriMesh):
+    presc: dict[int, tuple[float, str]] = {}
+
+    def put(dof, value, who):
+        if dof in presc and abs(presc[dof][0] - value) > 1e-14 * max(1.0, abs(value)):
+            raise SceneError(f"{who} and {presc[dof][1]} prescribe different values of w at their common node; "
+                             "make them agree")
+        presc[dof] = (value, who)
+
+    for (i, j), k, s in zip(mesh.edges, mesh.boundary, mesh.segment):
+        e = _edge_kind(scene, int(k), int(s))
+        if e is None:
+            continue
+        who = "edges.all" if "all" in scene.edges else f"edges.{RECT_SEGMENTS[s]}"
+        for n in (i, j):
+            put(3 * n, 0.0, who)
+            if e.kind == "clamped":
+                put(3 * n + 1, 0.0, who)
+                put(3 * n + 2, 0.0, who)
+    for i, pin in enumerate(scene.pins):
+        n = mesh.node_at(pin.x, pin.y)
+        if n is None:  # pragma: no cover - the mesher puts a node at every pin
+            raise SceneError(f"pins.{i}: no mesh node at ({pin.x}, {pin.y})")
+        put(3 * n, pin.w, f"pins.{i}")
+    fixed = np.array(sorted(presc), dtype=int)
+    return fixed, np.array([presc[d][0] for d in fixed], dtype=float)
+
+
+def _rigid_modes(model: TriModel) -> np.ndarray:
+    """Rigid motions w = α + βx + γy of each connected piece left free by the prescribed dofs."""
+    mesh: TriMesh = model.grid
+    t = mesh.triangles
+    n = mesh.n_nodes
+    A = sp.csr_matrix((np.ones(t.size * 3), (np.repeat(t, 3, axis=1).ravel(), np.tile(t, (1, 3)).ravel())),
+                      shape=(n, n))
+    _, label = connected_components(A, directed=False)
+    xy = mesh.nodes
+    modes = []
+    for comp in np.unique(label):
+        fx = model.fixed[label[model.fixed // 3] == comp]
+        node, kind = fx // 3, fx % 3
+        R = np.zeros((len(fx), 3))
+        R[kind == 0] = np.column_stack([np.ones((kind == 0).sum()), xy[node[kind == 0]]])
+        R[kind == 1, 1] = 1.0
+        R[kind == 2, 2] = 1.0
+        _, s, vt = np.linalg.svd(R if len(R) else np.zeros((1, 3)))
+        s_full = np.zeros(3)
+        s_full[: len(s)] = s
+        nodes = np.flatnonzero(label == comp)
+        for a, b, g in vt[s_full <= 1e-10 * max(1.0, s_full.max())]:
+            v = np.zeros(model.n_full)
+            v[3 * nodes] = a + b * xy[nodes, 0] + g * xy[nodes, 1]
+            v[3 * nodes + 1] = b
+            v[3 * nodes + 2] = g
+            modes.append(v[model.free])
+    return np.array(modes).T.reshape(model.n_free, len(modes))
