@@ -93,6 +93,14 @@ class TriMesh:
     def node_xy(self) -> np.ndarray:
         return self.nodes
 
+    def __getattr__(self, name: str):
+        """A rectangular grid's attribute (nx, ny, node_mask, cell_nodes, …), asked of a triangle
+        mesh by code that only works on grids (plots, nodal fields): a one-line SceneError."""
+        if name.startswith("_"):
+            raise AttributeError(name)
+        raise SceneError(f"plots, nodal fields and other grid-based output are not yet available on triangle "
+                         f"meshes (mesh.element = \"dkt\"; the grid's {name!r} was asked for)")
+
     # -- queries ------------------------------------------------------------------------
     def areas(self) -> np.ndarray:
         p = self.nodes[self.triangles]
