@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -135,7 +136,7 @@ MEMORY_ENV = "PLATEQP_MAX_MEMORY"
 def estimate_memory(scene: Scene) -> int:
     """Bytes a build and solve of ``scene`` is expected to need at its peak (see BYTES_PER_DOF)."""
     if scene.triangles:
-        from .triassembly import estimate_nodes
+        from .trimesh import estimate_nodes
         return int(BYTES_PER_DOF * 3 * estimate_nodes(scene))
     nd = len(ELEMENTS[scene.mesh.element].node_dofs)
     return int(BYTES_PER_DOF * (scene.mesh.nx + 1) * (scene.mesh.ny + 1) * nd)
@@ -182,13 +183,19 @@ def check_memory(scene: Scene) -> None:
                             f"use a coarser mesh, or raise the limit (--max-memory or ${MEMORY_ENV})")
 
 
+#: Model builders of the elements that are not on the rectangular grid, by ``mesh.element``; a
+#: module registers its own on import (:mod:`plateqp.triassembly` "dkt", imported by ``plateqp``),
+#: so that this module does not import it (no import cycle).
+MESH_BUILDERS: dict[str, Callable[[Scene], Model]] = {}
+
+
 def build_model(scene: Scene) -> Model:
     """Assemble the stiffness, loads, two-sided constraints and contact operator of a scene
     (after :func:`check_memory`: a mesh too large for the machine is refused before assembly).
-    A triangle-meshed scene (``mesh.element = "dkt"``) is built by :mod:`plateqp.triassembly`."""
-    if scene.triangles:
-        from .triassembly import build_tri_model
-        return build_tri_model(scene)
+    A scene on another mesh is built by its builder in :data:`MESH_BUILDERS` (triangles, DKT:
+    :func:`plateqp.triassembly.build_tri_model`)."""
+    if scene.mesh.element in MESH_BUILDERS:
+        return MESH_BUILDERS[scene.mesh.element](scene)
     check_memory(scene)
     grid = Grid.from_scene(scene)
     el = ELEMENTS[scene.mesh.element]()

@@ -19,16 +19,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from .assembly import BYTES_PER_DOF, Model, _contacts, human_bytes, memory_limit
+from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
 from .elements.dkt import DKT
 from .errors import ResourceError, SceneError
 from .geometry import RECT_SEGMENTS, mesh_size, scene_domain
 from .scene import PointLoad, Scene, UniformLoad
-from .trimesh import TriMesh, mesh_domain
-
-#: nodes of a gmsh mesh of area A at size h, about (measured 1.09 on the unit disc at h = 1/16)
-NODES_PER_AREA = 1.2
-
+from .trimesh import TriMesh, estimate_nodes, mesh_domain
 
 def not_on_triangles(what: str) -> SceneError:
     """The one-line error for a feature triangle meshes do not carry yet."""
@@ -64,11 +60,6 @@ class TriModel(Model):
         A = sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(tri), self.n_full))
         A.eliminate_zeros()
         return A
-
-
-def estimate_nodes(scene: Scene) -> float:
-    """About how many nodes the scene's triangle mesh has (:data:`NODES_PER_AREA` area / h²)."""
-    return NODES_PER_AREA * scene_domain(scene).area / mesh_size(scene) ** 2
 
 
 def check_memory_tri(scene: Scene, h: float) -> None:
@@ -182,3 +173,6 @@ def _rigid_modes(model: TriModel) -> np.ndarray:
             v[3 * nodes + 2] = g
             modes.append(v[model.free])
     return np.array(modes).T.reshape(model.n_free, len(modes))
+
+
+MESH_BUILDERS["dkt"] = build_tri_model
