@@ -172,3 +172,31 @@ def test_export_not_yet_on_triangles():
 
     with pytest.raises(pq.ProblemError, match="export is not yet available on triangle meshes"):
         contact_qp(disc("simple", size=R / 4, supports=posts([0.0])))
+
+
+def annulus_w(r, a, b, q, Dp, nu, kind):
+    """Deflection of an annular plate (radii b < a) under uniform q with both edges clamped or both
+    simply supported: the general axisymmetric solution w = A + B r² + C ln r + E r² ln r + q r⁴/64D
+    (Timoshenko & Woinowsky-Krieger § 62) with its four edge conditions."""
+    def rows(rr):
+        w = [1.0, rr**2, math.log(rr), rr**2 * math.log(rr)]
+        w1 = [0.0, 2 * rr, 1 / rr, 2 * rr * math.log(rr) + rr]
+        w2 = [0.0, 2.0, -1 / rr**2, 2 * math.log(rr) + 3]
+        p = q / (64 * Dp)
+        if kind == "clamped":
+            return [w, w1], [-p * rr**4, -4 * p * rr**3]
+        return [w, [w2[k] + nu * w1[k] / rr for k in range(4)]], [-p * rr**4, -(12 + 4 * nu) * p * rr**2]
+    (ra, fa), (rb, fb) = rows(a), rows(b)
+    c = np.linalg.solve(np.array(ra + rb), np.array(fa + fb))
+    return c @ [1.0, r**2, math.log(r), r**2 * math.log(r)] + q * r**4 / (64 * Dp)
+
+
+@pytest.mark.parametrize("kind", ["clamped", "simple"])
+def test_annular_plate_edges_all_holds_the_hole_too(kind):
+    """A disc with a concentric round hole, edges.all on both circles, against the closed form
+    (R/16: simple within 0.04 %, clamped 0.9 %, the narrower clamped ring being the coarser one)."""
+    sc = disc(kind, holes=[{"circle": [0.0, 0.0, 0.3]}])
+    res = pq.solve(sc)
+    for r in (0.5, 0.65, 0.8):
+        ref = annulus_w(r, R, 0.3, 1.0, sc.plate.D, NU, kind)
+        assert res.deflection(r * math.cos(0.4), r * math.sin(0.4)) == pytest.approx(ref, rel=0.015)
