@@ -26,11 +26,6 @@ from .geometry import RECT_SEGMENTS, mesh_size, scene_domain
 from .scene import PointLoad, Scene, UniformLoad
 from .trimesh import TriMesh, estimate_nodes, mesh_domain
 
-def not_on_triangles(what: str) -> SceneError:
-    """The one-line error for a feature triangle meshes do not carry yet."""
-    return SceneError(f"{what} is not yet available on triangle meshes (mesh.element = \"dkt\")")
-
-
 @dataclass
 class TriModel(Model):
     """A :class:`~plateqp.assembly.Model` on a triangle mesh (``grid`` is the :class:`TriMesh`,
@@ -40,10 +35,12 @@ class TriModel(Model):
         return _rigid_modes(self)
 
     def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
-        """(npts, n_full) sparse operator: w at points, from the full dofs (the node's w at a node,
-        the element's cubic inside). Derivatives of w: not yet available on triangles."""
-        if dx or dy:
-            raise not_on_triangles("slopes, curvatures, moments and stresses at points")
+        """(npts, n_full) sparse operator, from the full dofs, at points: w (the node's w at a node,
+        the element's cubic inside); the slopes (dx + dy = 1) and curvatures (dx + dy = 2) are
+        DKT's own, from its quadratic slope field β: w,x = βx, w,xx = βx,x, w,xy = (βx,y + βy,x)/2
+        (so moments and stresses are the element's M = −D_b κ). On an element edge: one neighbour's."""
+        if dx + dy > 2:
+            raise SceneError(f"derivatives of w of order {dx + dy} > 2 do not exist in a plate element")
         mesh: TriMesh = self.grid
         x = np.atleast_1d(np.asarray(x, dtype=float))
         y = np.atleast_1d(np.asarray(y, dtype=float))
@@ -51,11 +48,18 @@ class TriModel(Model):
         if np.any(tri < 0):
             bad = np.flatnonzero(tri < 0)[0]
             raise SceneError(f"point ({x[bad]}, {y[bad]}) is not on the plate")
-        N = self.element.shape(mesh.nodes[mesh.triangles[tri]], lam[:, None, :])[:, 0]
+        xy = mesh.nodes[mesh.triangles[tri]]
+        if dx + dy == 1:
+            N = self.element.slope_matrix(xy, lam[:, None, :])[:, 0, dy]
+        elif dx + dy == 2:
+            B = self.element.curvature_matrix(xy, lam[:, None, :])[:, 0]
+            N = B[:, 0] if dx == 2 else B[:, 1] if dy == 2 else 0.5 * B[:, 2]
+        else:
+            N = self.element.shape(xy, lam[:, None, :])[:, 0]
         dofs = self.cell_dofs[tri]
-        at_node = lam.max(axis=1) >= 1.0 - 1e-12  # a vertex: its w dof alone, no rounding noise
+        at_node = (lam.max(axis=1) >= 1.0 - 1e-12) & (dx + dy < 2)  # a vertex: its own dof, no rounding noise
         N[at_node] = 0.0
-        N[at_node, 3 * lam[at_node].argmax(axis=1)] = 1.0
+        N[at_node, 3 * lam[at_node].argmax(axis=1) + (dx + 2 * dy)] = 1.0
         rows = np.repeat(np.arange(len(tri)), 9)
         A = sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(tri), self.n_full))
         A.eliminate_zeros()

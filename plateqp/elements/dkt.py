@@ -85,18 +85,19 @@ class DKT:
         return T
 
     def curvature_matrix(self, xy, lam) -> np.ndarray:
-        """(nt, npts, 3, 9): κ = (w,xx, w,yy, 2 w,xy) = B u_e at barycentric points ``lam`` (npts, 3)."""
+        """(nt, npts, 3, 9): κ = (w,xx, w,yy, 2 w,xy) = B u_e at barycentric points ``lam``: (npts, 3),
+        the same in every triangle, or (nt, npts, 3), each triangle its own."""
         xy = _as_tris(xy)
         lam = np.atleast_2d(np.asarray(lam, dtype=float))
         G, _ = self._grad_l(xy)  # (nt, 3, 2)
         # quadratic 6-node shape functions: N_v = L_v (2 L_v − 1), N_{3+e} = 4 L_i L_j
-        dN_dL = np.zeros((lam.shape[0], 6, 3))
+        dN_dL = np.zeros(lam.shape[:-1] + (6, 3))
         for v in range(3):
-            dN_dL[:, v, v] = 4.0 * lam[:, v] - 1.0
+            dN_dL[..., v, v] = 4.0 * lam[..., v] - 1.0
         for e, (i, j) in enumerate(EDGES):
-            dN_dL[:, 3 + e, i] = 4.0 * lam[:, j]
-            dN_dL[:, 3 + e, j] = 4.0 * lam[:, i]
-        dN = np.einsum("pnk,tkd->tpnd", dN_dL, G)  # (nt, npts, 6, 2)
+            dN_dL[..., 3 + e, i] = 4.0 * lam[..., j]
+            dN_dL[..., 3 + e, j] = 4.0 * lam[..., i]
+        dN = np.einsum("pnk,tkd->tpnd" if lam.ndim == 2 else "tpnk,tkd->tpnd", dN_dL, G)  # (nt, npts, 6, 2)
         nt, npts = dN.shape[:2]
         B12 = np.zeros((nt, npts, 3, 12))
         B12[..., 0, :6] = dN[..., 0]
@@ -153,6 +154,15 @@ class DKT:
         xy = _as_tris(xy)
         _, area = self._grad_l(xy)
         return np.einsum("p,tpk->tk", CUBIC_WEIGHTS, self.shape(xy, CUBIC_POINTS)) * area[:, None]
+
+    def slope_matrix(self, xy, lam) -> np.ndarray:
+        """(nt, npts, 2, 9): the slope field β = (βx, βy) ≈ ∇w at barycentric points (as
+        :meth:`curvature_matrix` takes them): the 6-node quadratic interpolation of the nodal slopes."""
+        xy = _as_tris(xy)
+        lam = np.atleast_2d(np.asarray(lam, dtype=float))
+        N6 = np.concatenate([lam * (2 * lam - 1), 4 * lam[..., [0, 1, 2]] * lam[..., [1, 2, 0]]], axis=-1)
+        T = self.slope_transform(xy).reshape(-1, 2, 6, 9)
+        return np.einsum("pn,tdnk->tpdk" if lam.ndim == 2 else "tpn,tdnk->tpdk", N6, T)
 
     def moments(self, xy, u_e, lam, D: float, nu: float) -> np.ndarray:
         """(nt, npts, 3) moments (Mx, My, Mxy) = −D_b κ at barycentric points, from element dofs u_e (nt, 9)."""
