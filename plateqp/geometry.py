@@ -22,6 +22,7 @@ k − 1; a polygon's segment i runs from vertex i to vertex i + 1.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from typing import Callable
 
@@ -305,7 +306,7 @@ class Region:
 
 def validate_shaped(scene) -> Region:
     """The shape-specific checks of a scene with ``mesh.element`` a triangle element: the shape,
-    the holes, the edges (``all`` on a shape; the rectangle's names too on a rectangle), the mesh
+    the holes, the edge names (:func:`edge_table`), the mesh
     size, and what triangle meshes do not carry yet. Returns the Region for the point checks."""
     p, m = scene.plate, scene.mesh
     fail = scene._fail
@@ -314,11 +315,7 @@ def validate_shaped(scene) -> Region:
     if p.shape is not None:
         x0, x1, y0, y1 = domain.outer.bbox
         p.a, p.b = x1 - x0, y1 - y0  # the length scales of a shaped plate: its bounding box
-        for name in scene.edges:
-            if name != "all":
-                fail(f"edges.{name}", "a plate with a shape takes only edges.all (one kind for every boundary edge)")
-    elif "all" in scene.edges and len(scene.edges) > 1:
-        fail("edges.all", "give either edges.all or the named edges, not both")
+    edge_table(scene, domain)  # every edge name known, and no segment named twice
     for name, e in scene.edges.items():
         if e.w != 0.0 or e.slope != 0.0:
             fail(f"edges.{name}", "a prescribed w or slope is not yet available on triangle meshes")
@@ -361,3 +358,53 @@ def tidy_dict(scene, d: dict) -> None:
         del d["mesh"]["size"]
     if scene.holes:
         d["holes"] = [h.to_dict() if isinstance(h, (Polygon, Circle)) else dict(h) for h in scene.holes]
+
+
+# -- edges of a triangle-meshed plate, by name ----------------------------------------------------
+#: ``outer`` / ``holeK`` a whole boundary; ``outer_I`` / ``holeK_I`` segment I of a polygon (from
+#: vertex I to I + 1); ``outer_I-J`` / ``holeK_I-J`` segments I to J. Bare TOML keys, no quoting.
+EDGE_KEY = re.compile(r"^(outer|hole(\d+))(?:_(\d+)(?:-(\d+))?)?$")
+
+
+def edge_table(scene, domain: Domain) -> dict[tuple[int, int], tuple[str, object]]:
+    """(boundary, segment) → (edge name, Edge) for every segment of every boundary that an edge
+    name holds (a circle is one segment, 0); the most specific name wins: a segment range over a
+    whole boundary (``outer``, ``holeK``, or a rectangle's ``left``/``right``/``bottom``/``top``)
+    over ``all``. A name that is not one of these, or a segment two names of the same kind hold,
+    is a SceneError."""
+    shapes = (domain.outer, *domain.holes)
+    nseg = [len(s.vertices) if isinstance(s, Polygon) else 1 for s in shapes]
+    levels: list[dict[tuple[int, int], str]] = [{}, {}, {}]  # all, boundary, segments
+    for name in scene.edges:
+        where = f"edges.{name}"
+        if name == "all":
+            targets, level = [(k, i) for k in range(len(shapes)) for i in range(nseg[k])], 0
+        elif name in RECT_SEGMENTS and scene.plate.shape is None:
+            targets, level = [(0, RECT_SEGMENTS.index(name))], 2
+        else:
+            m = EDGE_KEY.match(name)
+            if m is None:
+                names = "all, outer, outer_I, outer_I-J, holeK, holeK_I, holeK_I-J" + (
+                    ", left, right, bottom, top" if scene.plate.shape is None else "")
+                scene._fail(where, f"unknown edge; on a triangle mesh edges are {names}")
+            k = 0 if m.group(2) is None else int(m.group(2)) + 1
+            if k > len(domain.holes):
+                scene._fail(where, f"there is no hole {k - 1} (the plate has {len(domain.holes)} holes)")
+            if m.group(3) is None:
+                targets, level = [(k, i) for i in range(nseg[k])], 1
+            else:
+                i, j = int(m.group(3)), int(m.group(4) or m.group(3))
+                if isinstance(shapes[k], Circle):
+                    scene._fail(where, "a circle has no segments; name the whole boundary")
+                if not i <= j < nseg[k]:
+                    scene._fail(where, f"segments {i} to {j} are not segments 0 to {nseg[k] - 1} of that polygon")
+                targets, level = [(k, s) for s in range(i, j + 1)], 2
+        for t in targets:
+            if t in levels[level]:
+                scene._fail(where, f"edges.{levels[level][t]} holds segment {t[1]} of that boundary too; "
+                            "name each segment once")
+            levels[level][t] = name
+    table = {}
+    for level in levels:
+        table.update({t: (name, scene.edges[name]) for t, name in level.items()})
+    return table

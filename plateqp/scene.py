@@ -308,7 +308,7 @@ class Scene:
             self._fail("plate.shape" if self.plate.shape is not None else "holes" if self.holes else "mesh.size",
                        'needs a triangle mesh: set mesh.element = "dkt"')
         for name, e in self.edges.items():
-            if name not in EDGE_NAMES and not (self.triangles and name == "all"):
+            if name not in EDGE_NAMES and not self.triangles:  # triangles: geometry.edge_table
                 self._fail(f"edges.{name}", f"unknown edge; edges are {EDGE_NAMES}")
             if e.kind not in EDGE_KINDS:
                 self._fail(f"edges.{name}", f"unknown kind {e.kind!r}; choose one of {EDGE_KINDS}")

@@ -4,11 +4,12 @@ The mesh (:mod:`plateqp.trimesh`) has a node at every support, point load and pi
 carries the dofs 3n, 3n + 1, 3n + 2 = (w, ∂w/∂x, ∂w/∂y), as on the ACM grid, so the contact
 code (scaling, rigid modes, formulations, KKT) reads a :class:`TriModel` as it reads a Model.
 
-Two-sided edges (``edges.all`` on a shape; ``left``/``right``/``bottom``/``top`` or ``all`` on a
-rectangle meshed with triangles): **simple** prescribes w = 0 at the edge's nodes and nothing
+Two-sided edges, by name (:func:`plateqp.geometry.edge_table`: ``all``, a whole boundary ``outer``
+or ``holeK``, polygon segments ``outer_I``, ``outer_I-J``, ``holeK_I-J``, and on a rectangle
+``left``/``right``/``bottom``/``top``): **simple** prescribes w = 0 at the edge's nodes and nothing
 else, the rotations stay free (imposing the tangential slope too would make a curved simple
 support converge to the clamped plate: Babuška's paradox); **clamped** also prescribes both
-slopes (w = 0 along the edge and ∂w/∂n = 0). Holes' edges take ``edges.all`` (free without it).
+slopes (w = 0 along the edge and ∂w/∂n = 0). An edge no name holds is free.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from scipy.sparse.csgraph import connected_components
 from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
 from .elements.dkt import DKT
 from .errors import ResourceError, SceneError
-from .geometry import RECT_SEGMENTS, mesh_size, scene_domain
+from .geometry import edge_table, mesh_size, scene_domain
 from .scene import PointLoad, Scene, UniformLoad
 from .trimesh import TriMesh, estimate_nodes, mesh_domain
 
@@ -113,14 +114,6 @@ def build_tri_model(scene: Scene) -> TriModel:
     return model
 
 
-def _edge_kind(scene: Scene, boundary: int, segment: int):
-    """The Edge that holds boundary edge (boundary, segment), or None if free."""
-    e = scene.edges.get("all")
-    if e is None and scene.plate.shape is None and boundary == 0:
-        e = scene.edges.get(RECT_SEGMENTS[segment])
-    return None if e is None or e.kind == "free" else e
-
-
 def _prescribed(scene: Scene, mesh: TriMesh):
     presc: dict[int, tuple[float, str]] = {}
 
@@ -130,11 +123,12 @@ def _prescribed(scene: Scene, mesh: TriMesh):
                              "make them agree")
         presc[dof] = (value, who)
 
+    table = edge_table(scene, mesh.domain)
     for (i, j), k, s in zip(mesh.edges, mesh.boundary, mesh.segment):
-        e = _edge_kind(scene, int(k), int(s))
-        if e is None:
+        name, e = table.get((int(k), int(s)), (None, None))
+        if e is None or e.kind == "free":
             continue
-        who = "edges.all" if "all" in scene.edges else f"edges.{RECT_SEGMENTS[s]}"
+        who = f"edges.{name}"
         for n in (i, j):
             put(3 * n, 0.0, who)
             if e.kind == "clamped":

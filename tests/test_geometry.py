@@ -90,7 +90,13 @@ BAD = [
     ("hole-circle-polygon", lambda t: t + "\n[[holes]]\npolygon = [[0.6, 0.4], [1.2, 0.4], [1.2, 0.8]]\n", "holes.1",
      "overlaps"),
     ("shape-on-acm", sub('element = "dkt"', 'element = "acm"'), "plate.shape", "dkt"),
-    ("named-edge-on-shape", sub('all = "simple"', 'left = "simple"'), "edges.left", "edges.all"),
+    ("named-edge-on-shape", sub('all = "simple"', 'left = "simple"'), "edges.left", "unknown edge"),
+    ("edge-no-such-hole", sub('all = "simple"', 'hole1 = "simple"'), "edges.hole1", "no hole 1"),
+    ("edge-circle-segment", sub('all = "simple"', 'hole0_0 = "simple"'), "edges.hole0_0", "no segments"),
+    ("edge-segment-range", sub('all = "simple"', 'outer_4-6 = "simple"'), "edges.outer_4-6", "segments 0 to 5"),
+    ("edge-reversed-range", sub('all = "simple"', 'outer_3-1 = "simple"'), "edges.outer_3-1", "not segments"),
+    ("edge-named-twice", sub('all = "simple"', 'outer_0-2 = "simple"\nouter_2 = "clamped"'), "edges.outer_2",
+     "holds segment 2"),
     ("no-size", sub("size = 0.25", ""), "mesh.size", "size = h"),
     ("bad-size", sub("size = 0.25", "size = -1.0"), "mesh.size", "> 0"),
     ("support-in-hole", sub("x = 1.5\ny = 0.5", "x = 0.5\ny = 0.5"), "supports.0", "in a hole"),
@@ -120,6 +126,17 @@ def test_rectangle_with_triangles_keeps_named_edges(tmp_path):
         pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), holes=[{"circle": [0.5, 0.5, 0.2]}])
     with pytest.raises(pq.SceneError, match="edges.all: unknown edge"):
         pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), edges={"all": pq.Edge("simple")})
+
+
+def test_edge_names_resolve_most_specific_first():
+    from plateqp.geometry import edge_table, scene_domain
+
+    sc = pq.Scene(plate=pq.Plate(shape={"polygon": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]}),
+                  mesh=pq.MeshSpec(element="dkt", size=0.25), holes=[{"circle": [0.5, 0.5, 0.2]}],
+                  edges={"all": pq.Edge("simple"), "outer": pq.Edge("free"), "outer_1-2": pq.Edge("clamped")})
+    t = {k: name for k, (name, _) in edge_table(sc, scene_domain(sc)).items()}
+    assert t == {(0, 0): "outer", (0, 1): "outer_1-2", (0, 2): "outer_1-2", (0, 3): "outer", (0, 4): "outer",
+                 (0, 5): "outer", (1, 0): "all"}
 
 
 def test_domain_covers_is_the_plate():

@@ -93,6 +93,21 @@ def test_rectangle_on_triangles_against_acm():
         assert dkt.deflection(x, y) == pytest.approx(acm.deflection(x, y), rel=0.02)
 
 
+def test_l_shape_by_segments_against_acm():
+    """An L-shaped polygon with its outer segments clamped by name (outer_0-1, outer_4-5) and the
+    re-entrant ones free, against ACM's grid of the same L (a square less a cut-out, whose
+    cut-out edges are free): within 1 % at points in all three arms and by the re-entrant corner."""
+    L = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]
+    dkt = pq.solve(pq.Scene(plate=pq.Plate(shape={"polygon": L}), mesh=pq.MeshSpec(element="dkt", size=1 / 16),
+                            edges={"outer_0-1": pq.Edge("clamped"), "outer_4-5": pq.Edge("clamped")},
+                            loads=[pq.UniformLoad(1.0)]))
+    acm = pq.solve(pq.Scene(plate=pq.Plate(a=2.0, b=2.0), mesh=pq.MeshSpec(32, 32, "acm"),
+                            openings=[pq.Opening(1.0, 2.0, 1.0, 2.0)], loads=[pq.UniformLoad(1.0)],
+                            edges={k: pq.Edge("clamped") for k in ("left", "right", "bottom", "top")}))
+    for x, y in [(0.5, 0.5), (1.5, 0.5), (0.5, 1.5), (1.5, 0.9), (0.9, 0.9)]:
+        assert dkt.deflection(x, y) == pytest.approx(acm.deflection(x, y), rel=0.01)
+
+
 def posts(gaps, r=0.6):
     return [pq.Support(r * math.cos(t), r * math.sin(t), gap=g)
             for t, g in zip(np.arange(len(gaps)) * 2 * math.pi / len(gaps), gaps)]
