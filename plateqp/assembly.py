@@ -120,6 +120,15 @@ class Model:
         rows = np.repeat(np.arange(len(cell)), N.shape[1])
         return sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(cell), self.n_full))
 
+    def bed_areas(self) -> np.ndarray:
+        """(n_nodes,) each node's tributary area of the scene's tensionless bed: a quarter of every
+        kept cell centred in the bed's region (the whole plate without one) that has it as a corner."""
+        grid, fnd = self.grid, self.scene.foundation
+        x0, x1, y0, y1 = fnd.region if fnd.region is not None else (0.0, grid.a, 0.0, grid.b)
+        area = np.zeros(grid.n_nodes)
+        np.add.at(area, grid.cell_nodes()[grid.cells_centred_in(x0, x1, y0, y1)].ravel(), 0.25 * grid.hx * grid.hy)
+        return area
+
     def grid_cell_dofs(self, cell: np.ndarray) -> np.ndarray:
         nd = self.element.ndof_node
         nodes = self.grid.cell_nodes()[cell]
@@ -430,9 +439,7 @@ def _contacts(scene: Scene, model: Model) -> ContactOperator | None:
         index.append(np.arange(len(sx)))
     if scene.foundation is not None:
         fnd = scene.foundation
-        x0, x1, y0, y1 = fnd.region if fnd.region is not None else (0.0, grid.a, 0.0, grid.b)
-        area = np.zeros(grid.n_nodes)
-        np.add.at(area, grid.cell_nodes()[grid.cells_centred_in(x0, x1, y0, y1)].ravel(), 0.25 * grid.hx * grid.hy)
+        area = model.bed_areas()
         nodes = np.flatnonzero(area > 0)
         wdof = nodes * nd
         nodes = nodes[free_pos[wdof] >= 0]  # a node whose w is prescribed gives its bed force to that support

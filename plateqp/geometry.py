@@ -303,6 +303,11 @@ class Region:
     def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
         return self.domain.covers_area(x0, x1, y0, y1)
 
+    def cells_centred_in(self, x0: float, x1: float, y0: float, y1: float) -> np.ndarray:
+        """Not empty if the box overlaps the plate (a bed region there has triangles, at a mesh
+        size below the box's)."""
+        return np.ones(int(self.covers_area(x0, x1, y0, y1)), dtype=int)
+
 
 def validate_shaped(scene) -> Region:
     """The shape-specific checks of a scene with ``mesh.element`` a triangle element: the shape,
@@ -331,8 +336,6 @@ def validate_shaped(scene) -> Region:
             fail("mesh.size", f"{m.size!r} would make about {n:.1g} triangles, more than any plate needs")
     if scene.openings:
         fail("openings", "cut-outs of whole cells are for rectangle meshes; on a triangle mesh use [[holes]]")
-    if scene.foundation is not None:
-        fail("foundation", "a tensionless bed is not yet available on triangle meshes (mesh.element = \"dkt\")")
     for i, ld in enumerate(scene.loads):
         if getattr(ld, "type", None) == "patch":
             fail(f"loads.{i}", "a patch load is not yet available on triangle meshes (mesh.element = \"dkt\")")

@@ -35,6 +35,21 @@ class TriModel(Model):
     def rigid_modes(self) -> np.ndarray:
         return _rigid_modes(self)
 
+    def bed_areas(self) -> np.ndarray:
+        """(n_nodes,) each node's tributary area of the scene's tensionless bed: a third of every
+        triangle whose centroid lies in the bed's region (the whole plate without one)."""
+        mesh: TriMesh = self.grid
+        c = mesh.nodes[mesh.triangles].mean(axis=1)
+        inside = np.ones(len(c), dtype=bool)
+        if self.scene.foundation.region is not None:
+            x0, x1, y0, y1 = self.scene.foundation.region
+            inside = (c[:, 0] >= x0) & (c[:, 0] <= x1) & (c[:, 1] >= y0) & (c[:, 1] <= y1)
+        if not inside.any():
+            raise SceneError(f"foundation.region: {self.scene.foundation.region} holds the centroid of no triangle "
+                             "of the mesh; make it larger than mesh.size")
+        return np.bincount(mesh.triangles[inside].ravel(), weights=np.repeat(mesh.areas()[inside] / 3, 3),
+                           minlength=mesh.n_nodes)
+
     def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
         """(npts, n_full) sparse operator, from the full dofs, at points: w (the node's w at a node,
         the element's cubic inside); the slopes (dx + dy = 1) and curvatures (dx + dy = 2) are

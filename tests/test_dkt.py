@@ -72,7 +72,7 @@ def test_assembled_patch_test():
 
 
 def test_uniform_load_is_statically_exact():
-    """Consistent load of a unit pressure: the w-loads add to the area, and their moment about the
+    """Lumped load of a unit pressure: the w-loads add to the area, and their moment about the
     origin to the area's first moment (the centroid), exactly."""
     f = DKT().load(TRI)[0]
     area = 0.5 * abs((TRI[1, 0] - TRI[0, 0]) * (TRI[2, 1] - TRI[0, 1]) - (TRI[2, 0] - TRI[0, 0]) * (TRI[1, 1] - TRI[0, 1]))

@@ -101,7 +101,8 @@ BAD = [
     ("bad-size", sub("size = 0.25", "size = -1.0"), "mesh.size", "> 0"),
     ("support-in-hole", sub("x = 1.5\ny = 0.5", "x = 0.5\ny = 0.5"), "supports.0", "in a hole"),
     ("support-in-notch", sub("x = 1.5\ny = 0.5", "x = 1.5\ny = 1.5"), "supports.0", "outside its shape"),
-    ("bed-on-triangles", lambda t: t + "\n[foundation]\nk = 100.0\n", "foundation", "not yet available"),
+    ("bed-off-the-plate", lambda t: t + "\n[foundation]\nk = 100.0\nregion = [1.2, 1.8, 1.2, 1.8]\n",
+     "foundation.region", "holds the centre of no cell"),
     ("patch-on-triangles", lambda t: t + '\n[[loads]]\ntype = "patch"\nq = 1.0\nx0 = 0\nx1 = 1\ny0 = 0\ny1 = 1\n',
      "loads.1", "not yet available"),
 ]

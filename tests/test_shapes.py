@@ -234,3 +234,40 @@ def test_annular_plate_edges_all_holds_the_hole_too(kind):
     for r in (0.5, 0.65, 0.8):
         ref = annulus_w(r, R, 0.3, 1.0, sc.plate.D, NU, kind)
         assert res.deflection(r * math.cos(0.4), r * math.sin(0.4)) == pytest.approx(ref, rel=0.015)
+
+
+def test_free_disc_on_a_bed_sinks_by_q_over_k():
+    """A free disc on a tensionless bed (no gap) under uniform q: a rigid translation w = q / k,
+    exactly (lumped load and lumped bed springs share the tributary areas); the bed carries it all."""
+    sc = disc(edge=None, size=R / 8, loads=[pq.UniformLoad(2.0)], foundation=pq.Foundation(k=100.0))
+    res = pq.solve(sc, accuracy="high")
+    assert res.kkt.ok and np.all(res.active)
+    assert res.deflection(np.array([0.0, 0.5, -0.3]), np.array([0.0, 0.7, 0.9])) == pytest.approx(0.02, rel=1e-7)
+    assert res.reactions.sum() == pytest.approx(total_load(res.model), rel=1e-10)
+    assert res.model.bed_areas().sum() == pytest.approx(res.model.grid.areas().sum(), rel=1e-12)
+
+
+def test_point_load_on_a_bed_against_hertz():
+    """A disc on an elastic bed (two-sided, solve_bilateral) under a central point load, radius
+    6.7 times the characteristic length ℓ = (D/k)^¼: Hertz's infinite plate, w0 = P / (8 √(k D))."""
+    ell = 0.15
+    k = D / ell**4
+    sc = disc(edge=None, loads=[pq.PointLoad(1.0, 0.0, 0.0)], foundation=pq.Foundation(k=k))
+    res = pq.solve_bilateral(sc)
+    assert w0(res) == pytest.approx(1.0 / (8 * math.sqrt(k * D)), rel=0.01)
+    assert res.reactions.sum() == pytest.approx(1.0, rel=1e-10)
+    one = pq.solve(sc, model=res.model)  # tensionless: the rim lifts off, the centre sinks deeper
+    assert one.kkt.ok and w0(one) > w0(res) and not np.all(one.active)
+
+
+def test_bed_region_on_a_polygon():
+    """A bed over part of a free square (its left half): the right half cantilevers, so its far
+    edge deflects more than the bedded left one; the bed carries the whole load."""
+    sq = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    sc = pq.Scene(plate=pq.Plate(shape={"polygon": sq}), mesh=pq.MeshSpec(element="dkt", size=1 / 8),
+                  loads=[pq.UniformLoad(1.0)], foundation=pq.Foundation(k=1e4, region=[0.0, 0.5, 0.0, 1.0]))
+    res = pq.solve(sc)
+    assert res.kkt.ok and res.reactions.sum() == pytest.approx(1.0, rel=1e-8)
+    # the region is resolved to the mesh (triangles whose centroid lies in it): within a strip h/2 wide
+    assert res.model.bed_areas().sum() == pytest.approx(0.5, abs=0.5 * (1 / 8) * 1.0)
+    assert res.deflection(1.0, 0.5) > res.deflection(0.0, 0.5)
