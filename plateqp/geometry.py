@@ -316,6 +316,10 @@ def validate_shaped(scene) -> Region:
     p, m = scene.plate, scene.mesh
     fail = scene._fail
     domain = scene_domain(scene)
+    # shapes given in Python as Polygon/Circle are kept in their scene form (as TOML gives them)
+    if p.shape is not None:
+        p.shape = domain.outer.to_dict() if isinstance(p.shape, (Polygon, Circle)) else p.shape
+    scene.holes = [h.to_dict() if isinstance(h, (Polygon, Circle)) else h for h in scene.holes]
     check_holes(domain.outer, list(domain.holes), fail)
     if p.shape is not None:
         x0, x1, y0, y1 = domain.outer.bbox

@@ -140,6 +140,14 @@ def test_edge_names_resolve_most_specific_first():
                  (0, 5): "outer", (1, 0): "all"}
 
 
+def test_shapes_given_in_python_save_as_toml(tmp_path):
+    sc = pq.Scene(plate=pq.Plate(shape=Circle(0.0, 0.0, 2.0)), mesh=pq.MeshSpec(element="dkt", size=0.5),
+                  holes=[Polygon(((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)))])
+    back = pq.Scene.from_toml(write(tmp_path, sc.to_toml()))
+    assert back.plate.shape == {"circle": [0.0, 0.0, 2.0]} and back.holes == [{"polygon": [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]}]
+    assert (back.plate.a, back.plate.b) == (4.0, 4.0)
+
+
 def test_domain_covers_is_the_plate():
     """Points of an L-shape with a round hole: in the plate, in the notch, in the hole, on edges."""
     d = Domain(Polygon(((0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2))), (Circle(0.5, 0.5, 0.2),))
