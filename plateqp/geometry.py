@@ -325,9 +325,6 @@ def validate_shaped(scene) -> Region:
         x0, x1, y0, y1 = domain.outer.bbox
         p.a, p.b = x1 - x0, y1 - y0  # the length scales of a shaped plate: its bounding box
     edge_table(scene, domain)  # every edge name known, and no segment named twice
-    for name, e in scene.edges.items():
-        if e.w != 0.0 or e.slope != 0.0:
-            fail(f"edges.{name}", "a prescribed w or slope is not yet available on triangle meshes")
     if m.size is None:
         if p.shape is not None:
             fail("mesh.size", "a plate with a shape needs the element size h: [mesh] size = h")

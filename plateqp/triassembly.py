@@ -6,10 +6,13 @@ code (scaling, rigid modes, formulations, KKT) reads a :class:`TriModel` as it r
 
 Two-sided edges, by name (:func:`plateqp.geometry.edge_table`: ``all``, a whole boundary ``outer``
 or ``holeK``, polygon segments ``outer_I``, ``outer_I-J``, ``holeK_I-J``, and on a rectangle
-``left``/``right``/``bottom``/``top``): **simple** prescribes w = 0 at the edge's nodes and nothing
-else, the rotations stay free (imposing the tangential slope too would make a curved simple
-support converge to the clamped plate: Babuška's paradox); **clamped** also prescribes both
-slopes (w = 0 along the edge and ∂w/∂n = 0). An edge no name holds is free.
+``left``/``right``/``bottom``/``top``): **simple** prescribes w (the edge's ``w``, 0 by default)
+at its nodes and nothing else, the rotations stay free (imposing the tangential slope too would
+make a curved simple support converge to the clamped plate: Babuška's paradox); **clamped** also
+prescribes both
+slopes, ∇w = (∂w/∂n) n with ∂w/∂n the edge's ``slope`` (w is constant along the edge; n the node's
+outward normal, the mean of its two edges' on a curve; at a corner ∇w meets both edges' slopes).
+An edge no name holds is free.
 """
 
 from __future__ import annotations
@@ -133,22 +136,25 @@ def _prescribed(scene: Scene, mesh: TriMesh):
     presc: dict[int, tuple[float, str]] = {}
 
     def put(dof, value, who):
-        if dof in presc and abs(presc[dof][0] - value) > 1e-14 * max(1.0, abs(value)):
-            raise SceneError(f"{who} and {presc[dof][1]} prescribe different values of w at their common node; "
-                             "make them agree")
+        if dof in presc and abs(presc[dof][0] - value) > 1e-12 * max(1.0, abs(value), abs(presc[dof][0])):
+            raise SceneError(f"{who} and {presc[dof][1]} prescribe different values of "
+                             f"{DKT.dof_names[dof % 3]} at their common node; make them agree")
         presc[dof] = (value, who)
 
     table = edge_table(scene, mesh.domain)
-    for (i, j), k, s in zip(mesh.edges, mesh.boundary, mesh.segment):
+    clamped: dict[int, list] = {}  # node -> [(outward normal, slope, who)] of its clamped edges
+    for (i, j), k, s, normal in zip(mesh.edges, mesh.boundary, mesh.segment, mesh.normals):
         name, e = table.get((int(k), int(s)), (None, None))
         if e is None or e.kind == "free":
             continue
         who = f"edges.{name}"
         for n in (i, j):
-            put(3 * n, 0.0, who)
+            put(3 * n, e.w, who)
             if e.kind == "clamped":
-                put(3 * n + 1, 0.0, who)
-                put(3 * n + 2, 0.0, who)
+                clamped.setdefault(int(n), []).append((normal, e.slope, who))
+    for n, held in clamped.items():
+        for dof, value in zip((3 * n + 1, 3 * n + 2), _gradient(held)):
+            put(dof, value, held[0][2])
     for i, pin in enumerate(scene.pins):
         n = mesh.node_at(pin.x, pin.y)
         if n is None:  # pragma: no cover - the mesher puts a node at every pin
@@ -156,6 +162,24 @@ def _prescribed(scene: Scene, mesh: TriMesh):
         put(3 * n, pin.w, f"pins.{i}")
     fixed = np.array(sorted(presc), dtype=int)
     return fixed, np.array([presc[d][0] for d in fixed], dtype=float)
+
+
+def _gradient(held) -> np.ndarray:
+    """∇w at a node of clamped edges [(outward normal, ∂w/∂n, who)]: w is constant along each, so
+    ∇w = (∂w/∂n) n. Along a smooth boundary (normals within 10°: a curve's two chords) n is their
+    mean direction and the slope their mean; at a corner every edge asks its own (∂w/∂n) n, and
+    they must agree (as on the rectangles: only zero slopes meet at a clamped corner)."""
+    N = np.array([h[0] for h in held])
+    s = np.array([h[1] for h in held])
+    mean = N.sum(axis=0)
+    if np.all(N @ mean / np.linalg.norm(mean) >= np.cos(np.radians(10.0))):
+        return s.mean() * mean / np.linalg.norm(mean)
+    g = s[:, None] * N
+    bad = np.flatnonzero(np.abs(g - g[0]).max(axis=1) > 1e-12 * max(np.abs(g).max(), 1e-300))
+    if bad.size:
+        raise SceneError(f"{held[0][2]} and {held[bad[0]][2]} prescribe different slopes at their common corner "
+                         "(w is constant along each clamped edge); make the slopes there zero")
+    return g[0]
 
 
 def _rigid_modes(model: TriModel) -> np.ndarray:

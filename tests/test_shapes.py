@@ -25,7 +25,7 @@ R, NU = 1.0, 0.3
 def disc(edge="clamped", size=R / 16, loads=None, **kw) -> pq.Scene:
     return pq.Scene(name="disc", plate=pq.Plate(shape={"circle": [0.0, 0.0, R]}, h=0.01, E=1.0e7, nu=NU),
                     mesh=pq.MeshSpec(element="dkt", size=size),
-                    edges={"all": pq.Edge(edge)} if edge else {},
+                    edges=kw.pop("edges", {"all": pq.Edge(edge)} if edge else {}),
                     loads=loads if loads is not None else [pq.UniformLoad(1.0)], **kw)
 
 
@@ -327,3 +327,29 @@ def test_command_line_solve_on_a_shape(tmp_path, capsys, form):
     edge = -(m.K_full @ ref.u - m.f_full)[m.fixed]
     assert ref.reactions.sum() + edge.sum() == pytest.approx(total_load(m), rel=1e-8)
     assert out["w_max"] == pytest.approx(float(np.abs(ref.u[0::3]).max() * np.sign(ref.u[0::3][np.abs(ref.u[0::3]).argmax()])))
+
+
+def test_prescribed_edge_w_and_slope_on_a_circle():
+    """The source paper's w = f1, ∂w/∂n = f2 on a curved edge, against the axisymmetric closed
+    forms: a clamped edge raised by δ moves the unloaded disc rigidly; a clamped edge at slope s
+    bends it to w = s (r² − R²)/2R; a simple edge at δ adds δ to the simply supported plate."""
+    delta, s = 1e-3, 2e-3
+    res = pq.solve(disc(edge=None, loads=[], edges={"all": pq.Edge("clamped", w=delta)}))
+    assert res.deflection(np.array([0.0, 0.4, -0.7]), np.array([0.0, 0.3, 0.2])) == pytest.approx(delta, rel=1e-9)
+    res = pq.solve(disc(edge=None, loads=[], edges={"all": pq.Edge("clamped", slope=s)}))
+    for r in (0.0, 0.5):
+        assert res.deflection(r, 0.0) == pytest.approx(s * (r * r - R * R) / (2 * R), rel=0.01)
+    res = pq.solve(disc(edge=None, edges={"all": pq.Edge("simple", w=delta)}))
+    assert w0(res) == pytest.approx(delta + SIMPLE, rel=0.01)
+    # a straight clamped edge at slope s, the rest free, no load: the rigid rotation w = −s x, exactly
+    sq = pq.Scene(plate=pq.Plate(shape={"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]]}),
+                  mesh=pq.MeshSpec(element="dkt", size=0.25), edges={"outer_3": pq.Edge("clamped", slope=s)})
+    res = pq.solve(sq)
+    assert res.deflection(np.array([1.0, 0.3]), np.array([0.5, 0.9])) == pytest.approx([-s, -0.3 * s], rel=1e-9)
+    with pytest.raises(pq.SceneError, match="edges.outer_0 and edges.outer_3 prescribe different slopes"):
+        pq.solve(pq.Scene(plate=sq.plate, mesh=sq.mesh, edges={"outer_0": pq.Edge("clamped", slope=s),
+                                                                 "outer_3": pq.Edge("clamped", slope=s)}))
+    with pytest.raises(pq.SceneError, match="different values of w"):
+        pq.solve(pq.Scene(plate=pq.Plate(shape={"polygon": [[0, 0], [1, 0], [1, 1], [0, 1]]}),
+                          mesh=pq.MeshSpec(element="dkt", size=0.25), loads=[pq.UniformLoad(1.0)],
+                          edges={"outer_0": pq.Edge("simple", w=delta), "outer_1": pq.Edge("simple")}))
