@@ -180,7 +180,10 @@ def mesh_domain(domain: Domain, size: float, points=()) -> TriMesh:
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
         gmsh.option.setNumber("Mesh.ElementOrder", 1)
         gmsh.model.add(name)
-        return _mesh(gmsh, domain, float(size), points)
+        try:
+            return _mesh(gmsh, domain, float(size), points)
+        except Exception as exn:  # gmsh raises plain Exceptions with its own message
+            raise SceneError(f"mesh: gmsh could not mesh the plate at size {size:g} ({str(exn).splitlines()[0]})") from exn
     finally:
         if owner:
             gmsh.finalize()

@@ -86,3 +86,15 @@ def test_missing_gmsh_is_one_clear_line(monkeypatch):
     with pytest.raises(pq.SceneError, match=r"needs gmsh: pip install 'plateqp\[shapes\]'") as info:
         pq.solve(sc)
     assert "\n" not in str(info.value)
+
+
+def test_a_gmsh_failure_is_one_clear_line(monkeypatch):
+    import plateqp.trimesh as tm
+
+    def fail(*args):
+        raise Exception("Invalid boundary mesh (overlapping facets) on surface 1\nmore detail")
+
+    monkeypatch.setattr(tm, "_mesh", fail)
+    with pytest.raises(pq.SceneError, match=r"^mesh: gmsh could not mesh the plate at size 0.5 \(Invalid boundary") as info:
+        mesh_domain(Domain(L_POLY), 0.5)
+    assert "\n" not in str(info.value) and not gmsh.isInitialized()
