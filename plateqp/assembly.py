@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -119,6 +120,15 @@ class Model:
         rows = np.repeat(np.arange(len(cell)), N.shape[1])
         return sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(cell), self.n_full))
 
+    def bed_areas(self) -> np.ndarray:
+        """(n_nodes,) each node's tributary area of the scene's tensionless bed: a quarter of every
+        kept cell centred in the bed's region (the whole plate without one) that has it as a corner."""
+        grid, fnd = self.grid, self.scene.foundation
+        x0, x1, y0, y1 = fnd.region if fnd.region is not None else (0.0, grid.a, 0.0, grid.b)
+        area = np.zeros(grid.n_nodes)
+        np.add.at(area, grid.cell_nodes()[grid.cells_centred_in(x0, x1, y0, y1)].ravel(), 0.25 * grid.hx * grid.hy)
+        return area
+
     def grid_cell_dofs(self, cell: np.ndarray) -> np.ndarray:
         nd = self.element.ndof_node
         nodes = self.grid.cell_nodes()[cell]
@@ -134,6 +144,9 @@ MEMORY_ENV = "PLATEQP_MAX_MEMORY"
 
 def estimate_memory(scene: Scene) -> int:
     """Bytes a build and solve of ``scene`` is expected to need at its peak (see BYTES_PER_DOF)."""
+    if scene.triangles:
+        from .trimesh import estimate_nodes
+        return int(BYTES_PER_DOF * 3 * estimate_nodes(scene))
     nd = len(ELEMENTS[scene.mesh.element].node_dofs)
     return int(BYTES_PER_DOF * (scene.mesh.nx + 1) * (scene.mesh.ny + 1) * nd)
 
@@ -179,9 +192,19 @@ def check_memory(scene: Scene) -> None:
                             f"use a coarser mesh, or raise the limit (--max-memory or ${MEMORY_ENV})")
 
 
+#: Model builders of the elements that are not on the rectangular grid, by ``mesh.element``; a
+#: module registers its own on import (:mod:`plateqp.triassembly` "dkt", imported by ``plateqp``),
+#: so that this module does not import it (no import cycle).
+MESH_BUILDERS: dict[str, Callable[[Scene], Model]] = {}
+
+
 def build_model(scene: Scene) -> Model:
     """Assemble the stiffness, loads, two-sided constraints and contact operator of a scene
-    (after :func:`check_memory`: a mesh too large for the machine is refused before assembly)."""
+    (after :func:`check_memory`: a mesh too large for the machine is refused before assembly).
+    A scene on another mesh is built by its builder in :data:`MESH_BUILDERS` (triangles, DKT:
+    :func:`plateqp.triassembly.build_tri_model`)."""
+    if scene.mesh.element in MESH_BUILDERS:
+        return MESH_BUILDERS[scene.mesh.element](scene)
     check_memory(scene)
     grid = Grid.from_scene(scene)
     el = ELEMENTS[scene.mesh.element]()
@@ -277,6 +300,9 @@ def _csr_from_blocks(V, cnode, pos, ncol):
 
 
 def _loads(scene, grid, el, cells, cell_dofs, n_full) -> np.ndarray:
+    if scene.triangles:  # a model re-used with new loads (sweeps): rectangles only so far
+        raise SceneError('re-using a model with new loads (sweeps) is not yet available on triangle meshes '
+                         '(mesh.element = "dkt")')
     hx, hy = grid.hx, grid.hy
     f = np.zeros(n_full)
     for ld in scene.loads:
@@ -413,9 +439,7 @@ def _contacts(scene: Scene, model: Model) -> ContactOperator | None:
         index.append(np.arange(len(sx)))
     if scene.foundation is not None:
         fnd = scene.foundation
-        x0, x1, y0, y1 = fnd.region if fnd.region is not None else (0.0, grid.a, 0.0, grid.b)
-        area = np.zeros(grid.n_nodes)
-        np.add.at(area, grid.cell_nodes()[grid.cells_centred_in(x0, x1, y0, y1)].ravel(), 0.25 * grid.hx * grid.hy)
+        area = model.bed_areas()
         nodes = np.flatnonzero(area > 0)
         wdof = nodes * nd
         nodes = nodes[free_pos[wdof] >= 0]  # a node whose w is prescribed gives its bed force to that support

@@ -165,6 +165,8 @@ def confirm(est: ErrorEstimate, final: Result, order: float = ORDER) -> ErrorEst
 
 
 def with_mesh(scene: Scene, nx: int, ny: int) -> Scene:
+    if scene.triangles:
+        raise SceneError('convergence by mesh refinement is not yet available on triangle meshes (mesh.element = "dkt")')
     sc = copy.deepcopy(scene)
     sc.mesh.nx, sc.mesh.ny = int(nx), int(ny)
     sc.validate()
@@ -189,6 +191,8 @@ def auto_tolerance(scene: Scene, solve: Callable[..., Result], backend: str = "a
     twice (fewer than 4 cells a side), or coarse meshes that cannot be built or solved, give
     (:data:`LOOSEST`, None): on such a mesh the discretisation error dwarfs 1e-3 anyway.
     """
+    if scene.triangles:
+        with_mesh(scene, 1, 1)  # the one-line SceneError: refinement is not yet available on triangles
     nx, ny = scene.mesh.nx, scene.mesh.ny
     if min(nx, ny) < 4:
         return LOOSEST, None

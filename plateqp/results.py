@@ -154,7 +154,9 @@ class Result:
 
     # -- summaries --------------------------------------------------------------------------
     def w_nodes(self) -> np.ndarray:
-        """w at every plate node (NaN off the plate), shape (ny+1, nx+1)."""
+        """w at every plate node (NaN off the plate), shape (ny+1, nx+1); on triangles (n_nodes,)."""
+        if self.scene.triangles:  # the mesh's nodes carry w as their first dof
+            return self.u[0::self.model.element.ndof_node].copy()
         return post.nodal_w(self.model, self.u)
 
     def w_max(self) -> tuple[float, float, float]:

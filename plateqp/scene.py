@@ -4,8 +4,8 @@ A scene is pure data; :func:`plateqp.assembly.build_model` turns it into matrice
 Every check raises :class:`~plateqp.errors.SceneError` naming the field (``supports.3.gap``)
 and, for a scene read from a file, the file.
 
-Units are any consistent set (plateqp never assumes SI). Conventions: the plate occupies
-[0, a] × [0, b]; w and loads are positive downward; a one-sided support's gap ``g0 > 0`` is
+Units: any consistent set. The plate occupies [0, a] × [0, b] (or, on triangles, a ``plate.shape``
+less its ``holes``: :mod:`plateqp.geometry`); w and loads are positive downward; a gap ``g0 > 0`` is
 settlement (support below the plate), ``g0 < 0`` heave (support pushed into the plate).
 """
 
@@ -36,19 +36,20 @@ MAX_FILE_BYTES = 16 * 2**20
 
 EDGE_KINDS = ("free", "simple", "clamped")
 EDGE_NAMES = ("left", "right", "bottom", "top")  # x = 0, x = a, y = 0, y = b
-ELEMENT_KINDS = ("acm", "bfs")
+ELEMENT_KINDS = ("acm", "bfs", "dkt")
 GAP_PROFILES = ("uniform", "linear", "trough", "bump")
 
 
 @dataclass
 class Plate:
-    """Rectangle [0, a] × [0, b], thickness h, Young's modulus E, Poisson's ratio ν."""
+    """Rectangle [0, a] × [0, b] (or a ``shape``: :mod:`plateqp.geometry`), thickness h, E, ν."""
 
     a: float = 1.0
     b: float = 1.0
     h: float = 0.01
     E: float = 1.0e7
     nu: float = 0.3
+    shape: dict | None = None
 
     @property
     def D(self) -> float:
@@ -58,11 +59,12 @@ class Plate:
 
 @dataclass
 class MeshSpec:
-    """A structured nx × ny grid of equal rectangles, with the element kind."""
+    """An nx × ny grid of equal rectangles and the element; "dkt": triangles of size ``size``."""
 
     nx: int = 16
     ny: int = 16
     element: str = "acm"
+    size: float | None = None
 
 
 @dataclass
@@ -200,11 +202,12 @@ class Scene:
     loads: list[Load] = field(default_factory=list)
     supports: list[Support] = field(default_factory=list)
     foundation: Foundation | None = None
+    holes: list = field(default_factory=list)  # shapes (dicts) cut out of a triangle-meshed plate
     source: str | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         # tuples given in Python become lists, as they come back from TOML (exact round trips)
-        for key in ("openings", "pins", "loads", "supports"):
+        for key in ("openings", "pins", "loads", "supports", "holes"):
             if isinstance(getattr(self, key), tuple):
                 setattr(self, key, list(getattr(self, key)))
         if self.foundation is not None and isinstance(self.foundation.region, tuple):
@@ -243,12 +246,13 @@ class Scene:
         ``covered``: the point's answer of ``grid.covers`` when already known (a batch)."""
         a, b = self.plate.a, self.plate.b
         tol = 1e-12 * max(a, b)
-        if not (-tol <= x <= a + tol and -tol <= y <= b + tol):
+        if self.plate.shape is None and not (-tol <= x <= a + tol and -tol <= y <= b + tol):
             self._fail(where, f"point ({x}, {y}) lies outside the plate [0, {a}] x [0, {b}]")
         if covered is None:
             covered = not self.in_opening(x, y) if grid is None else grid.covers(x, y)
         if not covered:
-            self._fail(where, f"point ({x}, {y}) lies in an opening (no plate there)")
+            self._fail(where, f"point ({x}, {y}) lies " + ("off the plate (outside its shape or in a hole)"
+                                                          if self.triangles else "in an opening (no plate there)"))
 
     def in_opening(self, x: float, y: float) -> bool:
         """True if (x, y) lies strictly inside the removed cells of an opening."""
@@ -300,8 +304,11 @@ class Scene:
                        f"(at most {MAX_CELLS:.0e}); the memory a mesh needs is checked before assembly")
         if m.element not in ELEMENT_KINDS:
             self._fail("mesh.element", f"unknown element {m.element!r}; choose one of {ELEMENT_KINDS}")
+        if not self.triangles and (self.plate.shape is not None or self.holes or m.size is not None):
+            self._fail("plate.shape" if self.plate.shape is not None else "holes" if self.holes else "mesh.size",
+                       'needs a triangle mesh: set mesh.element = "dkt"')
         for name, e in self.edges.items():
-            if name not in EDGE_NAMES:
+            if name not in EDGE_NAMES and not self.triangles:  # triangles: geometry.edge_table
                 self._fail(f"edges.{name}", f"unknown edge; edges are {EDGE_NAMES}")
             if e.kind not in EDGE_KINDS:
                 self._fail(f"edges.{name}", f"unknown kind {e.kind!r}; choose one of {EDGE_KINDS}")
@@ -316,9 +323,10 @@ class Scene:
                 self._num(f"openings.{i}.{k}", getattr(o, k))
             if not (o.x0 < o.x1 and o.y0 < o.y1):
                 self._fail(f"openings.{i}", "needs x0 < x1 and y0 < y1")
+        from .geometry import validate_shaped
         from .mesh import Grid
 
-        grid = Grid.from_scene(self)
+        grid = validate_shaped(self) if self.triangles else Grid.from_scene(self)
         if not grid.cell_mask.any():
             self._fail("openings", "the openings remove every cell of the plate")
         for i, pin in enumerate(self.pins):
@@ -440,6 +448,8 @@ class Scene:
                            "double precision can weigh against it; make the support rigid, or remove it")
 
     # -- convenience ----------------------------------------------------------------------
+    triangles = property(lambda self: self.mesh.element == "dkt", doc="True if meshed with triangles (DKT).")
+
     @property
     def one_sided(self) -> bool:
         """True if the scene has one-sided supports (discrete or a tensionless bed)."""
@@ -499,7 +509,7 @@ class Scene:
             except TypeError as exn:
                 fail(where, f"missing or bad keys ({exn})")
 
-        top = {"name", "plate", "mesh", "edges", "openings", "pins", "loads", "supports", "foundation"}
+        top = {"name", "plate", "mesh", "edges", "openings", "pins", "loads", "supports", "foundation", "holes"}
         extra = set(data) - top
         if extra:
             fail(sorted(extra)[0], f"unknown key; allowed top-level keys: {sorted(top)}")
@@ -531,11 +541,15 @@ class Scene:
         kw["loads"] = loads
         if "foundation" in data:
             kw["foundation"] = build(Foundation, data["foundation"], "foundation")
+        if not isinstance(kw.setdefault("holes", data.get("holes", [])), list):
+            fail("holes", "must be an array of tables ([[holes]])")
         return cls(**kw, source=source)
 
     def to_dict(self) -> dict:
         """The nested dict shape of the TOML file (exact inverse of :meth:`from_dict`)."""
         d: dict[str, Any] = {"name": self.name, "plate": asdict(self.plate), "mesh": asdict(self.mesh)}
+        from .geometry import tidy_dict
+        tidy_dict(self, d)  # the shape, holes and mesh size when set
         if self.edges:
             d["edges"] = {k: (e.kind if (e.w == 0.0 and e.slope == 0.0) else asdict(e)) for k, e in self.edges.items()}
         for key in ("openings", "pins", "supports"):

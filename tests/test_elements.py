@@ -55,7 +55,7 @@ def el(request):
 
 
 def test_registry():
-    assert set(ELEMENTS) == {"acm", "bfs"}
+    assert set(ELEMENTS) == {"acm", "bfs", "dkt"}
     assert ACM().ndof == 12 and ACM().ndof_node == 3 and ACM().dof_names == ("w", "wx", "wy")
     assert BFS().ndof == 16 and BFS().ndof_node == 4 and BFS().dof_names == ("w", "wx", "wy", "wxy")
 

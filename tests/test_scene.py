@@ -52,7 +52,7 @@ BAD = [
     ("zero-elements-x", {"sub": ("nx = 8", "nx = 0")}, "mesh.nx"),
     ("zero-elements-y", {"sub": ("ny = 4", "ny = 0")}, "mesh.ny"),
     ("fractional-elements", {"sub": ("nx = 8", "nx = 2.5")}, "mesh.nx"),
-    ("unknown-element", {"sub": ('element = "acm"', 'element = "dkt"')}, "mesh.element"),
+    ("unknown-element", {"sub": ('element = "acm"', 'element = "quad9"')}, "mesh.element"),
     ("unknown-edge-kind", {"sub": ('right = "simple"', 'right = "hinged"')}, "edges.right"),
     ("unknown-edge-name", {"sub": ('right = "simple"', 'front = "simple"')}, "edges.front"),
     ("unknown-edge-key", {"sub": ('right = "simple"', 'right = { kind = "simple", angle = 1.0 }')},

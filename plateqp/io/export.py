@@ -117,6 +117,8 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
     if formulation not in FORMULATIONS:
         raise ProblemError(f"unknown formulation {formulation!r}; choose one of {FORMULATIONS}")
     model = scene_or_model if isinstance(scene_or_model, Model) else build_model(scene_or_model)
+    if model.scene.triangles:
+        raise ProblemError('export is not yet available on triangle meshes (mesh.element = "dkt")')
     if model.contacts is None or model.contacts.m == 0:
         raise ProblemError(f"scene {model.scene.name!r} has no one-sided supports: there is no contact problem to export")
     data = Scaled.from_model(model)

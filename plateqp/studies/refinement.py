@@ -63,6 +63,8 @@ def solve_on_meshes(scene: Scene, meshes: Iterable[tuple[int, int]], backend: st
     without PlateQPWarnings (the result's status says it). A mesh that cannot be built or
     solved with an error of a class in ``skip`` is yielded with that error; others propagate.
     """
+    if scene.triangles:
+        with_mesh(scene, 1, 1)  # the one-line SceneError: refinement is not yet available on triangles
     for nx, ny in meshes:
         t0 = time.perf_counter()
         try:

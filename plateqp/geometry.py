@@ -1,0 +1,414 @@
+"""Plate outlines of any shape: polygons and circles, holes, and their validation.
+
+A shaped plate is an outer boundary (a counter-clockwise :class:`Polygon` or a :class:`Circle`)
+with holes of the same two kinds. In a scene file::
+
+    [plate]
+    shape = { polygon = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]] }   # or { circle = [xc, yc, r] }
+
+    [[holes]]
+    circle = [0.5, 0.5, 0.2]
+
+:func:`parse_shape` turns one such table into a shape and checks it (at least 3 vertices,
+counter-clockwise, not self-intersecting; a circle's r > 0); :func:`check_holes` checks that every
+hole lies strictly inside the plate and that no two holes touch or overlap. Every failure is a
+SceneError through the ``fail(where, what)`` callable the scene passes in (it names the field and
+the file). :class:`Domain` answers "is this point on the plate?" for the scene's other checks.
+
+Boundaries are numbered for the mesh and the edge supports: 0 the outer boundary, k ≥ 1 hole
+k − 1; a polygon's segment i runs from vertex i to vertex i + 1.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+Fail = Callable[[str, str], None]
+
+
+@dataclass(frozen=True)
+class Polygon:
+    """A simple polygon, vertices counter-clockwise (``(n, 2)`` as a tuple of pairs)."""
+
+    vertices: tuple[tuple[float, float], ...]
+
+    @property
+    def xy(self) -> np.ndarray:
+        return np.array(self.vertices, dtype=float)
+
+    @property
+    def area(self) -> float:
+        """Signed area (positive: counter-clockwise)."""
+        x, y = self.xy.T
+        return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+    def segments(self) -> np.ndarray:
+        """(n, 2, 2): segment i from vertex i to vertex i + 1."""
+        p = self.xy
+        return np.stack([p, np.roll(p, -1, axis=0)], axis=1)
+
+    def contains(self, x, y, tol: float = 0.0) -> np.ndarray:
+        """Points inside or within ``tol`` of the polygon (boundary included)."""
+        x, y = np.atleast_1d(np.asarray(x, float)), np.atleast_1d(np.asarray(y, float))
+        seg = self.segments()
+        inside = np.zeros(x.shape, dtype=bool)
+        for (x0, y0), (x1, y1) in seg:  # even-odd ray casting along +x
+            cross = (y0 > y) != (y1 > y)
+            xc = x0 + (y - y0) * (x1 - x0) / np.where(y1 != y0, y1 - y0, 1.0)
+            inside ^= cross & (x < xc)
+        return inside | (self.distance(x, y) <= tol)
+
+    def distance(self, x, y) -> np.ndarray:
+        """Distance of points to the polygon's boundary."""
+        x, y = np.atleast_1d(np.asarray(x, float)), np.atleast_1d(np.asarray(y, float))
+        return np.min([_point_segment(x, y, s) for s in self.segments()], axis=0)
+
+    @property
+    def bbox(self) -> tuple[float, float, float, float]:
+        p = self.xy
+        return float(p[:, 0].min()), float(p[:, 0].max()), float(p[:, 1].min()), float(p[:, 1].max())
+
+    def to_dict(self) -> dict:
+        return {"polygon": [list(v) for v in self.vertices]}
+
+
+@dataclass(frozen=True)
+class Circle:
+    """The disc of centre (xc, yc) and radius r > 0."""
+
+    xc: float
+    yc: float
+    r: float
+
+    @property
+    def area(self) -> float:
+        return math.pi * self.r**2
+
+    def contains(self, x, y, tol: float = 0.0) -> np.ndarray:
+        x, y = np.atleast_1d(np.asarray(x, float)), np.atleast_1d(np.asarray(y, float))
+        return np.hypot(x - self.xc, y - self.yc) <= self.r + tol
+
+    def distance(self, x, y) -> np.ndarray:
+        x, y = np.atleast_1d(np.asarray(x, float)), np.atleast_1d(np.asarray(y, float))
+        return np.abs(np.hypot(x - self.xc, y - self.yc) - self.r)
+
+    @property
+    def bbox(self) -> tuple[float, float, float, float]:
+        return self.xc - self.r, self.xc + self.r, self.yc - self.r, self.yc + self.r
+
+    def to_dict(self) -> dict:
+        return {"circle": [self.xc, self.yc, self.r]}
+
+
+Shape = Polygon | Circle
+
+
+def rectangle(a: float, b: float) -> Polygon:
+    """[0, a] × [0, b]; segments 0, 1, 2, 3 are the bottom, right, top and left edges."""
+    return Polygon(((0.0, 0.0), (a, 0.0), (a, b), (0.0, b)))
+
+
+#: the names of a rectangle's segments, in :func:`rectangle`'s order
+RECT_SEGMENTS = ("bottom", "right", "top", "left")
+
+
+def _point_segment(x, y, seg) -> np.ndarray:
+    (x0, y0), (x1, y1) = seg
+    dx, dy = x1 - x0, y1 - y0
+    t = np.clip(((x - x0) * dx + (y - y0) * dy) / max(dx * dx + dy * dy, 1e-300), 0.0, 1.0)
+    return np.hypot(x - x0 - t * dx, y - y0 - t * dy)
+
+
+def _segments_cross(s, t) -> bool:
+    """True if closed segments s and t share a point."""
+    (p1, p2), (p3, p4) = np.asarray(s, float), np.asarray(t, float)
+
+    def orient(a, b, c):
+        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+    d1, d2, d3, d4 = orient(p3, p4, p1), orient(p3, p4, p2), orient(p1, p2, p3), orient(p1, p2, p4)
+    if ((d1 > 0) != (d2 > 0)) and ((d3 > 0) != (d4 > 0)) and 0 not in (d1, d2, d3, d4):
+        return True
+    scale = max(np.abs([p1, p2, p3, p4]).max(), 1e-300)
+    on = 1e-12 * scale * scale
+    for d, a, b, c in ((d1, p3, p4, p1), (d2, p3, p4, p2), (d3, p1, p2, p3), (d4, p1, p2, p4)):
+        if abs(d) <= on and min(a[0], b[0]) - 1e-12 * scale <= c[0] <= max(a[0], b[0]) + 1e-12 * scale \
+                and min(a[1], b[1]) - 1e-12 * scale <= c[1] <= max(a[1], b[1]) + 1e-12 * scale:
+            return True
+    return False
+
+
+def _number(v, where: str, fail: Fail) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(float(v)):
+        fail(where, f"must be a finite number (got {v!r:.60})")
+    return float(v)
+
+
+def parse_shape(value, where: str, fail: Fail) -> Shape:
+    """A shape from its scene form ({polygon = [[x, y], ...]} or {circle = [xc, yc, r]}), or a
+    Polygon/Circle given in Python; checked (see the module docstring)."""
+    if isinstance(value, (Polygon, Circle)):
+        value = value.to_dict()
+    if not isinstance(value, dict) or len(value) != 1 or next(iter(value)) not in ("polygon", "circle"):
+        fail(where, "must be { polygon = [[x, y], ...] } or { circle = [xc, yc, r] }")
+    kind, data = next(iter(value.items()))
+    where = f"{where}.{kind}"
+    if kind == "circle":
+        if not isinstance(data, (list, tuple)) or len(data) != 3:
+            fail(where, f"must be [xc, yc, r] (got {data!r:.60})")
+        xc, yc, r = (_number(v, f"{where}.{i}", fail) for i, v in enumerate(data))
+        if r <= 0:
+            fail(where, f"a degenerate circle: the radius must be > 0 (got {r!r})")
+        return Circle(xc, yc, r)
+    if not isinstance(data, (list, tuple)) or len(data) < 3:
+        fail(where, f"a polygon needs at least 3 vertices [[x, y], ...] (got {data!r:.60})")
+    verts = []
+    for i, v in enumerate(data):
+        if not isinstance(v, (list, tuple)) or len(v) != 2:
+            fail(f"{where}.{i}", f"a vertex must be [x, y] (got {v!r:.60})")
+        verts.append((_number(v[0], f"{where}.{i}.0", fail), _number(v[1], f"{where}.{i}.1", fail)))
+    poly = Polygon(tuple(verts))
+    seg = poly.segments()
+    n = len(seg)
+    scale = max(np.abs(poly.xy).max(), np.ptp(poly.xy, axis=0).max())
+    for i in range(n):
+        if np.hypot(*(seg[i, 1] - seg[i, 0])) <= 1e-12 * scale:
+            fail(f"{where}.{i}", f"vertex {i} repeats vertex {(i + 1) % n}: remove one")
+    for i in range(n):
+        for j in range(i + 1, n):
+            adjacent = j == i + 1 or (i == 0 and j == n - 1)
+            if adjacent:
+                # neighbours share one vertex; they cross only if they fold back onto each other
+                a, b = (seg[i], seg[j]) if j == i + 1 else (seg[j], seg[i])
+                u, w = a[1] - a[0], b[1] - b[0]
+                if abs(u[0] * w[1] - u[1] * w[0]) <= 1e-12 * scale**2 and np.dot(u, w) < 0:
+                    fail(where, f"self-intersecting: segments {i} and {j} fold back onto each other")
+            elif _segments_cross(seg[i], seg[j]):
+                fail(where, f"self-intersecting: segment {i} (vertices {i}-{(i + 1) % n}) crosses "
+                     f"segment {j} (vertices {j}-{(j + 1) % n})")
+    if abs(poly.area) <= 1e-12 * scale**2:
+        fail(where, "the polygon has no area")
+    if poly.area < 0:
+        fail(where, "the vertices run clockwise; list them counter-clockwise (reverse the list)")
+    return poly
+
+
+def _inside_strictly(inner: Shape, outer: Shape) -> bool:
+    """True if ``inner`` lies inside ``outer`` without touching its boundary."""
+    if isinstance(outer, Circle):
+        if isinstance(inner, Circle):
+            return math.hypot(inner.xc - outer.xc, inner.yc - outer.yc) + inner.r < outer.r
+        return bool(np.all(np.hypot(inner.xy[:, 0] - outer.xc, inner.xy[:, 1] - outer.yc) < outer.r))
+    if isinstance(inner, Circle):
+        return bool(outer.contains(inner.xc, inner.yc)[0] and outer.distance(inner.xc, inner.yc)[0] > inner.r)
+    if any(_segments_cross(s, t) for s in inner.segments() for t in outer.segments()):
+        return False
+    return bool(outer.contains(*inner.xy[0])[0])
+
+
+def _disjoint(s: Shape, t: Shape) -> bool:
+    """True if two shapes neither overlap nor touch."""
+    if isinstance(s, Circle) and isinstance(t, Circle):
+        return math.hypot(s.xc - t.xc, s.yc - t.yc) > s.r + t.r
+    if isinstance(s, Circle) or isinstance(t, Circle):
+        c, p = (s, t) if isinstance(s, Circle) else (t, s)
+        return not p.contains(c.xc, c.yc)[0] and p.distance(c.xc, c.yc)[0] > c.r
+    if any(_segments_cross(a, b) for a in s.segments() for b in t.segments()):
+        return False
+    return not (t.contains(*s.xy[0])[0] or s.contains(*t.xy[0])[0])
+
+
+def check_holes(outer: Shape, holes: list[Shape], fail: Fail) -> None:
+    """Every hole strictly inside the plate; no two holes overlapping or touching."""
+    for i, h in enumerate(holes):
+        if not _inside_strictly(h, outer):
+            fail(f"holes.{i}", "the hole is not inside the plate: it lies outside it, crosses or touches its boundary")
+    for i, h in enumerate(holes):
+        for j in range(i):
+            if not _disjoint(h, holes[j]):
+                fail(f"holes.{i}", f"overlaps or touches holes.{j}; merge them into one hole or move them apart")
+
+
+@dataclass(frozen=True)
+class Domain:
+    """The plate's region: ``outer`` less ``holes`` (boundaries belong to the plate)."""
+
+    outer: Shape
+    holes: tuple[Shape, ...] = ()
+
+    @property
+    def size(self) -> float:
+        x0, x1, y0, y1 = self.outer.bbox
+        return max(x1 - x0, y1 - y0)
+
+    @property
+    def area(self) -> float:
+        return self.outer.area - sum(h.area for h in self.holes)
+
+    def covers(self, x, y) -> np.ndarray:
+        """(npts,) bool: the points lie on the plate (within 1e-9 of its size of a boundary)."""
+        tol = 1e-9 * self.size
+        ok = self.outer.contains(x, y, tol)
+        for h in self.holes:
+            ok &= ~h.contains(x, y) | (h.distance(x, y) <= tol)
+        return ok
+
+    def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
+        """True if the box [x0, x1] × [y0, y1] overlaps the plate (checked on a 33 × 33 lattice)."""
+        X, Y = np.meshgrid(np.linspace(x0, x1, 33), np.linspace(y0, y1, 33))
+        return bool(self.covers(X.ravel(), Y.ravel()).any())
+
+
+# -- the scene's side: a shaped (triangle-meshed) scene's checks ------------------------------
+TRI_ELEMENTS = ("dkt",)
+
+
+def scene_domain(scene) -> Domain:
+    """The Domain of a triangle-meshed scene: its shape (or the rectangle [0, a] × [0, b]) less its holes."""
+    def fail(where, what):
+        scene._fail(where, what)
+
+    p = scene.plate
+    outer = parse_shape(p.shape, "plate.shape", fail) if p.shape is not None else rectangle(p.a, p.b)
+    holes = tuple(parse_shape(h, f"holes.{i}", fail) for i, h in enumerate(scene.holes))
+    return Domain(outer, holes)
+
+
+class Region:
+    """A Domain with the names the scene's point checks ask a grid for (``covers``, ``locate``,
+    ``node_at``, ``covers_area``): any point of the plate can carry a pin, the mesher puts a node
+    there."""
+
+    def __init__(self, domain: Domain, size: float):
+        self.domain = domain
+        self.hx = self.hy = size
+        x0, x1, y0, y1 = domain.outer.bbox
+        self.a = self.b = 2.0 * max(abs(x0), abs(x1), abs(y0), abs(y1), domain.size)
+        self.cell_mask = np.ones(1, dtype=bool)
+
+    def covers(self, x: float, y: float) -> bool:
+        return bool(self.domain.covers(x, y)[0])
+
+    def locate(self, x, y):
+        return np.where(self.domain.covers(x, y), 0, -1), None, None
+
+    def node_at(self, x: float, y: float) -> int:
+        return 0
+
+    def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
+        return self.domain.covers_area(x0, x1, y0, y1)
+
+    def cells_centred_in(self, x0: float, x1: float, y0: float, y1: float) -> np.ndarray:
+        """Not empty if the box overlaps the plate (a bed region there has triangles, at a mesh
+        size below the box's)."""
+        return np.ones(int(self.covers_area(x0, x1, y0, y1)), dtype=int)
+
+
+def validate_shaped(scene) -> Region:
+    """The shape-specific checks of a scene with ``mesh.element`` a triangle element: the shape,
+    the holes, the edge names (:func:`edge_table`), the mesh
+    size, and what triangle meshes do not carry yet. Returns the Region for the point checks."""
+    p, m = scene.plate, scene.mesh
+    fail = scene._fail
+    domain = scene_domain(scene)
+    # shapes given in Python as Polygon/Circle are kept in their scene form (as TOML gives them)
+    if p.shape is not None:
+        p.shape = domain.outer.to_dict() if isinstance(p.shape, (Polygon, Circle)) else p.shape
+    scene.holes = [h.to_dict() if isinstance(h, (Polygon, Circle)) else h for h in scene.holes]
+    check_holes(domain.outer, list(domain.holes), fail)
+    if p.shape is not None:
+        x0, x1, y0, y1 = domain.outer.bbox
+        p.a, p.b = x1 - x0, y1 - y0  # the length scales of a shaped plate: its bounding box
+    edge_table(scene, domain)  # every edge name known, and no segment named twice
+    if m.size is None:
+        if p.shape is not None:
+            fail("mesh.size", "a plate with a shape needs the element size h: [mesh] size = h")
+    else:
+        scene._num("mesh.size", m.size, positive=True, physical=True)
+        if m.size > domain.size:
+            fail("mesh.size", f"{m.size!r} is larger than the plate ({domain.size:g})")
+        n = domain.area / (0.433 * m.size**2)
+        if n > 1e7:
+            fail("mesh.size", f"{m.size!r} would make about {n:.1g} triangles, more than any plate needs")
+    if scene.openings:
+        fail("openings", "cut-outs of whole cells are for rectangle meshes; on a triangle mesh use [[holes]]")
+    for i, ld in enumerate(scene.loads):
+        if getattr(ld, "type", None) == "patch":
+            fail(f"loads.{i}", "a patch load is not yet available on triangle meshes (mesh.element = \"dkt\")")
+    return Region(domain, mesh_size(scene))
+
+
+def mesh_size(scene) -> float:
+    """The element size h of a triangle-meshed scene: ``mesh.size``, or for a rectangle without
+    one the larger cell side of its nx × ny grid."""
+    m, p = scene.mesh, scene.plate
+    return float(m.size) if m.size is not None else max(p.a / m.nx, p.b / m.ny)
+
+
+def tidy_dict(scene, d: dict) -> None:
+    """The TOML dict of a scene (:meth:`Scene.to_dict`) without the shape fields it does not use:
+    no ``shape`` or ``size`` when unset, no ``a``, ``b`` on a shaped plate (they follow from the
+    shape), and the holes when there are some."""
+    if scene.plate.shape is None:
+        del d["plate"]["shape"]
+    else:
+        del d["plate"]["a"], d["plate"]["b"]
+    if scene.mesh.size is None:
+        del d["mesh"]["size"]
+    if scene.holes:
+        d["holes"] = [h.to_dict() if isinstance(h, (Polygon, Circle)) else dict(h) for h in scene.holes]
+
+
+# -- edges of a triangle-meshed plate, by name ----------------------------------------------------
+#: ``outer`` / ``holeK`` a whole boundary; ``outer_I`` / ``holeK_I`` segment I of a polygon (from
+#: vertex I to I + 1); ``outer_I-J`` / ``holeK_I-J`` segments I to J. Bare TOML keys, no quoting.
+EDGE_KEY = re.compile(r"^(outer|hole(\d+))(?:_(\d+)(?:-(\d+))?)?$")
+
+
+def edge_table(scene, domain: Domain) -> dict[tuple[int, int], tuple[str, object]]:
+    """(boundary, segment) → (edge name, Edge) for every segment of every boundary that an edge
+    name holds (a circle is one segment, 0); the most specific name wins: a segment range over a
+    whole boundary (``outer``, ``holeK``, or a rectangle's ``left``/``right``/``bottom``/``top``)
+    over ``all``. A name that is not one of these, or a segment two names of the same kind hold,
+    is a SceneError."""
+    shapes = (domain.outer, *domain.holes)
+    nseg = [len(s.vertices) if isinstance(s, Polygon) else 1 for s in shapes]
+    levels: list[dict[tuple[int, int], str]] = [{}, {}, {}]  # all, boundary, segments
+    for name in scene.edges:
+        where = f"edges.{name}"
+        if name == "all":
+            targets, level = [(k, i) for k in range(len(shapes)) for i in range(nseg[k])], 0
+        elif name in RECT_SEGMENTS and scene.plate.shape is None:
+            targets, level = [(0, RECT_SEGMENTS.index(name))], 2
+        else:
+            m = EDGE_KEY.match(name)
+            if m is None:
+                names = "all, outer, outer_I, outer_I-J, holeK, holeK_I, holeK_I-J" + (
+                    ", left, right, bottom, top" if scene.plate.shape is None else "")
+                scene._fail(where, f"unknown edge; on a triangle mesh edges are {names}")
+            k = 0 if m.group(2) is None else int(m.group(2)) + 1
+            if k > len(domain.holes):
+                scene._fail(where, f"there is no hole {k - 1} (the plate has {len(domain.holes)} holes)")
+            if m.group(3) is None:
+                targets, level = [(k, i) for i in range(nseg[k])], 1
+            else:
+                i, j = int(m.group(3)), int(m.group(4) or m.group(3))
+                if isinstance(shapes[k], Circle):
+                    scene._fail(where, "a circle has no segments; name the whole boundary")
+                if not i <= j < nseg[k]:
+                    scene._fail(where, f"segments {i} to {j} are not segments 0 to {nseg[k] - 1} of that polygon")
+                targets, level = [(k, s) for s in range(i, j + 1)], 2
+        for t in targets:
+            if t in levels[level]:
+                scene._fail(where, f"edges.{levels[level][t]} holds segment {t[1]} of that boundary too; "
+                            "name each segment once")
+            levels[level][t] = name
+    table = {}
+    for level in levels:
+        table.update({t: (name, scene.edges[name]) for t, name in level.items()})
+    return table

@@ -1,0 +1,215 @@
+"""From a triangle-meshed Scene to a Model: the DKT sibling of :mod:`plateqp.assembly`.
+
+The mesh (:mod:`plateqp.trimesh`) has a node at every support, point load and pin. Node n
+carries the dofs 3n, 3n + 1, 3n + 2 = (w, ∂w/∂x, ∂w/∂y), as on the ACM grid, so the contact
+code (scaling, rigid modes, formulations, KKT) reads a :class:`TriModel` as it reads a Model.
+
+Two-sided edges, by name (:func:`plateqp.geometry.edge_table`: ``all``, a whole boundary ``outer``
+or ``holeK``, polygon segments ``outer_I``, ``outer_I-J``, ``holeK_I-J``, and on a rectangle
+``left``/``right``/``bottom``/``top``): **simple** prescribes w (the edge's ``w``, 0 by default)
+at its nodes and nothing else, the rotations stay free (imposing the tangential slope too would
+make a curved simple support converge to the clamped plate: Babuška's paradox); **clamped** also
+prescribes both
+slopes, ∇w = (∂w/∂n) n with ∂w/∂n the edge's ``slope`` (w is constant along the edge; n the node's
+outward normal, the mean of its two edges' on a curve; at a corner ∇w meets both edges' slopes).
+An edge no name holds is free.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
+from .elements.dkt import DKT
+from .errors import ResourceError, SceneError
+from .geometry import edge_table, mesh_size, scene_domain
+from .scene import PointLoad, Scene, UniformLoad
+from .trimesh import TriMesh, estimate_nodes, mesh_domain
+
+@dataclass
+class TriModel(Model):
+    """A :class:`~plateqp.assembly.Model` on a triangle mesh (``grid`` is the :class:`TriMesh`,
+    ``cells`` the triangles, ``cell_dofs`` their 9 dofs)."""
+
+    def rigid_modes(self) -> np.ndarray:
+        return _rigid_modes(self)
+
+    def bed_areas(self) -> np.ndarray:
+        """(n_nodes,) each node's tributary area of the scene's tensionless bed: a third of every
+        triangle whose centroid lies in the bed's region (the whole plate without one)."""
+        mesh: TriMesh = self.grid
+        c = mesh.nodes[mesh.triangles].mean(axis=1)
+        inside = np.ones(len(c), dtype=bool)
+        if self.scene.foundation.region is not None:
+            x0, x1, y0, y1 = self.scene.foundation.region
+            inside = (c[:, 0] >= x0) & (c[:, 0] <= x1) & (c[:, 1] >= y0) & (c[:, 1] <= y1)
+        if not inside.any():
+            raise SceneError(f"foundation.region: {self.scene.foundation.region} holds the centroid of no triangle "
+                             "of the mesh; make it larger than mesh.size")
+        return np.bincount(mesh.triangles[inside].ravel(), weights=np.repeat(mesh.areas()[inside] / 3, 3),
+                           minlength=mesh.n_nodes)
+
+    def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
+        """(npts, n_full) sparse operator, from the full dofs, at points: w (the node's w at a node,
+        the element's cubic inside); the slopes (dx + dy = 1) and curvatures (dx + dy = 2) are
+        DKT's own, from its quadratic slope field β: w,x = βx, w,xx = βx,x, w,xy = (βx,y + βy,x)/2
+        (so moments and stresses are the element's M = −D_b κ). On an element edge: one neighbour's."""
+        if dx + dy > 2:
+            raise SceneError(f"derivatives of w of order {dx + dy} > 2 do not exist in a plate element")
+        mesh: TriMesh = self.grid
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        y = np.atleast_1d(np.asarray(y, dtype=float))
+        tri, lam = mesh.locate(x, y)
+        if np.any(tri < 0):
+            bad = np.flatnonzero(tri < 0)[0]
+            raise SceneError(f"point ({x[bad]}, {y[bad]}) is not on the plate")
+        xy = mesh.nodes[mesh.triangles[tri]]
+        if dx + dy == 1:
+            N = self.element.slope_matrix(xy, lam[:, None, :])[:, 0, dy]
+        elif dx + dy == 2:
+            B = self.element.curvature_matrix(xy, lam[:, None, :])[:, 0]
+            N = B[:, 0] if dx == 2 else B[:, 1] if dy == 2 else 0.5 * B[:, 2]
+        else:
+            N = self.element.shape(xy, lam[:, None, :])[:, 0]
+        dofs = self.cell_dofs[tri]
+        at_node = (lam.max(axis=1) >= 1.0 - 1e-12) & (dx + dy < 2)  # a vertex: its own dof, no rounding noise
+        N[at_node] = 0.0
+        N[at_node, 3 * lam[at_node].argmax(axis=1) + (dx + 2 * dy)] = 1.0
+        rows = np.repeat(np.arange(len(tri)), 9)
+        A = sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(tri), self.n_full))
+        A.eliminate_zeros()
+        return A
+
+
+def check_memory_tri(scene: Scene, h: float) -> None:
+    """ResourceError before meshing if the triangle mesh would need more memory than allowed."""
+    need = BYTES_PER_DOF * 3 * estimate_nodes(scene)
+    if need > memory_limit():
+        raise ResourceError(f"mesh.size: a triangle mesh of size {h:g} needs about {human_bytes(need)} to build "
+                            f"and solve, above the limit of {human_bytes(memory_limit())}; use a larger mesh.size")
+
+
+def build_tri_model(scene: Scene) -> TriModel:
+    """Mesh a triangle-meshed scene with gmsh and assemble its DKT stiffness, loads, two-sided
+    supports and contact operator."""
+    domain = scene_domain(scene)
+    h = mesh_size(scene)
+    check_memory_tri(scene, h)
+    points = [(s.x, s.y) for s in scene.supports] + [(ld.x, ld.y) for ld in scene.loads
+                                                     if isinstance(ld, PointLoad)] + [(p.x, p.y) for p in scene.pins]
+    mesh = mesh_domain(domain, h, points)
+    el = DKT()
+    p = scene.plate
+    n_full = 3 * mesh.n_nodes
+    xy = mesh.nodes[mesh.triangles]
+    cell_dofs = (mesh.triangles[:, :, None] * 3 + np.arange(3)).reshape(-1, 9)
+    Ke = el.stiffness(xy, p.D, p.nu)
+    rows = np.repeat(cell_dofs, 9, axis=1).ravel()
+    cols = np.tile(cell_dofs, (1, 9)).ravel()
+    K_full = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(n_full, n_full))
+    K_full.sum_duplicates()
+
+    f_full = np.zeros(n_full)
+    model = TriModel(scene, mesh, el, None, None, None, None, None, n_full, cell_dofs,
+                     np.arange(len(cell_dofs)), f_full, K_full)
+    for ld in scene.loads:
+        if isinstance(ld, UniformLoad):
+            f_full += np.bincount(cell_dofs.ravel(), weights=(ld.q * el.load(xy)).ravel(), minlength=n_full)
+        elif isinstance(ld, PointLoad):
+            f_full += ld.P * np.asarray(model.interpolation(ld.x, ld.y).todense()).ravel()
+    fixed, values = _prescribed(scene, mesh)
+    free = np.setdiff1d(np.arange(n_full), fixed)
+    u_c = np.zeros(n_full)
+    u_c[fixed] = values
+    model.K = K_full[free][:, free].tocsr()
+    model.f = f_full[free] - (K_full @ u_c)[free]
+    model.free, model.fixed, model.values = free, fixed, values
+    model.contacts = _contacts(scene, model)
+    return model
+
+
+def _prescribed(scene: Scene, mesh: TriMesh):
+    presc: dict[int, tuple[float, str]] = {}
+
+    def put(dof, value, who):
+        if dof in presc and abs(presc[dof][0] - value) > 1e-12 * max(1.0, abs(value), abs(presc[dof][0])):
+            raise SceneError(f"{who} and {presc[dof][1]} prescribe different values of "
+                             f"{DKT.dof_names[dof % 3]} at their common node; make them agree")
+        presc[dof] = (value, who)
+
+    table = edge_table(scene, mesh.domain)
+    clamped: dict[int, list] = {}  # node -> [(outward normal, slope, who)] of its clamped edges
+    for (i, j), k, s, normal in zip(mesh.edges, mesh.boundary, mesh.segment, mesh.normals):
+        name, e = table.get((int(k), int(s)), (None, None))
+        if e is None or e.kind == "free":
+            continue
+        who = f"edges.{name}"
+        for n in (i, j):
+            put(3 * n, e.w, who)
+            if e.kind == "clamped":
+                clamped.setdefault(int(n), []).append((normal, e.slope, who))
+    for n, held in clamped.items():
+        for dof, value in zip((3 * n + 1, 3 * n + 2), _gradient(held)):
+            put(dof, value, held[0][2])
+    for i, pin in enumerate(scene.pins):
+        n = mesh.node_at(pin.x, pin.y)
+        if n is None:  # pragma: no cover - the mesher puts a node at every pin
+            raise SceneError(f"pins.{i}: no mesh node at ({pin.x}, {pin.y})")
+        put(3 * n, pin.w, f"pins.{i}")
+    fixed = np.array(sorted(presc), dtype=int)
+    return fixed, np.array([presc[d][0] for d in fixed], dtype=float)
+
+
+def _gradient(held) -> np.ndarray:
+    """∇w at a node of clamped edges [(outward normal, ∂w/∂n, who)]: w is constant along each, so
+    ∇w = (∂w/∂n) n. Along a smooth boundary (normals within 10°: a curve's two chords) n is their
+    mean direction and the slope their mean; at a corner every edge asks its own (∂w/∂n) n, and
+    they must agree (as on the rectangles: only zero slopes meet at a clamped corner)."""
+    N = np.array([h[0] for h in held])
+    s = np.array([h[1] for h in held])
+    mean = N.sum(axis=0)
+    if np.all(N @ mean / np.linalg.norm(mean) >= np.cos(np.radians(10.0))):
+        return s.mean() * mean / np.linalg.norm(mean)
+    g = s[:, None] * N
+    bad = np.flatnonzero(np.abs(g - g[0]).max(axis=1) > 1e-12 * max(np.abs(g).max(), 1e-300))
+    if bad.size:
+        raise SceneError(f"{held[0][2]} and {held[bad[0]][2]} prescribe different slopes at their common corner "
+                         "(w is constant along each clamped edge); make the slopes there zero")
+    return g[0]
+
+
+def _rigid_modes(model: TriModel) -> np.ndarray:
+    """Rigid motions w = α + βx + γy of each connected piece left free by the prescribed dofs."""
+    mesh: TriMesh = model.grid
+    t = mesh.triangles
+    n = mesh.n_nodes
+    A = sp.csr_matrix((np.ones(t.size * 3), (np.repeat(t, 3, axis=1).ravel(), np.tile(t, (1, 3)).ravel())),
+                      shape=(n, n))
+    _, label = connected_components(A, directed=False)
+    xy = mesh.nodes
+    modes = []
+    for comp in np.unique(label):
+        fx = model.fixed[label[model.fixed // 3] == comp]
+        node, kind = fx // 3, fx % 3
+        R = np.zeros((len(fx), 3))
+        R[kind == 0] = np.column_stack([np.ones((kind == 0).sum()), xy[node[kind == 0]]])
+        R[kind == 1, 1] = 1.0
+        R[kind == 2, 2] = 1.0
+        _, s, vt = np.linalg.svd(R if len(R) else np.zeros((1, 3)))
+        s_full = np.zeros(3)
+        s_full[: len(s)] = s
+        nodes = np.flatnonzero(label == comp)
+        for a, b, g in vt[s_full <= 1e-10 * max(1.0, s_full.max())]:
+            v = np.zeros(model.n_full)
+            v[3 * nodes] = a + b * xy[nodes, 0] + g * xy[nodes, 1]
+            v[3 * nodes + 1] = b
+            v[3 * nodes + 2] = g
+            modes.append(v[model.free])
+    return np.array(modes).T.reshape(model.n_free, len(modes))
+
+
+MESH_BUILDERS["dkt"] = build_tri_model

@@ -1,0 +1,325 @@
+"""Unstructured triangle meshes of shaped plates, made with gmsh (imported lazily).
+
+:func:`mesh_domain` meshes a :class:`~plateqp.geometry.Domain` with gmsh's Python API (the
+``shapes`` extra: ``pip install plateqp[shapes]``): target size h, circles as true arcs (boundary
+nodes lie on the circle), given points (supports, point loads, pins) embedded as mesh nodes with
+the mesh refined around them (size h/4 at the point, growing to h at 2h away).
+
+The mesh is deterministic: gmsh runs on one thread with fixed options (Frontal-Delaunay, no
+random factor changes, no configuration files read), so the same scene gives the same mesh. gmsh
+is initialised and finalised around every call (a session the caller opened is left open, and
+only the model made here is removed), and never prints (``General.Terminal = 0``).
+
+:class:`TriMesh` is the mesh: nodes, counter-clockwise triangles, boundary edges with their
+outward unit normals and the boundary/segment each belongs to (see :mod:`plateqp.geometry`).
+It has the names the contact code reads from a grid (``node_xy``, ``hx``, ``hy``, ``a``, ``b``).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import SceneError
+from .geometry import Circle, Domain, Polygon
+
+#: refinement around embedded points: size REFINE·h at the point, h from 2h away
+REFINE = 0.25
+#: nodes of a mesh per area / h², about (measured: 1.09 on the unit disc at h = 1/16)
+NODES_PER_AREA = 1.2
+_model_names = itertools.count()
+
+
+def estimate_nodes(scene) -> float:
+    """About how many nodes a triangle-meshed scene's mesh has (:data:`NODES_PER_AREA` area / h²)."""
+    from .geometry import mesh_size, scene_domain
+
+    return NODES_PER_AREA * scene_domain(scene).area / mesh_size(scene) ** 2
+
+
+def import_gmsh():
+    """gmsh's module, or a one-line SceneError saying how to install it."""
+    try:
+        import gmsh
+    except ImportError:  # pragma: no cover - depends on the environment
+        raise SceneError("a plate with a shape (or mesh.element = \"dkt\") needs gmsh: "
+                         "pip install 'plateqp[shapes]' (or pip install gmsh)") from None
+    return gmsh
+
+
+@dataclass
+class TriMesh:
+    """A triangle mesh of a plate.
+
+    Attributes
+    ----------
+    nodes : (n, 2) coordinates
+    triangles : (nt, 3) node indices, counter-clockwise
+    edges : (ne, 2) boundary edges (node pairs, in the direction of their boundary's curve)
+    normals : (ne, 2) outward unit normal of each boundary edge
+    boundary : (ne,) which boundary: 0 outer, k ≥ 1 hole k − 1
+    segment : (ne,) which segment of a polygon boundary (0 for a circle)
+    size : the target element size h
+    domain : the meshed :class:`~plateqp.geometry.Domain`
+    """
+
+    nodes: np.ndarray
+    triangles: np.ndarray
+    edges: np.ndarray
+    normals: np.ndarray
+    boundary: np.ndarray
+    segment: np.ndarray
+    size: float
+    domain: Domain
+    _tree: object = field(default=None, repr=False, compare=False)
+
+    # -- the names the contact code reads from a grid ------------------------------------
+    @property
+    def n_nodes(self) -> int:
+        return self.nodes.shape[0]
+
+    @property
+    def hx(self) -> float:
+        return self.size
+
+    @property
+    def hy(self) -> float:
+        return self.size
+
+    @property
+    def a(self) -> float:
+        x0, x1, _, _ = self.domain.outer.bbox
+        return x1 - x0
+
+    @property
+    def b(self) -> float:
+        _, _, y0, y1 = self.domain.outer.bbox
+        return y1 - y0
+
+    def node_xy(self) -> np.ndarray:
+        return self.nodes
+
+    def __getattr__(self, name: str):
+        """A rectangular grid's attribute (nx, ny, node_mask, cell_nodes, …), asked of a triangle
+        mesh by code that only works on grids (plots, nodal fields): a one-line SceneError."""
+        if name.startswith("_"):
+            raise AttributeError(name)
+        raise SceneError(f"plots, nodal fields and other grid-based output are not yet available on triangle "
+                         f"meshes (mesh.element = \"dkt\"; the grid's {name!r} was asked for)")
+
+    # -- queries ------------------------------------------------------------------------
+    def areas(self) -> np.ndarray:
+        p = self.nodes[self.triangles]
+        return 0.5 * ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                      - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+
+    def node_at(self, x: float, y: float, rtol: float = 1e-6) -> int | None:
+        """The node at (x, y) (within rtol·h), or None."""
+        d = np.hypot(self.nodes[:, 0] - x, self.nodes[:, 1] - y)
+        k = int(np.argmin(d))
+        return k if d[k] <= rtol * self.size else None
+
+    def locate(self, x, y):
+        """Triangle index and barycentric coordinates (npts, 3) of points; −1 off the mesh."""
+        from scipy.spatial import cKDTree
+
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        y = np.atleast_1d(np.asarray(y, dtype=float))
+        p = self.nodes[self.triangles]
+        if self._tree is None:
+            self._tree = cKDTree(p.mean(axis=1))
+        k = min(16, len(self.triangles))
+        _, cand = self._tree.query(np.column_stack([x, y]), k=k)
+        cand = cand.reshape(len(x), k)
+        tri = np.full(len(x), -1)
+        lam = np.zeros((len(x), 3))
+        best = np.full(len(x), -np.inf)
+        for c in range(k):
+            t = cand[:, c]
+            l_ = _barycentric(p[t], x, y)
+            worst = l_.min(axis=1)
+            better = worst > best
+            tri = np.where(better, t, tri)
+            lam = np.where(better[:, None], l_, lam)
+            best = np.maximum(best, worst)
+        tri = np.where(best >= -1e-9, tri, -1)
+        return tri, np.clip(lam, 0.0, 1.0) / np.clip(lam, 0.0, 1.0).sum(axis=1, keepdims=True)
+
+
+def _barycentric(p, x, y):
+    (x1, y1), (x2, y2), (x3, y3) = p[:, 0].T, p[:, 1].T, p[:, 2].T
+    det = (x2 - x1) * (y3 - y1) - (x3 - x1) * (y2 - y1)
+    l2 = ((x - x1) * (y3 - y1) - (x3 - x1) * (y - y1)) / det
+    l3 = ((x2 - x1) * (y - y1) - (x - x1) * (y2 - y1)) / det
+    return np.column_stack([1.0 - l2 - l3, l2, l3])
+
+
+def mesh_domain(domain: Domain, size: float, points=()) -> TriMesh:
+    """Mesh ``domain`` with gmsh at target size ``size``; every point of ``points`` becomes a node.
+
+    Points on the boundary are embedded in its curve, points inside in the surface; a point at a
+    polygon vertex is that vertex. Duplicates are merged.
+    """
+    gmsh = import_gmsh()
+    owner = not gmsh.isInitialized()
+    if owner:
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
+    name = f"plateqp-{next(_model_names)}"
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.Verbosity", 0)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.option.setNumber("Mesh.MaxNumThreads2D", 1)
+        gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay
+        gmsh.option.setNumber("Mesh.RandomFactor", 1e-9)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.ElementOrder", 1)
+        gmsh.model.add(name)
+        try:
+            return _mesh(gmsh, domain, float(size), points)
+        except Exception as exn:  # gmsh raises plain Exceptions with its own message
+            raise SceneError(f"mesh: gmsh could not mesh the plate at size {size:g} ({str(exn).splitlines()[0]})") from exn
+    finally:
+        if owner:
+            gmsh.finalize()
+        else:  # pragma: no cover - a session the caller opened
+            gmsh.model.setCurrent(name)
+            gmsh.model.remove()
+
+
+def _mesh(gmsh, domain: Domain, h: float, points) -> TriMesh:
+    geo = gmsh.model.geo
+    curve_owner: dict[int, tuple[int, int]] = {}  # curve tag -> (boundary, segment)
+    curves_of: list[list[int]] = []
+    vertex_tags: list[tuple[float, float, int]] = []
+    loops = []
+    for k, shape in enumerate((domain.outer, *domain.holes)):
+        tags = []
+        if isinstance(shape, Polygon):
+            pts = [geo.addPoint(x, y, 0.0) for x, y in shape.vertices]
+            vertex_tags += [(x, y, t) for (x, y), t in zip(shape.vertices, pts)]
+            for i in range(len(pts)):
+                c = geo.addLine(pts[i], pts[(i + 1) % len(pts)])
+                curve_owner[c] = (k, i)
+                tags.append(c)
+        else:
+            centre = geo.addPoint(shape.xc, shape.yc, 0.0)
+            pts = [geo.addPoint(shape.xc + shape.r * math.cos(t), shape.yc + shape.r * math.sin(t), 0.0)
+                   for t in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)]
+            vertex_tags += [(x, y, t) for (x, y), t in zip(
+                [(shape.xc + shape.r, shape.yc), (shape.xc, shape.yc + shape.r),
+                 (shape.xc - shape.r, shape.yc), (shape.xc, shape.yc - shape.r)], pts)]
+            for i in range(4):
+                c = geo.addCircleArc(pts[i], centre, pts[(i + 1) % 4])
+                curve_owner[c] = (k, 0)
+                tags.append(c)
+        curves_of.append(tags)
+        loop = geo.addCurveLoop(tags)
+        loops.append(loop)
+    surf = geo.addPlaneSurface(loops)
+    geo.synchronize()
+
+    tol = 1e-9 * domain.size
+    embedded, seen = [], []
+    for x, y in points:
+        if any(math.hypot(x - u, y - v) <= tol for u, v in seen):
+            continue
+        seen.append((x, y))
+        if any(math.hypot(x - u, y - v) <= tol for u, v, _ in vertex_tags):
+            continue
+        on = _curve_at(domain, curves_of, x, y, tol)
+        # built-in kernel: new points after synchronize need another synchronize before embedding
+        t = geo.addPoint(x, y, 0.0)
+        embedded.append((t, on))
+    geo.synchronize()
+    for t, on in embedded:
+        if on is None:
+            gmsh.model.mesh.embed(0, [t], 2, surf)
+        else:
+            gmsh.model.mesh.embed(0, [t], 1, on)
+
+    f_const = gmsh.model.mesh.field.add("MathEval")
+    gmsh.model.mesh.field.setString(f_const, "F", repr(h))
+    fields = [f_const]
+    if embedded:
+        f_dist = gmsh.model.mesh.field.add("Distance")
+        gmsh.model.mesh.field.setNumbers(f_dist, "PointsList", [t for t, _ in embedded])
+        f_thr = gmsh.model.mesh.field.add("Threshold")
+        gmsh.model.mesh.field.setNumber(f_thr, "InField", f_dist)
+        gmsh.model.mesh.field.setNumber(f_thr, "SizeMin", REFINE * h)
+        gmsh.model.mesh.field.setNumber(f_thr, "SizeMax", h)
+        gmsh.model.mesh.field.setNumber(f_thr, "DistMin", 0.0)
+        gmsh.model.mesh.field.setNumber(f_thr, "DistMax", 2.0 * h)
+        fields.append(f_thr)
+    f_min = gmsh.model.mesh.field.add("Min")
+    gmsh.model.mesh.field.setNumbers(f_min, "FieldsList", fields)
+    gmsh.model.mesh.field.setAsBackgroundMesh(f_min)
+    gmsh.model.mesh.generate(2)
+
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    index = np.full(int(tags.max()) + 1, -1)
+    xyz = coords.reshape(-1, 3)
+    _, tri_nodes = gmsh.model.mesh.getElementsByType(2, surf)
+    tri_tags = tri_nodes.astype(np.int64).reshape(-1, 3)
+    used = np.unique(tri_tags)
+    index[used] = np.arange(len(used))
+    pos = np.full(int(tags.max()) + 1, -1)
+    pos[tags.astype(np.int64)] = np.arange(len(tags))
+    nodes = xyz[pos[used], :2].copy()
+    tris = index[tri_tags]
+    p = nodes[tris]
+    signed = ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+              - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    tris[signed < 0] = tris[signed < 0][:, [0, 2, 1]]
+
+    edges, boundary, segment = [], [], []
+    for c, (k, i) in sorted(curve_owner.items()):
+        _, en = gmsh.model.mesh.getElementsByType(1, c)
+        e = index[en.astype(np.int64).reshape(-1, 2)]
+        edges.append(e)
+        boundary += [k] * len(e)
+        segment += [i] * len(e)
+    edges = np.vstack(edges)
+    normals = _outward_normals(nodes, tris, edges)
+    return TriMesh(nodes, tris, edges, normals, np.array(boundary), np.array(segment), h, domain)
+
+
+def _curve_at(domain: Domain, curves_of, x: float, y: float, tol: float):
+    """The gmsh curve tag a point on the boundary lies on, or None for an interior point."""
+    for k, shape in enumerate((domain.outer, *domain.holes)):
+        if shape.distance(x, y)[0] > tol:
+            continue
+        if isinstance(shape, Polygon):
+            seg = shape.segments()
+            d = [float(np.hypot(*_closest(s, x, y))) for s in seg]
+            return curves_of[k][int(np.argmin(d))]
+        angle = math.atan2(y - shape.yc, x - shape.xc) % (2 * math.pi)
+        return curves_of[k][min(int(angle // (0.5 * math.pi)), 3)]
+    return None
+
+
+def _closest(seg, x, y):
+    (x0, y0), (x1, y1) = seg
+    dx, dy = x1 - x0, y1 - y0
+    t = min(max(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0.0), 1.0)
+    return x - x0 - t * dx, y - y0 - t * dy
+
+
+def _outward_normals(nodes, tris, edges) -> np.ndarray:
+    """Unit normals of boundary edges, pointing away from the triangle that holds each edge."""
+    key = {}
+    for t, tri in enumerate(tris):
+        for a, b in ((0, 1), (1, 2), (2, 0)):
+            key[(min(tri[a], tri[b]), max(tri[a], tri[b]))] = tri[3 - a - b]
+    third = np.array([key[(min(i, j), max(i, j))] for i, j in edges])
+    d = nodes[edges[:, 1]] - nodes[edges[:, 0]]
+    n = np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None]
+    inward = nodes[third] - nodes[edges[:, 0]]
+    flip = np.einsum("ij,ij->i", n, inward) > 0
+    n[flip] *= -1.0
+    return n

@@ -1,0 +1,157 @@
+"""Shaped plates in the scene (plateqp.geometry): the keys, their round trip, and bad geometry as a
+SceneError naming the field and the file. No meshing here (gmsh is not needed to load a scene)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import plateqp as pq
+from plateqp.geometry import Circle, Domain, Polygon
+
+L_SHAPE = "[[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]"
+
+BASE = f"""
+name = "shaped"
+
+[plate]
+shape = {{ polygon = {L_SHAPE} }}
+h = 0.01
+E = 1.0e7
+nu = 0.3
+
+[mesh]
+element = "dkt"
+size = 0.25
+
+[edges]
+all = "simple"
+
+[[holes]]
+circle = [0.5, 0.5, 0.2]
+
+[[loads]]
+type = "uniform"
+q = 1.0
+
+[[supports]]
+x = 1.5
+y = 0.5
+gap = -0.001
+"""
+
+
+def write(tmp_path, text, name="scene.toml"):
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def test_shaped_scene_loads_and_round_trips(tmp_path):
+    sc = pq.Scene.from_toml(write(tmp_path, BASE))
+    assert sc.triangles and sc.plate.shape == {"polygon": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]}
+    assert (sc.plate.a, sc.plate.b) == (2.0, 2.0)  # the bounding box's sides: the length scales
+    assert sc.holes == [{"circle": [0.5, 0.5, 0.2]}] and sc.mesh.size == 0.25 and sc.edges["all"].kind == "simple"
+    back = pq.Scene.from_toml(write(tmp_path, sc.to_toml(), "back.toml"))
+    assert back.to_dict() == sc.to_dict()
+    assert "a" not in sc.to_dict()["plate"] and "shape" not in pq.Scene().to_dict()["plate"]
+    assert "size" not in pq.Scene().to_dict()["mesh"] and "holes" not in pq.Scene().to_dict()
+
+
+def sub(old, new):
+    def edit(text):
+        assert old in text
+        return text.replace(old, new, 1)
+    return edit
+
+
+BOWTIE = "[[0, 0], [1, 1], [1, 0], [0, 1]]"
+BAD = [
+    ("self-intersecting", sub(L_SHAPE, BOWTIE), "plate.shape.polygon", "self-intersecting"),
+    ("clockwise", sub(L_SHAPE, "[[0, 2], [1, 2], [1, 1], [2, 1], [2, 0], [0, 0]]"), "plate.shape.polygon",
+     "clockwise"),
+    ("two-vertices", sub(L_SHAPE, "[[0, 0], [2, 0]]"), "plate.shape.polygon", "at least 3 vertices"),
+    ("repeated-vertex", sub(L_SHAPE, "[[0, 0], [2, 0], [2, 0], [2, 2]]"), "plate.shape.polygon.1", "repeats"),
+    ("collinear", sub(L_SHAPE, "[[0, 0], [1, 0], [2, 0]]"), "plate.shape.polygon", "fold back"),
+    ("zero-radius", sub(f"polygon = {L_SHAPE}", "circle = [0, 0, 0.0]"), "plate.shape.circle", "radius must be > 0"),
+    ("negative-radius", sub(f"polygon = {L_SHAPE}", "circle = [0, 0, -1.0]"), "plate.shape.circle", "> 0"),
+    ("not-a-shape", sub(f"polygon = {L_SHAPE}", "square = 1.0"), "plate.shape", "polygon"),
+    ("nan-vertex", sub("[2, 1], [1, 1]", "[2, nan], [1, 1]"), "plate.shape.polygon.2.1", "finite"),
+    ("hole-outside", sub("circle = [0.5, 0.5, 0.2]", "circle = [1.5, 1.5, 0.2]"), "holes.0", "not inside"),
+    ("hole-crossing", sub("circle = [0.5, 0.5, 0.2]", "circle = [0.5, 0.1, 0.2]"), "holes.0", "crosses"),
+    ("hole-touching", sub("circle = [0.5, 0.5, 0.2]", "circle = [0.5, 0.2, 0.2]"), "holes.0", "touches"),
+    ("hole-polygon-crossing", sub("circle = [0.5, 0.5, 0.2]", "polygon = [[0.5, 0.5], [1.5, 0.5], [1.5, 1.5]]"),
+     "holes.0", "not inside"),
+    ("holes-overlap", lambda t: t + "\n[[holes]]\ncircle = [0.7, 0.5, 0.15]\n", "holes.1", "overlaps"),
+    ("holes-nested", lambda t: t + "\n[[holes]]\npolygon = [[0.45, 0.45], [0.55, 0.45], [0.5, 0.55]]\n", "holes.1",
+     "overlaps"),
+    ("hole-circle-polygon", lambda t: t + "\n[[holes]]\npolygon = [[0.6, 0.4], [1.2, 0.4], [1.2, 0.8]]\n", "holes.1",
+     "overlaps"),
+    ("shape-on-acm", sub('element = "dkt"', 'element = "acm"'), "plate.shape", "dkt"),
+    ("named-edge-on-shape", sub('all = "simple"', 'left = "simple"'), "edges.left", "unknown edge"),
+    ("edge-no-such-hole", sub('all = "simple"', 'hole1 = "simple"'), "edges.hole1", "no hole 1"),
+    ("edge-circle-segment", sub('all = "simple"', 'hole0_0 = "simple"'), "edges.hole0_0", "no segments"),
+    ("edge-segment-range", sub('all = "simple"', 'outer_4-6 = "simple"'), "edges.outer_4-6", "segments 0 to 5"),
+    ("edge-reversed-range", sub('all = "simple"', 'outer_3-1 = "simple"'), "edges.outer_3-1", "not segments"),
+    ("edge-named-twice", sub('all = "simple"', 'outer_0-2 = "simple"\nouter_2 = "clamped"'), "edges.outer_2",
+     "holds segment 2"),
+    ("no-size", sub("size = 0.25", ""), "mesh.size", "size = h"),
+    ("bad-size", sub("size = 0.25", "size = -1.0"), "mesh.size", "> 0"),
+    ("support-in-hole", sub("x = 1.5\ny = 0.5", "x = 0.5\ny = 0.5"), "supports.0", "in a hole"),
+    ("support-in-notch", sub("x = 1.5\ny = 0.5", "x = 1.5\ny = 1.5"), "supports.0", "outside its shape"),
+    ("bed-off-the-plate", lambda t: t + "\n[foundation]\nk = 100.0\nregion = [1.2, 1.8, 1.2, 1.8]\n",
+     "foundation.region", "holds the centre of no cell"),
+    ("patch-on-triangles", lambda t: t + '\n[[loads]]\ntype = "patch"\nq = 1.0\nx0 = 0\nx1 = 1\ny0 = 0\ny1 = 1\n',
+     "loads.1", "not yet available"),
+]
+
+
+@pytest.mark.parametrize("edit, field, words", [b[1:] for b in BAD], ids=[b[0] for b in BAD])
+def test_bad_geometry_names_field_and_file(tmp_path, edit, field, words):
+    path = write(tmp_path, edit(BASE), "bad-shape.toml")
+    with pytest.raises(pq.SceneError) as info:
+        pq.Scene.from_toml(path)
+    msg = str(info.value)
+    assert msg.startswith(f"{path}: {field}:"), msg
+    assert words in msg and "\n" not in msg
+
+
+def test_rectangle_with_triangles_keeps_named_edges(tmp_path):
+    """A rectangle meshed with DKT takes the rectangle's edge names (or all), and holes."""
+    sc = pq.Scene(plate=pq.Plate(a=2.0, b=1.0), mesh=pq.MeshSpec(8, 4, "dkt"),
+                  edges={"left": pq.Edge("clamped")}, holes=[{"circle": [1.0, 0.5, 0.2]}])
+    assert sc.triangles and sc.plate.a == 2.0
+    with pytest.raises(pq.SceneError, match="holes: needs a triangle mesh"):
+        pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), holes=[{"circle": [0.5, 0.5, 0.2]}])
+    with pytest.raises(pq.SceneError, match="edges.all: unknown edge"):
+        pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), edges={"all": pq.Edge("simple")})
+
+
+def test_edge_names_resolve_most_specific_first():
+    from plateqp.geometry import edge_table, scene_domain
+
+    sc = pq.Scene(plate=pq.Plate(shape={"polygon": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]}),
+                  mesh=pq.MeshSpec(element="dkt", size=0.25), holes=[{"circle": [0.5, 0.5, 0.2]}],
+                  edges={"all": pq.Edge("simple"), "outer": pq.Edge("free"), "outer_1-2": pq.Edge("clamped")})
+    t = {k: name for k, (name, _) in edge_table(sc, scene_domain(sc)).items()}
+    assert t == {(0, 0): "outer", (0, 1): "outer_1-2", (0, 2): "outer_1-2", (0, 3): "outer", (0, 4): "outer",
+                 (0, 5): "outer", (1, 0): "all"}
+
+
+def test_shapes_given_in_python_save_as_toml(tmp_path):
+    sc = pq.Scene(plate=pq.Plate(shape=Circle(0.0, 0.0, 2.0)), mesh=pq.MeshSpec(element="dkt", size=0.5),
+                  holes=[Polygon(((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)))])
+    back = pq.Scene.from_toml(write(tmp_path, sc.to_toml()))
+    assert back.plate.shape == {"circle": [0.0, 0.0, 2.0]} and back.holes == [{"polygon": [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]}]
+    assert (back.plate.a, back.plate.b) == (4.0, 4.0)
+
+
+def test_domain_covers_is_the_plate():
+    """Points of an L-shape with a round hole: in the plate, in the notch, in the hole, on edges."""
+    d = Domain(Polygon(((0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2))), (Circle(0.5, 0.5, 0.2),))
+    x = np.array([1.5, 1.5, 0.5, 0.5, 2.0, 1.0, 0.5 + 0.2 * math.cos(1.0)])
+    y = np.array([0.5, 1.5, 0.5, 1.5, 0.5, 1.5, 0.5 + 0.2 * math.sin(1.0)])
+    assert d.covers(x, y).tolist() == [True, False, False, True, True, True, True]
+    assert d.area == pytest.approx(3.0 - math.pi * 0.04, rel=1e-14)
