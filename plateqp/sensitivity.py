@@ -372,6 +372,7 @@ class _SceneLoads:
     def __init__(self, scene, load) -> None:
         self.loads = [load]
         self.plate = scene.plate
+        self.triangles = scene.triangles
 
 
 def scaled_state(result) -> tuple[Scaled, np.ndarray, np.ndarray, np.ndarray]:
