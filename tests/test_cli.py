@@ -218,3 +218,27 @@ def test_json_alone_on_stdout_whatever_the_solver_prints(tmp_path, backend, gap)
     assert code in (0, 5), err
     d = json.loads(out)
     assert d["backend"] == backend
+
+
+def test_negative_values_are_values_not_options(capsys):
+    """``--values -0.2,0`` (a heave) is read as the values, not as an unknown option; the row at
+    the scene's own gap is the scene's own solve."""
+    code, out, err = run_cli(capsys, "sweep", "heave", "--param", "supports.1.gap", "--values", "-0.2,0",
+                             "--no-refine", "--json")
+    assert code == 0, err
+    rows = json.loads(out)["rows"]
+    assert [r["value"] for r in rows] == [-0.2, 0.0]
+    ref = pq.solve(pq.Scene.from_toml(scenes.path("heave")))
+    np.testing.assert_allclose(rows[0]["reactions"], ref.reactions, rtol=1e-9, atol=1e-9 * abs(ref.reactions).max())
+    code, out, err = run_cli(capsys, "solve", "heave", "--probe", "-1,5")
+    assert code == 2 and "--probe -1,5" in err and err.count("\n") == 1  # checked before any work
+
+
+def test_probe_in_a_hole_is_refused_before_any_work(capsys, tmp_path):
+    p = tmp_path / "disc.toml"
+    p.write_text('name = "disc"\n[plate]\nshape = { circle = [0.0, 0.0, 1.0] }\nh = 0.02\nE = 1e7\nnu = 0.3\n'
+                 '[mesh]\nelement = "dkt"\nsize = 0.25\n[edges]\nall = "simple"\n'
+                 '[[holes]]\ncircle = [0.5, 0.0, 0.2]\n[[loads]]\ntype = "uniform"\nq = 1.0\n')
+    code, out, err = run_cli(capsys, "solve", str(p), "--probe", "0.5,0.05", "--out", str(tmp_path / "o"))
+    assert code == 2 and "--probe 0.5,0.05" in err and "hole" in err and out == ""
+    assert not (tmp_path / "o").exists()  # nothing made: refused before the folder and the solve

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 
 from .. import scenes
@@ -25,6 +26,26 @@ from .common import _accuracy, _out_dir, _probe, _target
 from .solve import cmd_solve
 from .studies import cmd_regulate, cmd_sweep
 from .tools import cmd_backends, cmd_demo, cmd_export
+
+
+#: Options whose value may start with a minus sign (a heave, a negative range or probe).
+_NUMERIC_OPTIONS = ("--values", "--range", "--target", "--probe")
+
+
+def _negative_values_joined(argv: list[str]) -> list[str]:
+    """``--values -0.2,0`` as ``--values=-0.2,0``: argparse takes a value that starts with '-' and is
+    not a plain number for an option and fails with "expected one argument"."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a in _NUMERIC_OPTIONS and i + 1 < len(argv) and re.match(r"-[\d.]", argv[i + 1]):
+            out.append(f"{a}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(a)
+        i += 1
+    return out
 
 
 def main(argv=None) -> int:
@@ -99,7 +120,7 @@ def main(argv=None) -> int:
     r.add_argument("--force", action="store_true", help="--out: overwrite the file if it exists")
     b = sub.add_parser("backends", help="list the backends and the formulations each takes")
     b.add_argument("--json", action="store_true")
-    args = ap.parse_args(argv)
+    args = ap.parse_args(_negative_values_joined(sys.argv[1:] if argv is None else list(argv)))
     saved_limit = os.environ.get("PLATEQP_MAX_MEMORY")  # --max-memory holds for this command only
     try:
         return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends,

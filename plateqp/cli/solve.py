@@ -17,6 +17,20 @@ from ..io.vtk import vtu_files, write_vtu
 from .common import _options, _backend_name, _out_dir, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin
 
 
+def _check_probes(scene, probes) -> None:
+    """Before any work: a probe off the plate (outside it, in an opening or a hole) is a SceneError
+    naming it, so that no solve is lost to it."""
+    if not probes:
+        return
+    grid = None
+    if scene.triangles:
+        from ..geometry import Region, scene_domain
+
+        grid = Region(scene_domain(scene), 1.0)
+    for px, py in probes:
+        scene._inside(f"--probe {px:g},{py:g}", px, py, grid=grid)
+
+
 def _summary(result, probes=()) -> str:
     w, x, y = result.w_max()
     lines = [f"scene {result.scene.name!r}: {result.formulation} / {result.backend} / {result.accuracy}"
@@ -38,10 +52,10 @@ def _summary(result, probes=()) -> str:
         if not result.deflection_unique:
             lines.append("  reactions unique, deflection not unique: the supports that carry the load leave a rigid"
                          " motion of the plate free; shown: its lowest position, nearest the level")
-        lines.append("  support      x          y        gap0        reaction     in contact")
+        lines.append("  support      x          y        gap0        reaction     in contact   (numbered from 1)")
         sc = result.scene
         for i, s in enumerate(sc.supports):
-            lines.append(f"  {i:5d} {s.x:10.4g} {s.y:10.4g} {s.gap:11.4g} {result.reactions[i]:14.6g}"
+            lines.append(f"  {i + 1:5d} {s.x:10.4g} {s.y:10.4g} {s.gap:11.4g} {result.reactions[i]:14.6g}"
                          f"     {'yes' if result.active[i] else 'no'}")
     t = result.times
     lines.append(f"  times: build {t.get('build', 0):.3f} s, solve {t.get('solve', 0):.3f} s, total {t.get('total', 0):.3f} s")
@@ -82,6 +96,7 @@ def cmd_solve(args) -> int:
     scene = _scene_or_builtin(args.scene)
     opts = _options(args.options)
     _backend_name(args.backend)
+    _check_probes(scene, args.probe)
     stem = safe_filename(scene.name)
     if args.sensitivity and not scene.one_sided:
         raise ProblemError("--sensitivity: the scene has no one-sided supports (nothing to differentiate)")

@@ -115,9 +115,12 @@ class ExactPath:
 
     def __str__(self) -> str:
         lines = [f"exact path of {self.path} from {self.start:g} to {self.stop:g}: {len(self.pieces)} piece(s)"]
+        if self.breakpoints:
+            lines.append("  (contact points numbered from 1: the supports in scene order, then bed nodes)")
         for b in self.breakpoints:
-            lines.append(f"  at {b['at']:.12g}: comes into contact {b['comes_into_contact'] or '-'},"
-                         f" lifts off {b['lifts_off'] or '-'}")
+            on = [i + 1 for i in b["comes_into_contact"]]
+            off = [i + 1 for i in b["lifts_off"]]
+            lines.append(f"  at {b['at']:.12g}: comes into contact {on or '-'}, lifts off {off or '-'}")
         if not self.breakpoints:
             lines.append("  the contact set is the same along the whole path")
         return "\n".join(lines)

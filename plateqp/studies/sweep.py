@@ -106,10 +106,11 @@ class SweepResult:
                          f" {r['kkt_worst'] if r['kkt_worst'] is not None else float('nan'):9.1e}"
                          f" {r['times']['total']:8.3f}")
         if self.breakpoints:
-            lines.append("changes of the contact set (working scheme):")
+            lines.append("changes of the contact set (working scheme; contact points numbered from 1: the supports"
+                         " in scene order, then bed nodes):")
             for b in self.breakpoints:
-                on = sorted(set(b["after"]) - set(b["before"]))
-                off = sorted(set(b["before"]) - set(b["after"]))
+                on = [i + 1 for i in sorted(set(b["after"]) - set(b["before"]))]
+                off = [i + 1 for i in sorted(set(b["before"]) - set(b["after"]))]
                 where = f"at {b['at']:.6g}" if b["at"] is not None else f"in {b['bracket']}"
                 lines.append(f"  between {b['between'][0]} and {b['between'][1]}: {where};"
                              f" comes into contact {on or '-'}, lifts off {off or '-'}"
