@@ -219,8 +219,8 @@ def main():
         n = args.mesh
         bindings = [b for b in args.bindings.split(",") if b and binding_available(b)]
         print(f"\n### {n}×{n} ACM plate: pdas against one two-sided factorise-and-solve (medians of {args.repeat})\n")
-        print("Both through the same library: plateqp.linalg.Factor for the two-sided solve, pdas's own "
-              "CHOLMOD calls (or Factor's SuperLU) for pdas.\n")
+        print("Both through the same library: plateqp.linalg.Factor for the two-sided solve, "
+              "plateqp.linalg's Cholesky / SchurFactor (or Factor's SuperLU) for pdas.\n")
         print("| scene | library | dofs | contact rows | in contact | method | two-sided s | pdas s | ratio | "
               "KKT worst | iterations | factorisations | solves |")
         print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
