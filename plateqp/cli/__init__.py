@@ -99,6 +99,11 @@ def main(argv=None) -> int:
     w.add_argument("--max-values", type=int, default=10_000, metavar="N", help="most values a sweep takes")
     w.add_argument("--max-memory", metavar="BYTES", help="refuse meshes estimated to need more (e.g. 8G)")
     w.add_argument("--json", action="store_true")
+    w.add_argument("--store", metavar="FILE.jsonl", help="write each row as it is solved; if FILE holds rows of "
+                   "this same sweep (a stopped run), solve only the values it lacks")
+    w.add_argument("--out", metavar="FILE.nc", help="the rows as an xarray Dataset in netCDF (value as the "
+                   "dimension); checked before any work")
+    w.add_argument("--force", action="store_true", help="--out: overwrite the file if it exists")
     x = sub.add_parser("export", help="write the contact problem as a QPS file or a qpbenchmark test set")
     x.add_argument("scene", help="a scene file, or the name of a built-in scene")
     x.add_argument("--formulation", default="primal", choices=["primal", "condensed", "dual"])

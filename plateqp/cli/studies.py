@@ -122,7 +122,7 @@ def _sweep_exact(scene, values, opts, args):
     return exact_sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
                        accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
                        max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
-                       warm_start=not args.no_warm_start)
+                       warm_start=not args.no_warm_start, store=args.store)
 
 
 def cmd_sweep(args) -> int:
@@ -133,6 +133,12 @@ def cmd_sweep(args) -> int:
     values = _sweep_values(args)
     opts = _options(args.options)
     _backend_name(args.backend)
+    if args.out:  # before any work
+        from ..io.fields import _optional
+        from ..io.files import check_file
+
+        _optional("xarray")
+        check_file(args.out, force=args.force, label=f"--out {args.out}", flag="--force")
     with _sigterm_as_interrupt() as seen:
         try:
             with _stdout_to_stderr():
@@ -144,9 +150,10 @@ def cmd_sweep(args) -> int:
                                 executor="serial" if args.workers <= 1 else None,
                                 max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
                                 refine_breakpoints=not args.no_refine, rtol=args.rtol,
-                                warm_start=not args.no_warm_start)
+                                warm_start=not args.no_warm_start, store=args.store)
         except SweepInterrupted as exn:
             part = exn.result
+            _write_netcdf(part, args.out)
             print(json.dumps({"method": "none" if args.no_refine else "bisection", **part.to_dict()}, indent=1)
                   if args.json else part)
             sys.stdout.flush()
@@ -157,6 +164,7 @@ def cmd_sweep(args) -> int:
                   f" ({where}); not done: {len(left)}"
                   + (f" (from {args.param} = {left[0]})" if left else ""), file=sys.stderr)
             return 143 if seen else 130
+    _write_netcdf(res, args.out)
     if args.json:
         print(json.dumps({"method": "none" if args.no_refine else "bisection", **res.to_dict()}, indent=1))
     else:
@@ -167,6 +175,17 @@ def cmd_sweep(args) -> int:
               f"(first: {args.param} = {bad[0]['value']}: {bad[0]['error'] or bad[0]['status']})", file=sys.stderr)
         return 5
     return 0
+
+
+def _write_netcdf(res, out) -> None:
+    """--out FILE.nc: the rows as an xarray Dataset (:meth:`SweepResult.to_xarray`), netCDF 3
+    through SciPy (no netCDF library needed); the file was checked before any work."""
+    if not out:
+        return
+    from pathlib import Path
+
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
+    res.to_xarray().to_netcdf(out, engine="scipy")
 
 
 @contextlib.contextmanager

@@ -15,6 +15,8 @@ module                 job
                        :func:`most_uniform_stiffness`
 :mod:`.homotopy`       :func:`exact_path`: the exact piecewise-linear path along a parameter that
                        enters linearly (gap, load, prescribed displacement), every breakpoint
+:mod:`.store`          :class:`RowStore`: a sweep's rows on disk as they are solved (JSON Lines),
+                       so that a stopped sweep resumes; ``SweepResult.to_xarray`` for netCDF
 =====================  ==========================================================================
 
 Scene fields are named by dotted paths (:mod:`plateqp.paths`: :func:`get_param`,

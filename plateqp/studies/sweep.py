@@ -15,6 +15,7 @@ re-use on; ``warm_start=False`` turns them off alone. Where the values are solve
 
 from __future__ import annotations
 
+import json
 import math
 import time
 import uuid
@@ -77,6 +78,41 @@ class SweepResult:
             d["interrupted"] = self.interrupted
         return d
 
+    def to_xarray(self):
+        """The rows as an :class:`xarray.Dataset` with the dimension ``value`` (the parameter;
+        "rigid" as inf) and ``point`` (the contact points: supports in scene order, then bed
+        nodes): ``reactions`` and ``active`` (value, point); ``status``, ``w_max``, ``s1_max``,
+        ``kkt_worst``, ``n_contact`` and ``time`` per value (NaN where a value failed)."""
+        from ..io.fields import _optional
+
+        xr = _optional("xarray")
+        vals = np.array([np.inf if v == "rigid" else float(v) for v in (r["value"] for r in self.rows)])
+        R = self.reactions
+        m = R.shape[1] if R.ndim == 2 else 0
+        act = np.array([[bool(a) for a in r["active"]] if r["active"] is not None else [False] * m
+                        for r in self.rows], dtype=bool).reshape(len(self.rows), m)
+
+        def col(key):
+            return np.array([np.nan if r.get(key) is None else float(r[key]) for r in self.rows])
+
+        data = {
+            "reactions": (("value", "point"), R.reshape(len(self.rows), m),
+                          {"long_name": "reaction (positive pushes the plate up)", "units": "F"}),
+            "active": (("value", "point"), act, {"long_name": "in contact"}),
+            "status": (("value",), np.array([str(r["status"]) for r in self.rows])),
+            "w_max": (("value",), col("w_max"), {"long_name": "largest |w|, with its sign", "units": "L"}),
+            "s1_max": (("value",), col("s1_max"), {"long_name": "largest nodal σ1", "units": "F/L^2"}),
+            "kkt_worst": (("value",), col("kkt_worst"), {"long_name": "worst KKT residual"}),
+            "n_contact": (("value",), act.sum(axis=1)),
+            "time": (("value",), np.array([float(r["times"]["total"]) if r.get("times") else np.nan
+                                           for r in self.rows]), {"units": "s"}),
+        }
+        attrs = {"parameter": self.path, "breakpoints": json.dumps(self.breakpoints, default=str)}
+        if self.interrupted is not None:
+            attrs["interrupted"] = json.dumps(self.interrupted, default=str)
+        return xr.Dataset(data, coords={"value": ("value", vals, {"long_name": self.path}),
+                                        "point": ("point", np.arange(1, m + 1))}, attrs=attrs)
+
     @property
     def reactions(self) -> np.ndarray:
         """(n_values, m) reactions; NaN rows for failed values."""
@@ -123,7 +159,7 @@ class SweepResult:
 def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", formulation: str = "auto",
           accuracy: str = "default", executor=None, progress: bool = True, refine_breakpoints: bool = True,
           rtol: float = 1e-3, options: dict | None = None, reuse: bool = True, max_workers: int = 2,
-          bisection: str = "auto", warm_start: bool = True) -> SweepResult:
+          bisection: str = "auto", warm_start: bool = True, store=None) -> SweepResult:
     """Solve ``scene`` for each value of the field PATH; find where the contact set changes.
 
     Parameters
@@ -149,6 +185,10 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
         Other backends ignore it. Each row's ``iterations`` counts the backend's steps.
     bisection : "auto" (geometric when every value is positive and they span a decade or
         more, else linear), "geometric" or "linear"
+    store : None, or a file (JSON Lines, :mod:`plateqp.studies.store`) where each row is
+        written as soon as it is solved; if the file holds rows of this same sweep (same scene,
+        path, values and solver settings) from a stopped run, those values are not solved
+        again. A file of another sweep is a ProblemError.
 
     Returns
     -------
@@ -179,6 +219,14 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
         raise ProblemError("geometric bisection needs positive values")
     bis = Bisection(geometric, rtol, 1e-3 * max((abs(x) for x in finite), default=1.0), is_int)
 
+    rowstore = None
+    if store is not None:
+        from .. import __version__
+        from .store import RowStore, scene_fingerprint
+
+        rowstore = RowStore(store, {"scene": scene_fingerprint(scene), "name": str(scene.name), "path": path,
+                                    "values": values, "backend": backend, "formulation": formulation,
+                                    "accuracy": accuracy, "options": options, "version": __version__})
     t0 = time.perf_counter()
     ctx = Context(uuid.uuid4().hex, scene, path, backend, formulation, accuracy, options, reuse,
                    bool(warm_start))
@@ -189,20 +237,27 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
     found: dict[int, list[dict]] = {}
     solves = bisection_steps = 0
     stopped = False
+    if rowstore is not None:  # values a stopped run already solved
+        for i, row in rowstore.done.items():
+            rows[i] = row
+            actives[i] = tuple(row["active"]) if row.get("active") is not None else None
+    todo = [i for i in range(n) if rows[i] is None]
     try:
-        bar = Progress(n, f"sweep {path}", progress)
+        bar = Progress(len(todo), f"sweep {path}", progress)
         try:
             if runner.kind == "serial":
                 # a plain loop, warm-starting each value from the one before
                 state = None
-                for i in range(n):
+                for i in todo:
                     row, act, new = solve_value(ctx, values[i], next_start(ctx, state))
                     rows[i], actives[i] = row, act
+                    if rowstore is not None:
+                        rowstore.append(i, row)
                     state = new or state
                     bar.update()
             else:
-                size = max(1, math.ceil(n / (4 * runner.workers)))
-                chunks = [[(i, values[i]) for i in range(j, min(n, j + size))] for j in range(0, n, size)]
+                size = max(1, math.ceil(len(todo) / (4 * runner.workers)))
+                chunks = [[(i, values[i]) for i in todo[j:j + size]] for j in range(0, len(todo), size)]
                 futs = {runner.submit(run_chunk, ctx, ch): ch for ch in chunks}
                 for key, fut in runner.as_completed(futs):
                     ch = futs[key]
@@ -213,6 +268,8 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
                     for i, row in done:
                         rows[i] = row
                         actives[i] = tuple(row["active"]) if row["active"] is not None else None
+                        if rowstore is not None:
+                            rowstore.append(i, row)
                     bar.update(len(ch))
         finally:
             bar.close()
