@@ -14,7 +14,7 @@ from ..errors import SolverError
 from .base import ACCURACIES, LCP, PRESET_TOL, QP, Backend, RawSolution, Status, accuracy_tol
 
 # module name -> the backends it provides (a family such as qpsolvers provides many)
-_MODULES = ("lemke", "bpp", "pgs", "pdas", "osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
+_MODULES = ("lemke", "bpp", "pgs", "pdas", "toggle", "osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
 
 _registry: dict[str, Backend] | None = None
 
