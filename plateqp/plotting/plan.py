@@ -45,6 +45,10 @@ def _draw_supports(ax, result: Result, *, all_active: bool = False, size: float 
 
 
 def _plan_axes(ax, result: Result, units, title: str | None = None):
+    from .tri import on_triangles, tri_plan_axes
+
+    if on_triangles(result):
+        return tri_plan_axes(ax, result, units, title)
     g = result.model.grid
     L = _units(units)[0]
     ax.set_aspect("equal")
@@ -93,6 +97,10 @@ def plot_mesh(result: Result, units=None, *, sections=None, annotate: bool = Tru
     from matplotlib.lines import Line2D
     from matplotlib.patches import Rectangle
 
+    from .tri import on_triangles, plot_mesh_tri
+
+    if on_triangles(result):  # the true outline, triangles, edges by kind
+        return plot_mesh_tri(result, units, sections=sections, annotate=annotate, numbers=numbers)
     L, F = _units(units)
     sc = result.scene
     g = result.model.grid
@@ -223,8 +231,12 @@ def default_sections(result: Result) -> list[tuple[str, tuple[float, float], tup
     Rows: the distinct y of the supports when there are 2 to 6 of them with at least two
     supports each (the source paper's sections 1–5 through a grid of supports). Otherwise the
     horizontal and vertical lines through the largest point load (or the centre), the bottom
-    edge if supports stand on it, and the diagonal.
+    edge if supports stand on it, and the diagonal. On a triangle mesh: :func:`.tri.tri_sections`.
     """
+    from .tri import on_triangles, tri_sections
+
+    if on_triangles(result):
+        return tri_sections(result)
     sc = result.scene
     a, b = sc.plate.a, sc.plate.b
     sup = _supports(result)
