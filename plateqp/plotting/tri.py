@@ -94,7 +94,7 @@ def plot_mesh_tri(result: Result, units=None, *, sections=None, annotate: bool =
     from matplotlib.lines import Line2D
 
     from ..geometry import edge_table
-    from .plan import _draw_supports, _legend_handles, _norm_sections
+    from .marks import _draw_supports, _legend_handles, _norm_sections
 
     L, F = _units(units)
     sc = result.scene
@@ -154,7 +154,7 @@ def plot_mesh_tri(result: Result, units=None, *, sections=None, annotate: bool =
 
 # -- fields -----------------------------------------------------------------------------------
 def _contour_pair(result, two_sided, units, fields, levels, title, cbar_label, extra_handles=(), mark_max=None):
-    from .plan import _draw_supports, _legend_handles
+    from .marks import _draw_supports, _legend_handles
 
     pairs = [(result, _name(result))] + ([(two_sided, TWO_SIDED)] if two_sided is not None else [])
     fig = _figure((6.0 * len(pairs) + 1.2, 6.2))
@@ -215,7 +215,7 @@ def plot_principal_tri(result: Result, two_sided: Result | None = None, units=No
 
 def plot_difference_tri(result: Result, two_sided: Result, units=None, *, levels: int = 20) -> Figure:
     """w(one-sided) − w(two-sided) at the nodes as a contour map (``tricontourf``)."""
-    from .plan import _draw_supports, _legend_handles
+    from .marks import _draw_supports, _legend_handles
 
     L = _units(units)[0]
     fig = _figure((7.6, 7.4))
