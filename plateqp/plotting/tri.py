@@ -258,7 +258,7 @@ def plot_surface_tri(result: Result, two_sided: Result | None = None, units=None
     lo, hi = _range(fields)
     norm, cmap = _symmetric_or_not(lo, hi)
     surf = ax.plot_trisurf(mesh.nodes[:, 0], mesh.nodes[:, 1], W, triangles=mesh.triangles, cmap=cmap, norm=norm,
-                           linewidth=0.1, edgecolor="0.35", alpha=0.92, zorder=1)
+                           linewidth=0.0, antialiased=False, alpha=0.92, zorder=1)
     what = (ONE_SIDED + " (surface)") if result.scene.one_sided else "deflection w (surface)"
     handles = [Patch(facecolor=surf.get_cmap()(0.7), edgecolor="0.3", label=what)]
     if two_sided is not None:
@@ -266,8 +266,8 @@ def plot_surface_tri(result: Result, two_sided: Result | None = None, units=None
         t = mesh.triangles
         e = np.unique(np.sort(np.vstack([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1), axis=0)
         P = np.column_stack([mesh.nodes, W2])
-        ax.add_collection3d(Line3DCollection(P[e], colors="k", linewidths=0.3, linestyles="--", zorder=3))
-        handles.append(Line2D([], [], color="k", lw=0.8, ls="--", label=TWO_SIDED + " (mesh lines)"))
+        ax.add_collection3d(Line3DCollection(P[e], colors="k", linewidths=0.15, alpha=0.4, zorder=3))
+        handles.append(Line2D([], [], color="k", lw=0.6, alpha=0.6, label=TWO_SIDED + " (mesh lines)"))
     sup = _supports(result)
     if sup.n:
         wsup = np.atleast_1d(result.deflection(sup.xy[:, 0], sup.xy[:, 1]))
