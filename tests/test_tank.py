@@ -66,6 +66,7 @@ def test_demo_on_the_tank_skips_the_grid_parts_with_reasons(tmp_path, capsys):
     assert "tank" in out and "14/19" in out
     assert "tank: comparison skipped:" in out and "tank: convergence skipped:" in out
     assert "two-sided comparison" not in out
+    assert "convergence study skipped" not in err  # not even tried: no study on a mesh it cannot halve
     pngs = {p.name for p in tmp_path.glob("*.png")}
     assert pngs == {f"tank-{k}.png" for k in ("mesh", "surface", "contours", "sections", "difference", "sigma1",
                                                 "reactions")}
