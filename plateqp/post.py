@@ -15,6 +15,12 @@ For the ACM element moments are discontinuous between cells (non-conforming). A 
 value just inside its corner at that node; NaN at nodes off the plate. The operator holds the
 interpolation at those points, built once per mesh, so that many solutions on one mesh (a
 sweep) cost a sparse product each.
+
+On a triangle mesh (:class:`~plateqp.triassembly.TriModel`, the DKT element) :class:`TriNodalOperator`
+does the same: each triangle's own curvatures at each of its three vertices (DKT's linear
+curvature field, :meth:`~plateqp.elements.dkt.DKT.curvature_matrix`), averaged over the triangles
+around each node; w is the node's own dof. Values come as (n_nodes,) arrays in the mesh's node
+order, every node on the plate.
 """
 
 from __future__ import annotations
@@ -138,6 +144,63 @@ class NodalOperator:
         return self._averaged(from_curvatures(plate, quantity, kxx, kyy, kxy))
 
 
+class TriNodalOperator:
+    """Nodal averages of the fields of one triangle mesh (the triangle analogue of :class:`NodalOperator`).
+
+    Each triangle's curvatures (w,xx, w,yy, w,xy) at its three vertices are taken from the
+    element (its own value there, not a neighbour's), the fields recovered from them, and each
+    node's value is the plain mean over the triangles that hold it. The operator from the full
+    dofs to those 3 × n_triangles vertex curvatures is built once. Valid for every model on the
+    same mesh.
+
+    Parameters
+    ----------
+    model : :class:`~plateqp.triassembly.TriModel`
+    """
+
+    def __init__(self, model) -> None:
+        mesh = model.grid
+        self.model = model
+        t = mesh.triangles
+        nt, n = len(t), mesh.n_nodes
+        self.n_nodes = n
+        xy = mesh.nodes[t]
+        B = model.element.curvature_matrix(xy, np.eye(3))  # (nt, 3 vertices, 3 curvatures, 9)
+        B = B.copy()
+        B[..., 2, :] *= 0.5  # κ3 = 2 w,xy -> w,xy
+        # rows: curvature c of vertex v of triangle k at c * (3 nt) + 3 k + v
+        rows = (np.arange(3)[None, None, :, None] * 3 * nt + 3 * np.arange(nt)[:, None, None, None]
+                + np.arange(3)[None, :, None, None])
+        rows = np.broadcast_to(rows, B.shape)
+        cols = np.broadcast_to(model.cell_dofs[:, None, None, :], B.shape)
+        self._curv = sp.csr_matrix((B.ravel(), (rows.ravel(), cols.ravel())), shape=(9 * nt, model.n_full))
+        nodes = t.ravel()  # vertex v of triangle k at 3 k + v, as the rows above
+        cnt = np.bincount(nodes, minlength=n).astype(float)
+        self._on = cnt > 0
+        A = sp.csr_matrix((np.ones(nodes.size), (nodes, np.arange(nodes.size))), shape=(n, nodes.size))
+        self._average = sp.diags(np.where(self._on, 1.0 / np.where(self._on, cnt, 1.0), 0.0)) @ A
+        self._nd = model.element.ndof_node
+
+    def __call__(self, u: np.ndarray, plate, quantity: str = "w") -> np.ndarray:
+        """(n_nodes,) nodal values of ``quantity`` (one of :data:`QUANTITIES`) of the full dof
+        vector ``u`` of a plate (``plate``: its :class:`~plateqp.scene.Plate`)."""
+        check_quantity(quantity)
+        if quantity == "w":
+            return np.asarray(u[0::self._nd][: self.n_nodes], dtype=float).copy()
+        kxx, kyy, kxy = (self._curv @ u).reshape(3, -1)
+        out = self._average @ from_curvatures(plate, quantity, kxx, kyy, kxy)
+        out[~self._on] = np.nan
+        return out
+
+
+def nodal_operator(model):
+    """The nodal-average operator of ``model``: :class:`TriNodalOperator` on a triangle mesh,
+    :class:`NodalOperator` on the structured grid."""
+    from .trimesh import TriMesh
+
+    return TriNodalOperator(model) if isinstance(model.grid, TriMesh) else NodalOperator(model)
+
+
 def nodal_w(model, u: np.ndarray) -> np.ndarray:
     """w at every plate node from the nodal dofs (NaN off the plate), shape (ny+1, nx+1)."""
     g = model.grid
@@ -147,5 +210,5 @@ def nodal_w(model, u: np.ndarray) -> np.ndarray:
     return w.reshape(g.ny + 1, g.nx + 1)
 
 
-__all__ = ["CURVATURE_QUANTITIES", "NodalOperator", "QUANTITIES", "check_quantity", "from_curvatures", "moments",
-           "nodal_w", "principal", "stresses"]
+__all__ = ["CURVATURE_QUANTITIES", "NodalOperator", "QUANTITIES", "TriNodalOperator", "check_quantity",
+           "from_curvatures", "moments", "nodal_operator", "nodal_w", "principal", "stresses"]

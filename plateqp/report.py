@@ -7,8 +7,8 @@ facts, statements and figures, and per study (the paper's figures 5 and 6) its w
 figures (PNG embedded as base64, so the file stands alone).
 
 The functions read the demo's per-scene runs (:class:`plateqp.demo.SceneRun`: ``name``,
-``story``, ``units``, ``one``, ``two``, ``comparison``, ``figures``, ``captions`` and the
-times) and study runs (:class:`plateqp.demo.paper.StudyRun`) by their attributes; this module
+``story``, ``units``, ``one``, ``two``, ``comparison``, ``figures``, ``captions``, the
+times and ``skipped``: the parts that did not run on the scene, with the reason, shown in the report) and study runs (:class:`plateqp.demo.paper.StudyRun`) by their attributes; this module
 imports neither the demo nor matplotlib.
 """
 
@@ -152,6 +152,8 @@ def report_html(runs: list, table: str, studies: list = ()) -> str:
         if r.story:
             parts.append(f"<pre class='story'>{e(r.story)}</pre>")
         parts.append(_scene_facts(r))
+        for part, why in getattr(r, "skipped", {}).items():
+            parts.append(f"<p class='skipped'><b>{e(part)} skipped</b>: {e(why)}.</p>")
         if r.comparison is not None:
             parts.append("<ul>" + "".join(f"<li>{e(s)}</li>" for s in r.comparison.lines(r.units)) + "</ul>")
         for stem, png in r.figures.items():
@@ -205,8 +207,17 @@ def _scene_facts(r) -> str:
             loads.append(f"patch q = {ld.q:g} on [{ld.x0:g}, {ld.x1:g}] × [{ld.y0:g}, {ld.y1:g}]")
     n = len(sc.supports)
     Eu, Du = (f" {F}/{L}²", f" {F}·{L}") if r.units else ("", "")
-    facts = [f"plate {p.a:g} × {p.b:g} {L}, h = {p.h:g} {L}, E = {p.E:g}{Eu}, ν = {p.nu:g}, "
-             f"D = {p.D:.4g}{Du}; mesh {sc.mesh.nx} × {sc.mesh.ny} {sc.mesh.element.upper()}",
+    if sc.triangles:
+        mesh = r.one.model.grid
+        shape = ", ".join(f"{k} {v}" for k, v in (p.shape or {}).items()) or f"{p.a:g} × {p.b:g}"
+        plan = f"plate {shape} {L}" + (f" with {len(sc.holes)} hole(s)" if sc.holes else "")
+        mesh_txt = (f"mesh: {len(mesh.triangles)} triangles, {mesh.n_nodes} nodes, size {mesh.size:g} {L}, "
+                    f"{sc.mesh.element.upper()}")
+    else:
+        plan = f"plate {p.a:g} × {p.b:g} {L}"
+        mesh_txt = f"mesh {sc.mesh.nx} × {sc.mesh.ny} {sc.mesh.element.upper()}"
+    facts = [f"{plan}, h = {p.h:g} {L}, E = {p.E:g}{Eu}, ν = {p.nu:g}, "
+             f"D = {p.D:.4g}{Du}; {mesh_txt}",
              "loads: " + "; ".join(loads)]
     if n:
         heaved = [i + 1 for i, s in enumerate(sc.supports) if s.gap < 0]

@@ -149,8 +149,10 @@ class Result:
 
     def nodal(self, quantity: str = "w") -> np.ndarray:
         """(ny+1, nx+1) smoothed nodal values (average over the kept cells at each node; NaN off
-        the plate): :class:`plateqp.post.NodalOperator`. ``quantity`` as for :meth:`section`."""
-        return post.NodalOperator(self.model)(self.u, self.scene.plate, quantity)
+        the plate): :class:`plateqp.post.NodalOperator`; on a triangle mesh (n_nodes,), averaged
+        over the triangles at each node: :class:`plateqp.post.TriNodalOperator`. ``quantity`` as
+        for :meth:`section`."""
+        return post.nodal_operator(self.model)(self.u, self.scene.plate, quantity)
 
     # -- summaries --------------------------------------------------------------------------
     def w_nodes(self) -> np.ndarray:

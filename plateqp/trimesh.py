@@ -104,11 +104,12 @@ class TriMesh:
 
     def __getattr__(self, name: str):
         """A rectangular grid's attribute (nx, ny, node_mask, cell_nodes, …), asked of a triangle
-        mesh by code that only works on grids (plots, nodal fields): a one-line SceneError."""
+        mesh by code that only works on grids (the studies by mesh halving, the demo's zone
+        comparison): a one-line SceneError."""
         if name.startswith("_"):
             raise AttributeError(name)
-        raise SceneError(f"plots, nodal fields and other grid-based output are not yet available on triangle "
-                         f"meshes (mesh.element = \"dkt\"; the grid's {name!r} was asked for)")
+        raise SceneError(f"this grid-based output is not yet available on triangle meshes "
+                         f"(mesh.element = \"dkt\"; the grid's {name!r} was asked for)")
 
     # -- queries ------------------------------------------------------------------------
     def areas(self) -> np.ndarray:

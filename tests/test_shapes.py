@@ -190,10 +190,9 @@ def test_moments_and_slopes_of_the_clamped_circular_plate():
 
 
 @pytest.mark.parametrize("call, words", [
-    (lambda r: r.nodal("w"), "plots, nodal fields"),
     (lambda r: convergence(r.scene), "convergence"),
     (lambda r: pq.solve(disc("simple", size=R / 4, supports=posts([0.0])), accuracy="auto"), "convergence"),
-], ids=["nodal", "convergence", "auto-accuracy"])
+], ids=["convergence", "auto-accuracy"])
 def test_not_yet_on_triangles_is_one_clear_line(call, words):
     res = pq.solve(disc("clamped", size=R / 4))
     with pytest.raises(pq.PlateQPError, match="not yet available on triangle meshes") as info:

@@ -8,6 +8,12 @@ point (discrete supports in scene order, 1-based as in the figures, then bed nod
 
 Units are the scene's own consistent units (plateqp has no unit system): a length L, a force
 F; the attributes of each variable say which.
+
+On a triangle mesh (``mesh.element = "dkt"``) the fields are (n_nodes,) arrays on the mesh's
+nodes (every node on the plate; moments averaged over the triangles around a node,
+:class:`plateqp.post.TriNodalOperator`), and :func:`to_xarray` puts them on a ``node``
+dimension with ``x`` and ``y`` coordinates and the triangles as the variable ``triangles``
+(``triangle`` × ``vertex``, 0-based node indices, counter-clockwise).
 """
 
 from __future__ import annotations
@@ -15,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import PlateQPError
-from ..post import QUANTITIES, NodalOperator, nodal_w
+from ..post import QUANTITIES, NodalOperator, TriNodalOperator, nodal_w
 
 #: (long name, units in the scene's length L and force F) of each nodal field.
 FIELD_ATTRS = {
@@ -45,10 +51,21 @@ def _grid(result):
     return grid
 
 
+def on_triangles(result) -> bool:
+    """Whether ``result`` is on a triangle mesh (a :class:`~plateqp.triassembly.TriModel`)."""
+    from ..trimesh import TriMesh
+
+    return isinstance(getattr(result.model, "grid", None), TriMesh)
+
+
 def node_fields(result, quantities=QUANTITIES) -> dict[str, np.ndarray]:
     """Each field of ``quantities`` at the nodes: (ny+1, nx+1) arrays, NaN off the plate; w is
     the nodal dof itself, the others are averaged over the kept cells around a node
-    (:class:`plateqp.post.NodalOperator`)."""
+    (:class:`plateqp.post.NodalOperator`). On a triangle mesh (n_nodes,) arrays
+    (:class:`plateqp.post.TriNodalOperator`)."""
+    if on_triangles(result):
+        top = TriNodalOperator(result.model)
+        return {q: top(result.u, result.scene.plate, q) for q in quantities}
     _grid(result)
     op = NodalOperator(result.model)
     return {q: nodal_w(result.model, result.u) if q == "w" else op(result.u, result.scene.plate, q)
@@ -61,20 +78,32 @@ def to_xarray(result, quantities=QUANTITIES):
     Dimensions ``y`` and ``x`` (the node coordinates), one variable per field of
     ``quantities`` with ``long_name`` and ``units`` attributes; the dataset's attributes name
     the scene, backend, formulation, status and the plate's E, ν, h. NaN off the plate.
+    On a triangle mesh: dimension ``node`` with coordinates ``x``, ``y``, and ``triangles``
+    (``triangle`` × ``vertex``) among the variables (see the module docstring).
     """
     xr = _optional("xarray")
-    g = _grid(result)
     fields = node_fields(result, quantities)
-    x = np.arange(g.nx + 1) * g.hx
-    y = np.arange(g.ny + 1) * g.hy
-    data = {q: (("y", "x"), v, {"long_name": FIELD_ATTRS[q][0], "units": FIELD_ATTRS[q][1]})
+    if on_triangles(result):
+        mesh = result.model.grid
+        dims = ("node",)
+        coords = {"x": ("node", mesh.nodes[:, 0].copy(), {"units": "L"}),
+                  "y": ("node", mesh.nodes[:, 1].copy(), {"units": "L"})}
+    else:
+        g = _grid(result)
+        dims = ("y", "x")
+        coords = {"x": ("x", np.arange(g.nx + 1) * g.hx, {"units": "L"}),
+                  "y": ("y", np.arange(g.ny + 1) * g.hy, {"units": "L"})}
+    data = {q: (dims, v, {"long_name": FIELD_ATTRS[q][0], "units": FIELD_ATTRS[q][1]})
             for q, v in fields.items()}
+    if on_triangles(result):
+        data["triangles"] = (("triangle", "vertex"), result.model.grid.triangles.astype(np.int64),
+                             {"long_name": "the mesh's triangles: 0-based node indices, counter-clockwise"})
     plate = result.scene.plate
     attrs = {"scene": str(result.scene.name), "backend": str(result.backend),
              "formulation": str(result.formulation), "status": result.status.value,
              "E": float(plate.E), "nu": float(plate.nu), "h": float(plate.h),
              "units": "the scene's own consistent units: length L, force F"}
-    return xr.Dataset(data, coords={"x": ("x", x, {"units": "L"}), "y": ("y", y, {"units": "L"})}, attrs=attrs)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 #: The columns of :func:`supports_frame`, in order.

@@ -2,7 +2,7 @@
 
 :func:`write_vtu` writes two VTK unstructured-grid files:
 
-- ``<stem>.vtu``: the plate's kept cells (quads) on its nodes, z = 0, with the nodal fields
+- ``<stem>.vtu``: the plate's kept cells (quads; on a triangle mesh its triangles) on its nodes, z = 0, with the nodal fields
   (:data:`plateqp.post.QUANTITIES`: w, moments, surface stresses, σ1, σ2; averaged over the
   cells around a node) and ``displacement`` = (0, 0, −w) for ParaView's "Warp By Vector" (w is
   positive downward, z up); for a tensionless bed also the bed's ``reaction`` and ``contact``
@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import ExportError
 from .files import safe_filename
-from .fields import _grid, _optional, node_fields, supports_columns
+from .fields import _grid, _optional, node_fields, on_triangles, supports_columns
 
 
 def vtu_files(stem: str, result=None) -> list[str]:
@@ -42,14 +42,20 @@ def _has_supports(result) -> bool:
 def plate_mesh(result):
     """The meshio Mesh of the plate (see the module docstring)."""
     meshio = _optional("meshio")
-    g = _grid(result)
     model = result.model
-    keep = g.node_mask()
+    if on_triangles(result):
+        g = model.grid
+        keep = np.ones(g.n_nodes, dtype=bool)
+        cells = ("triangle", g.triangles.astype(np.int64))
+    else:
+        g = _grid(result)
+        keep = g.node_mask()
     new = np.full(g.n_nodes, -1, dtype=np.int64)
     new[keep] = np.arange(int(keep.sum()))
     xy = g.node_xy()[keep]
     points = np.column_stack([xy, np.zeros(len(xy))])
-    quads = new[g.cell_nodes()[model.cells]]
+    if not on_triangles(result):
+        cells = ("quad", new[g.cell_nodes()[model.cells]])
     data = {q: v.ravel()[keep] for q, v in node_fields(result).items()}
     data["displacement"] = np.column_stack([np.zeros(len(xy)), np.zeros(len(xy)), -data["w"]])
     c = model.contacts
@@ -62,7 +68,7 @@ def plate_mesh(result):
         contact[nodes] = np.asarray(result.active, dtype=float)[bed]
         data["reaction"] = react[keep]
         data["contact"] = contact[keep]
-    return meshio.Mesh(points, [("quad", quads)], point_data=data)
+    return meshio.Mesh(points, [cells], point_data=data)
 
 
 def supports_mesh(result):

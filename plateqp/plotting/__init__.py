@@ -17,12 +17,14 @@ blue ▼ = settled (g0 > 0), black ● = level (g0 = 0); reactions in force unit
 carry the units (stresses in force/length², reactions in force).
 
 Modules, by job: :mod:`.style` (figure creation, labels and units, colours, :func:`save`,
-:func:`png_bytes`), :mod:`.data` (what a figure reads from a result), :mod:`.plan` (the plan
+:func:`png_bytes`), :mod:`.data` (what a figure reads from a result), :mod:`.marks` (the
+support markers and legend entries every plan-view map shares), :mod:`.plan` (the plan
 view: mesh, supports, contact state, section lines), :mod:`.fields` (deflection surface,
 contours, principal stresses, difference map), :mod:`.charts` (sections, reactions,
 convergence as line and bar charts), :mod:`.studies` (the source paper's figures 5 and 6:
 working schemes, w along sections per scheme, contact pressure along a contour, uniformity
-against κ).
+against κ), :mod:`.tri` (the same figures on a triangle mesh: the true outline and holes,
+``tricontourf``, ``plot_trisurf``; the public functions hand such results to it).
 """
 
 from __future__ import annotations

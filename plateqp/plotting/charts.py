@@ -34,7 +34,13 @@ def plot_sections(result: Result, two_sided: Result | None = None, sections=None
     fig = _figure((8.6, 1.0 + 2.15 * k))
     axs = fig.subplots(k, 1, squeeze=False)[:, 0]
     sup = _supports(result)
-    span = max(result.scene.plate.a, result.scene.plate.b)
+    from .tri import _bbox, on_triangles
+
+    if on_triangles(result):
+        x0, x1, y0, y1 = _bbox(result)
+        span = max(x1 - x0, y1 - y0)
+    else:
+        span = max(result.scene.plate.a, result.scene.plate.b)
     for j, (ax, (lab, p0, p1)) in enumerate(zip(axs, secs), 1):
         t = np.linspace(0.0, 1.0, n)
         px, py = p0[0] + t * (p1[0] - p0[0]), p0[1] + t * (p1[1] - p0[1])
@@ -96,7 +102,11 @@ def plot_reactions(result: Result, two_sided: Result | None = None, units=None) 
     sup = _supports(result)
     fig = _figure((10.0, 4.6))
     ax = fig.add_subplot()
+    from .tri import on_triangles
+
     pos, along = _contour_position(sup.xy, sc.plate.a, sc.plate.b)
+    if on_triangles(result):  # a shaped plate: by support number
+        along = False
     if along:
         order = np.argsort(pos)
         x = pos[order]

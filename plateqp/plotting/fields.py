@@ -35,6 +35,10 @@ def plot_deflection_surface(result: Result, two_sided: Result | None = None, uni
     """
     import mpl_toolkits.mplot3d  # noqa: F401  (registers the 3d projection)
 
+    from .tri import on_triangles, plot_surface_tri
+
+    if on_triangles(result):
+        return plot_surface_tri(result, two_sided, units, elev=elev, azim=azim)
     L = _units(units)[0]
     fig = _figure((8.4, 6.4))
     fig._plateqp_tight = True
@@ -103,7 +107,12 @@ def _auto_azim(result: Result) -> float:
 # -- contour maps of w ------------------------------------------------------------------------
 def plot_deflection_contours(result: Result, two_sided: Result | None = None, units=None, *,
                              levels: int = 20) -> Figure:
-    """Contour maps of w, one-sided and two-sided side by side on the same levels."""
+    """Contour maps of w, one-sided and two-sided side by side on the same levels (on a triangle
+    mesh: ``tricontourf`` of the nodal w, :func:`.tri.plot_contours_tri`)."""
+    from .tri import on_triangles, plot_contours_tri
+
+    if on_triangles(result):
+        return plot_contours_tri(result, two_sided, units, levels=levels)
     pairs = [(result, _name(result))] + ([(two_sided, TWO_SIDED)] if two_sided is not None else [])
     fig = _figure((6.0 * len(pairs) + 1.2, 6.2))
     axs = fig.subplots(1, len(pairs), squeeze=False)[0]
@@ -135,8 +144,12 @@ def plot_principal_stress(result: Result, two_sided: Result | None = None, units
     """Principal stress σ1 (bottom face) of the one-sided and two-sided results side by side.
 
     Nodal values smoothed by :meth:`~plateqp.results.Result.nodal`; same colour scale in
-    both panels; the largest σ1 of each is marked.
+    both panels; the largest σ1 of each is marked. On a triangle mesh: :func:`.tri.plot_principal_tri`.
     """
+    from .tri import on_triangles, plot_principal_tri
+
+    if on_triangles(result):
+        return plot_principal_tri(result, two_sided, units, quantity=quantity, levels=levels)
     name = {"s1": "σ1", "s2": "σ2", "sx": "σx", "sy": "σy", "txy": "τxy"}.get(quantity, quantity)
     pairs = [(result, _name(result))] + ([(two_sided, TWO_SIDED)] if two_sided is not None else [])
     fig = _figure((6.0 * len(pairs) + 1.2, 6.2))
@@ -176,8 +189,13 @@ def plot_difference(result: Result, two_sided: Result, units=None, *, zones: np.
     """w(one-sided) − w(two-sided) as a contour map, with the contact / lift-off zones marked.
 
     ``zones``: optional (ny+1, nx+1) array of +1 (contact zone), −1 (lift-off zone), 0 (neither)
-    per node, as :func:`plateqp.demo.zones` returns.
+    per node, as :func:`plateqp.demo.zones` returns. On a triangle mesh (:func:`.tri.plot_difference_tri`)
+    ``zones`` is not drawn.
     """
+    from .tri import on_triangles, plot_difference_tri
+
+    if on_triangles(result):
+        return plot_difference_tri(result, two_sided, units, levels=levels)
     from matplotlib.lines import Line2D
 
     L = _units(units)[0]

@@ -2,8 +2,9 @@
 contact, hollow lifted off, shaped and coloured by the sign of their gap), the bed's contact
 nodes, point loads, reactions and the section lines drawn on the plate.
 
-Also the helpers every plan-view map shares (:func:`_draw_supports`, :func:`_plan_axes`,
-:func:`_legend_handles`) and the choice of section lines (:func:`default_sections`).
+Also the axes every plan-view map shares (:func:`_plan_axes`; the markers are in :mod:`.marks`)
+and the choice of section lines (:func:`default_sections`). A result on a triangle mesh is
+drawn by :mod:`.tri`.
 """
 
 from __future__ import annotations
@@ -12,7 +13,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .data import _bed, _point_loads, _supports, support_spacing
+from .data import _point_loads, _supports, support_spacing
+from .marks import _draw_supports, _legend_handles, _norm_sections  # noqa: F401  (shared by the maps)
 from .style import _figure, _fmt, _gap_style, _lab, _units
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -21,30 +23,12 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..results import Result
 
 
-# -- markers and axes shared by the plan-view maps --------------------------------------------
-def _draw_supports(ax, result: Result, *, all_active: bool = False, size: float = 42):
-    """Support markers on a plan view: filled in contact, hollow lifted off, shaped by gap sign."""
-    sup = _supports(result)
-    on = np.ones(sup.n, dtype=bool) if all_active else sup.active
-    kind = np.sign(sup.g0)
-    for k in (-1.0, 0.0, 1.0):
-        col, mk, _ = _gap_style(k)
-        for filled in (True, False):
-            sel = (kind == k) & (on == filled)
-            if sel.any():
-                ax.scatter(sup.xy[sel, 0], sup.xy[sel, 1], s=size, marker=mk, edgecolors=col,
-                           facecolors=(col if filled else "white"), linewidths=1.2, zorder=5, clip_on=False)
-    bxy, bon = _bed(result)
-    if bxy.size:
-        on = np.ones_like(bon) if all_active else bon
-        ax.scatter(bxy[on, 0], bxy[on, 1], s=6, c="k", marker=".", zorder=4, clip_on=False)
-        ax.scatter(bxy[~on, 0], bxy[~on, 1], s=6, facecolors="none", edgecolors="0.4", marker="o",
-                   linewidths=0.5, zorder=4, clip_on=False)
-    for ld in _point_loads(result.scene):
-        ax.scatter(ld.x, ld.y, s=90, marker="X", c="tab:orange", edgecolors="k", linewidths=0.8, zorder=6)
-
-
+# -- axes shared by the plan-view maps (the markers: .marks) ------------------------------------
 def _plan_axes(ax, result: Result, units, title: str | None = None):
+    from .tri import on_triangles, tri_plan_axes
+
+    if on_triangles(result):
+        return tri_plan_axes(ax, result, units, title)
     g = result.model.grid
     L = _units(units)[0]
     ax.set_aspect("equal")
@@ -54,31 +38,6 @@ def _plan_axes(ax, result: Result, units, title: str | None = None):
     ax.set_ylabel(_lab("y", L))
     if title:
         ax.set_title(title)
-
-
-def _legend_handles(result: Result, *, all_active: bool = False):
-    """Legend entries for the support markers present in a figure."""
-    from matplotlib.lines import Line2D
-
-    sup = _supports(result)
-    hs = []
-    kinds = {_gap_style(g)[2] for g in sup.g0}
-    txt = {"level": "support, level (g0 = 0)", "heaved": "support, heaved (g0 < 0)",
-           "settled": "support, settled (g0 > 0)"}
-    for g0 in (0.0, -1.0, 1.0):
-        col, mk, kind = _gap_style(g0)
-        if kind in kinds:
-            hs.append(Line2D([], [], ls="none", marker=mk, mec=col, mfc=col, label=txt[kind]))
-    if sup.n:
-        hs.append(Line2D([], [], ls="none", marker="s", mec="0.45", mfc="0.45", label="filled: in contact"))
-        if not all_active and not sup.active.all():
-            hs.append(Line2D([], [], ls="none", marker="s", mec="0.45", mfc="white", label="hollow: lifted off"))
-    bxy, _ = _bed(result)
-    if bxy.size:
-        hs.append(Line2D([], [], ls="none", marker=".", color="k", label="bed node"))
-    if _point_loads(result.scene):
-        hs.append(Line2D([], [], ls="none", marker="X", mfc="tab:orange", mec="k", ms=9, label="point load"))
-    return hs
 
 
 # -- the mesh, the supports, their reactions --------------------------------------------------
@@ -93,6 +52,10 @@ def plot_mesh(result: Result, units=None, *, sections=None, annotate: bool = Tru
     from matplotlib.lines import Line2D
     from matplotlib.patches import Rectangle
 
+    from .tri import on_triangles, plot_mesh_tri
+
+    if on_triangles(result):  # the true outline, triangles, edges by kind
+        return plot_mesh_tri(result, units, sections=sections, annotate=annotate, numbers=numbers)
     L, F = _units(units)
     sc = result.scene
     g = result.model.grid
@@ -223,8 +186,12 @@ def default_sections(result: Result) -> list[tuple[str, tuple[float, float], tup
     Rows: the distinct y of the supports when there are 2 to 6 of them with at least two
     supports each (the source paper's sections 1–5 through a grid of supports). Otherwise the
     horizontal and vertical lines through the largest point load (or the centre), the bottom
-    edge if supports stand on it, and the diagonal.
+    edge if supports stand on it, and the diagonal. On a triangle mesh: :func:`.tri.tri_sections`.
     """
+    from .tri import on_triangles, tri_sections
+
+    if on_triangles(result):
+        return tri_sections(result)
     sc = result.scene
     a, b = sc.plate.a, sc.plate.b
     sup = _supports(result)
@@ -238,18 +205,4 @@ def default_sections(result: Result) -> list[tuple[str, tuple[float, float], tup
     if sup.n and np.any(np.abs(sup.xy[:, 1]) <= 1e-9 * max(a, b)):
         out.append(("y = 0 (edge)", (0.0, 0.0), (a, 0.0)))
     out.append(("diagonal", (0.0, 0.0), (a, b)))
-    return out
-
-
-def _norm_sections(sections, result):
-    if sections is None:
-        return []
-    out = []
-    for sec in sections:
-        if len(sec) == 3:
-            lab, p0, p1 = sec
-        else:
-            p0, p1 = sec
-            lab = f"({p0[0]:g}, {p0[1]:g}) – ({p1[0]:g}, {p1[1]:g})"
-        out.append((str(lab), (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))))
     return out

@@ -1,0 +1,77 @@
+"""Markers every plan-view map shares (grid or triangles): the supports (filled in contact, hollow
+lifted off, shaped and coloured by the sign of their gap), the bed's contact nodes, point loads,
+their legend entries, and the normalised section lines."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .data import _bed, _point_loads, _supports
+from .style import _gap_style
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..results import Result
+
+
+def _draw_supports(ax, result: Result, *, all_active: bool = False, size: float = 42):
+    """Support markers on a plan view: filled in contact, hollow lifted off, shaped by gap sign."""
+    sup = _supports(result)
+    on = np.ones(sup.n, dtype=bool) if all_active else sup.active
+    kind = np.sign(sup.g0)
+    for k in (-1.0, 0.0, 1.0):
+        col, mk, _ = _gap_style(k)
+        for filled in (True, False):
+            sel = (kind == k) & (on == filled)
+            if sel.any():
+                ax.scatter(sup.xy[sel, 0], sup.xy[sel, 1], s=size, marker=mk, edgecolors=col,
+                           facecolors=(col if filled else "white"), linewidths=1.2, zorder=5, clip_on=False)
+    bxy, bon = _bed(result)
+    if bxy.size:
+        on = np.ones_like(bon) if all_active else bon
+        ax.scatter(bxy[on, 0], bxy[on, 1], s=6, c="k", marker=".", zorder=4, clip_on=False)
+        ax.scatter(bxy[~on, 0], bxy[~on, 1], s=6, facecolors="none", edgecolors="0.4", marker="o",
+                   linewidths=0.5, zorder=4, clip_on=False)
+    for ld in _point_loads(result.scene):
+        ax.scatter(ld.x, ld.y, s=90, marker="X", c="tab:orange", edgecolors="k", linewidths=0.8, zorder=6)
+
+
+def _legend_handles(result: Result, *, all_active: bool = False):
+    """Legend entries for the support markers present in a figure."""
+    from matplotlib.lines import Line2D
+
+    sup = _supports(result)
+    hs = []
+    kinds = {_gap_style(g)[2] for g in sup.g0}
+    txt = {"level": "support, level (g0 = 0)", "heaved": "support, heaved (g0 < 0)",
+           "settled": "support, settled (g0 > 0)"}
+    for g0 in (0.0, -1.0, 1.0):
+        col, mk, kind = _gap_style(g0)
+        if kind in kinds:
+            hs.append(Line2D([], [], ls="none", marker=mk, mec=col, mfc=col, label=txt[kind]))
+    if sup.n:
+        hs.append(Line2D([], [], ls="none", marker="s", mec="0.45", mfc="0.45", label="filled: in contact"))
+        if not all_active and not sup.active.all():
+            hs.append(Line2D([], [], ls="none", marker="s", mec="0.45", mfc="white", label="hollow: lifted off"))
+    bxy, _ = _bed(result)
+    if bxy.size:
+        hs.append(Line2D([], [], ls="none", marker=".", color="k", label="bed node"))
+    if _point_loads(result.scene):
+        hs.append(Line2D([], [], ls="none", marker="X", mfc="tab:orange", mec="k", ms=9, label="point load"))
+    return hs
+
+
+
+def _norm_sections(sections, result):
+    if sections is None:
+        return []
+    out = []
+    for sec in sections:
+        if len(sec) == 3:
+            lab, p0, p1 = sec
+        else:
+            p0, p1 = sec
+            lab = f"({p0[0]:g}, {p0[1]:g}) – ({p1[0]:g}, {p1[1]:g})"
+        out.append((str(lab), (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))))
+    return out
