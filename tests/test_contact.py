@@ -66,8 +66,16 @@ def run_checked(scene, backend, formulation, reference):
     check_claim(res, reference)
 
 
+#: Declared give-ups with status ERROR, by (backend, formulation): the teaching backend toggle
+#: starts with every support in contact, which on a floating plate is a singular M_AA (it says so).
+KNOWN_ERRORS = {("toggle", "condensed"): "floating plate: all supports at once give a singular M_AA"}
+
+
 def check_claim(res, reference, rtol=1e-6):
-    """An OPTIMAL result must be right and say so; an INACCURATE one must have a failing KKT."""
+    """An OPTIMAL result must be right and say so; an INACCURATE one must have a failing KKT; an
+    ERROR only where declared in KNOWN_ERRORS."""
+    if res.status == pq.Status.ERROR and (res.backend, res.formulation) in KNOWN_ERRORS:
+        return
     if res.status == pq.Status.OPTIMAL:
         assert res.kkt.ok
         scale = np.abs(reference).max()
