@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import SceneError
-from .geometry import Circle, Domain, Polygon
+from .geometry import Domain, Polygon
 
 #: refinement around embedded points: size REFINE·h at the point, h from 2h away
 REFINE = 0.25

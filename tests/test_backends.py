@@ -15,7 +15,7 @@ import scipy.sparse as sp
 
 import plateqp as pq
 from plateqp.backends import get_backend, registry
-from plateqp.backends.base import LCP, QP, Backend, RawSolution, Status
+from plateqp.backends.base import LCP, QP, Backend, Status
 from plateqp.contact.formulations import FORMULATIONS
 from plateqp.errors import ProblemError
 

@@ -19,7 +19,6 @@ import os
 import re
 import sys
 
-from .. import scenes
 from ..errors import NoEquilibriumError, PlateQPError, SolverError
 from ..io.files import safe_filename
 from .common import _accuracy, _out_dir, _probe, _target
@@ -52,7 +51,10 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="plateqp", description="Thin plates on one-sided supports, contact as a convex QP.")
     sub = ap.add_subparsers(dest="cmd", required=True)
     d = sub.add_parser("demo", help="solve a built-in scene and print a summary")
-    d.add_argument("name", nargs="?", help=f"one of: {', '.join(scenes.names())} (default: all)")
+    from ..demo import names_all  # matplotlib stays unimported until a figure is drawn
+
+    d.add_argument("name", nargs="?", help=f"a built-in scene or a study of the paper's figures: one of: "
+                   f"{', '.join(names_all())} (default: all)")
     d.add_argument("--out", metavar="DIR", help="folder for the figures, JSON files and report.html "
                    "(default: ./plateqp-demo)")
     d.add_argument("--force", action="store_true", help="--out: overwrite files that exist")

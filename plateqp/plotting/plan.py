@@ -15,7 +15,7 @@ import numpy as np
 
 from .data import _point_loads, _supports, support_spacing
 from .marks import _draw_supports, _legend_handles, _norm_sections  # noqa: F401  (shared by the maps)
-from .style import _figure, _fmt, _gap_style, _lab, _units
+from .style import _figure, _fmt, _lab, _units
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure

@@ -32,7 +32,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..assembly import Model, build_model
 from ..contact.scaling import Scaled
@@ -216,7 +215,6 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
     limit = max_pieces or 4 * m + 50
     pieces, breaks, affine = [], [], []
     prev_contact = None
-    zeros = np.zeros((m, 1))
     steps_taken = 0
     while True:
         steps_taken += 1
