@@ -132,8 +132,8 @@ about a line of supports, or on a corner support), every ``u + t d`` solves the 
 well: the corrections leave ``d`` out (projected off in the ``diag(K)`` metric, at most three
 such motions) and the method goes on; the reactions are unique, the deflection is not, and
 :func:`plateqp.contact.statics.settle` picks the canonical one (``deflection_unique = False``).
-The answer's residuals are checked as always, so a load that does work along ``d`` above
-rounding shows as ``INACCURATE``, not as a wrong ``OPTIMAL``. The condensed method needs a definite ``K`` and leaves
+The answer's residuals are checked as always: the work left along ``d`` stays in the
+stationarity residual that decides ``OPTIMAL`` against ``INACCURATE``. The condensed method needs a definite ``K`` and leaves
 floating plates to the sparse one.
 
 Warm start and output
