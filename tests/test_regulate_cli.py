@@ -100,11 +100,8 @@ def test_out_is_checked_before_any_work(capsys, corners, tmp_path):
 
 def test_supports_are_numbered_from_one(capsys, corners, tmp_path):
     out = tmp_path / "two.toml"
-    # Regulating two opposite corners solves the plate on the other two (a diagonal) under a load
-    # balanced about it: a rigid rotation is left free. Clarabel's interior point takes one of
-    # the minimisers; pdas gives up and the condensed form refuses (issue 10 items 4-5).
     code, stdout, err = run(capsys, "regulate", corners, "--target", "300", "--supports", "1,3", "--json",
-                            "--out", out, "--backend", "clarabel", "--formulation", "primal")
+                            "--out", out)
     assert code == 0, err
     d = json.loads(stdout)
     assert [r["support"] for r in d["supports"]] == [1, 3]

@@ -100,9 +100,8 @@ def random_scene(seed: int) -> pq.Scene:
                     edges=edges, loads=loads, supports=sup)
 
 
-#: (seed, backend, formulation). pdas ends MAX_ITER on the held (odd-seed) scenes here (seen
-#: 2026-11-24, reported), so it is checked on the floating ones.
-ROUTES = [(s, "lemke", "condensed") for s in range(4)] + [(s, "pdas", "primal") for s in (0, 2, 4)]
+#: (seed, backend, formulation): held (odd seeds) and floating (even seeds) scenes on both.
+ROUTES = [(s, "lemke", "condensed") for s in range(4)] + [(s, "pdas", "primal") for s in range(6)]
 
 
 def _fd(scene, path, value, h, base_active, backend, formulation):

@@ -126,7 +126,14 @@ quotient ``δuᵀ(H_A − σD)δu / (σ δuᵀDδu) < 1`` (a held plate gives ``
 does work along ``d`` (``fᵀd > 0``), then ``K d = 0``, ``G d ≤ 0``, ``qᵀd < 0``: a certificate
 that the QP is unbounded below, the plate cannot be held (``Status.UNBOUNDED``,
 ``extras["ray"]``; the contact driver turns it into :class:`~plateqp.errors.NoEquilibriumError`
-after its own statics check). The condensed method needs a definite ``K`` and leaves
+after its own statics check). Before it is judged, ``d`` is sharpened by inverse iteration with
+``H_A``. If the load does no work along it (``|fᵀd| ≤ FREE_WORK Σ|f_j d_j|``: a load balanced
+about a line of supports, or on a corner support), every ``u + t d`` solves the step equally
+well: the corrections leave ``d`` out (projected off in the ``diag(K)`` metric, at most three
+such motions) and the method goes on; the reactions are unique, the deflection is not, and
+:func:`plateqp.contact.statics.settle` picks the canonical one (``deflection_unique = False``).
+The answer's residuals are checked as always: the work left along ``d`` stays in the
+stationarity residual that decides ``OPTIMAL`` against ``INACCURATE``. The condensed method needs a definite ``K`` and leaves
 floating plates to the sparse one.
 
 Warm start and output

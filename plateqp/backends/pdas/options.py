@@ -40,6 +40,11 @@ OPTIONS = ("active", "trace") + tuple(SETTINGS) + tuple(ACCURACY["default"])
 #: (sparse) A first correction with Rayleigh quotient δuᵀ(H − σD)δu / (σ δuᵀDδu) below this is
 #: a rigid motion the active rows do not hold.
 SINGULAR_QUOTIENT = 1.0
+#: (sparse) A rigid motion d the active rows leave free is one the load does no work along when
+#: |fᵀd| ≤ FREE_WORK Σ|f_j d_j| (rounding); the steps then leave d out (any solution along it is
+#: one; contact.statics.settle picks the canonical deflection). At most FREE_MOTIONS of them (a
+#: plate has three rigid motions); each sharpened by FREE_SHARPEN inverse iterations.
+FREE_WORK, FREE_MOTIONS, FREE_SHARPEN = 1e-9, 3, 2
 #: Refinement: at most this many solves per active set while it changes, and for the final set.
 INNER_LOOSE, INNER_EXACT = 2, 12
 #: (sparse) While the active set changes, refinement stops at this relative residual.

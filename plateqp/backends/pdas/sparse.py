@@ -15,6 +15,9 @@ from ..base import Status
 from .options import (
     ALPHA_MAX,
     DOWNDATE_LOSS,
+    FREE_MOTIONS,
+    FREE_SHARPEN,
+    FREE_WORK,
     INNER_EXACT,
     INNER_LOOSE,
     LOOSE_TOL,
@@ -184,9 +187,19 @@ class Step:
         self.u, self.lam, self.residual, self.solves, self.ray = u, lam, residual, solves, ray
 
 
+def _project(null: list, D: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``v`` without its components along the (``D``-orthonormal) free rigid motions ``null``."""
+    for n in null:
+        v = v - n * float(n @ (D * v))
+    return v
+
+
 def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray, u: np.ndarray,
-                  lam: np.ndarray, sigma: float, exact: bool) -> Step:
-    """Refine ``(u, λ_A)`` towards the exact step of active set ``A`` (see the module docstring)."""
+                  lam: np.ndarray, sigma: float, exact: bool, null: list = ()) -> Step:
+    """Refine ``(u, λ_A)`` towards the exact step of active set ``A`` (see the module docstring).
+
+    ``null``: free rigid motions of ``A`` that the load does no work along (``D``-orthonormal);
+    the corrections leave them out, so the step is one of the (equally good) solutions."""
     idx = np.flatnonzero(A)
     BA = pb.B[idx]
     WA, gA, rhoA = W[idx], pb.g[idx], pb.rho[idx]
@@ -209,7 +222,7 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
         if res <= tol or k == n_max or (k >= 2 and res > 0.5 * best):
             break
         best = min(best, res)
-        du = fac.solve(r_u - BA.T @ (WA * r_A))
+        du = _project(null, pb.Kd, fac.solve(r_u - BA.T @ (WA * r_A)))
         solves += 1
         if k == 0:
             Bdu = BA @ du
@@ -222,6 +235,15 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     out = np.zeros_like(lam)
     out[idx] = lamA
     return Step(u, out, res, solves)
+
+
+def _free_motion(pb: ReducedQP, fac: SpringFactor, null: list, d: np.ndarray) -> np.ndarray:
+    """The rigid motion ``d`` sharpened by inverse iteration with ``H_A`` (its error in the held
+    modes falls by ``σ/λ`` each time) and ``D``-normalised against ``null``."""
+    for _ in range(FREE_SHARPEN):
+        d = _project(null, pb.Kd, fac.solve(pb.Kd * d))
+        d /= np.sqrt(float(d @ (pb.Kd * d)))
+    return d
 
 
 def line_search(pb: ReducedQP, W: np.ndarray, u: np.ndarray, du: np.ndarray) -> float:
@@ -316,11 +338,16 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
     A = np.ones(pb.m, dtype=bool) if A is None else A.copy()
     for it in range(1, max_iter + 1):
         fac.set(np.where(A, W, 0.0))
-        step = solve_active(pb, fac, W, A, u, lam, sigma, exact)
-        if step.ray is not None and fac.loss > 0:  # judge a free rigid motion on a clean factor
-            fac.refactor(np.where(A, W, 0.0))
-            step = solve_active(pb, fac, W, A, u, lam, sigma, exact)
-        if step.ray is not None:  # the active rows do not hold the plate: it falls along d
+        null: list = []  # free rigid motions of A along which the load does no work
+        entered = False
+        while True:
+            step = solve_active(pb, fac, W, A, u, lam, sigma, exact, null)
+            if step.ray is not None and fac.loss > 0:  # judge a free rigid motion on a clean factor
+                fac.refactor(np.where(A, W, 0.0))
+                step = solve_active(pb, fac, W, A, u, lam, sigma, exact, null)
+            if step.ray is None:
+                break
+            # the active rows do not hold the plate: it can move along d
             d = step.ray
             Bd = pb.B @ d
             scale = np.abs(Bd).max(initial=0.0)
@@ -331,14 +358,34 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
             if hit.any():
                 A = A | hit
                 exact = False
-                continue
+                entered = True
+                break
+            d = _free_motion(pb, fac, null, d)  # sharpened: its work and K d judged on rounding
+            Bd = pb.B @ d
+            scale = np.abs(Bd).max(initial=0.0)
             Kd_rel = np.abs(pb.K @ d).max() / (pb.Kd.max() * np.abs(d).max())
-            if pb.f @ d > 0 and Kd_rel <= 1e-6 and np.all(Bd <= 1e-9 * scale):
+            if Kd_rel > 1e-6 or len(null) >= FREE_MOTIONS:
+                return Outcome(Status.ERROR, "the active rows leave a null direction of K that is not a "
+                               "rigid motion of the plate: cannot go on", A, it=newton + it)
+            work = float(pb.f @ d)
+            if work > FREE_WORK * float(np.abs(pb.f) @ np.abs(d)) and np.all(Bd <= 1e-9 * scale):
                 ray = np.zeros(pb.n)
                 ray[pb.keep] = d  # (d, 0): P (d, 0) = 0, G (d, 0) = B d ≤ 0, qᵀ(d, 0) = −fᵀd < 0
                 return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
-            return Outcome(Status.ERROR, "the active rows leave a null direction of K, no row bounds it, "
-                            "yet q does no work along it (qᵀd ≥ 0): cannot go on", A, it=newton + it)
+            if work < -FREE_WORK * float(np.abs(pb.f) @ np.abs(d)):  # the load pushes along −d
+                hit = ~A & (Bd < -1e-9 * scale)
+                if hit.any():
+                    A = A | hit
+                    exact = False
+                    entered = True
+                    break
+                ray = np.zeros(pb.n)
+                ray[pb.keep] = -d
+                return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
+            # the load does no work along d: every u + t d is as good; keep d out of the steps
+            null.append(d)
+        if entered:
+            continue
         u, lam = step.u, step.lam
         gap = pb.g + pb.rho * lam - pb.B @ u
         bad = infeasible(pb, A, lam, gap, feas_tol)
