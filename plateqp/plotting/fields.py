@@ -12,7 +12,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .data import _nodes, _supports, _w_grid
+from .data import _nodes, _w_grid
+from .marks import _supports_on_surface
 from .plan import _draw_supports, _legend_handles, _plan_axes
 from .style import (ONE_SIDED, TWO_SIDED, _fig_legend, _figure, _fmt, _lab, _levels, _name, _range,
                     _stress_unit, _symmetric_or_not, _units, _w_label)
@@ -60,16 +61,7 @@ def plot_deflection_surface(result: Result, two_sided: Result | None = None, uni
     if two_sided is not None:
         ax.plot_wireframe(X, Y, two_sided.w_nodes(), color="k", linewidth=0.6, linestyles="--", zorder=3)
         handles.append(Line2D([], [], color="k", lw=0.8, ls="--", label=TWO_SIDED + " (wire frame)"))
-    sup = _supports(result)
-    if sup.n:
-        wsup = np.atleast_1d(result.deflection(sup.xy[:, 0], sup.xy[:, 1]))
-        on = sup.active
-        ax.scatter(sup.xy[on, 0], sup.xy[on, 1], wsup[on], c="k", s=18, depthshade=False, zorder=4)
-        ax.scatter(sup.xy[~on, 0], sup.xy[~on, 1], wsup[~on], facecolors="white", edgecolors="k", s=18,
-                   depthshade=False, zorder=4)
-        handles.append(Line2D([], [], ls="none", marker="o", mec="k", mfc="k", label="support in contact"))
-        if not on.all():
-            handles.append(Line2D([], [], ls="none", marker="o", mec="k", mfc="white", label="support lifted off"))
+    _supports_on_surface(ax, result, handles)
     pad = 0.04 * (hi - lo)
     ax.set_zlim(hi + pad, lo - pad)  # inverted: w positive down is drawn downward
     ax.view_init(elev=elev, azim=_auto_azim(result) if azim is None else azim)

@@ -75,3 +75,21 @@ def _norm_sections(sections, result):
             lab = f"({p0[0]:g}, {p0[1]:g}) – ({p1[0]:g}, {p1[1]:g})"
         out.append((str(lab), (float(p0[0]), float(p0[1])), (float(p1[0]), float(p1[1]))))
     return out
+
+
+def _supports_on_surface(ax, result: Result, handles: list) -> None:
+    """The one-sided supports on a 3-d deflection surface (filled in contact, hollow lifted off),
+    and their legend entries appended to ``handles``."""
+    from matplotlib.lines import Line2D
+
+    sup = _supports(result)
+    if not sup.n:
+        return
+    wsup = np.atleast_1d(result.deflection(sup.xy[:, 0], sup.xy[:, 1]))
+    on = sup.active
+    ax.scatter(sup.xy[on, 0], sup.xy[on, 1], wsup[on], c="k", s=18, depthshade=False, zorder=4)
+    ax.scatter(sup.xy[~on, 0], sup.xy[~on, 1], wsup[~on], facecolors="white", edgecolors="k", s=18,
+               depthshade=False, zorder=4)
+    handles.append(Line2D([], [], ls="none", marker="o", mec="k", mfc="k", label="support in contact"))
+    if not on.all():
+        handles.append(Line2D([], [], ls="none", marker="o", mec="k", mfc="white", label="support lifted off"))

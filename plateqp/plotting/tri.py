@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .data import _supports
+from .marks import _supports_on_surface
 from .style import (ONE_SIDED, TWO_SIDED, _fig_legend, _figure, _fmt, _lab, _levels, _name, _range,
                     _stress_unit, _symmetric_or_not, _units, _w_label)
 
@@ -268,16 +269,7 @@ def plot_surface_tri(result: Result, two_sided: Result | None = None, units=None
         P = np.column_stack([mesh.nodes, W2])
         ax.add_collection3d(Line3DCollection(P[e], colors="k", linewidths=0.15, alpha=0.4, zorder=3))
         handles.append(Line2D([], [], color="k", lw=0.6, alpha=0.6, label=TWO_SIDED + " (mesh lines)"))
-    sup = _supports(result)
-    if sup.n:
-        wsup = np.atleast_1d(result.deflection(sup.xy[:, 0], sup.xy[:, 1]))
-        on = sup.active
-        ax.scatter(sup.xy[on, 0], sup.xy[on, 1], wsup[on], c="k", s=18, depthshade=False, zorder=4)
-        ax.scatter(sup.xy[~on, 0], sup.xy[~on, 1], wsup[~on], facecolors="white", edgecolors="k", s=18,
-                   depthshade=False, zorder=4)
-        handles.append(Line2D([], [], ls="none", marker="o", mec="k", mfc="k", label="support in contact"))
-        if not on.all():
-            handles.append(Line2D([], [], ls="none", marker="o", mec="k", mfc="white", label="support lifted off"))
+    _supports_on_surface(ax, result, handles)
     pad = 0.04 * (hi - lo)
     ax.set_zlim(hi + pad, lo - pad)  # inverted: w positive down is drawn downward
     ax.view_init(elev=elev, azim=-60.0 if azim is None else azim)
