@@ -36,6 +36,7 @@ that leaves a rigid motion free (the answer is not unique) a
 
 from __future__ import annotations
 
+import copy
 import itertools
 import warnings
 from dataclasses import dataclass, field
@@ -356,22 +357,14 @@ def parameters(model, data: Scaled, R: np.ndarray, wrt: str):
 
         cols = []
         for ld in scene.loads:
-            one = _SceneLoads(scene, ld)
+            one = copy.copy(scene)  # the scene with this load alone (a shallow copy: nothing else changes)
+            one.loads = [ld]
             f_full = _loads(one, model.grid, model.element, model.cells, model.cell_dofs, model.n_full)
             cols.append(data.dof_scale * f_full[model.free] / (data.F0 * data.W))
         df = np.column_stack(cols) if cols else np.zeros((n, 0))
         p = df.shape[1]
         return [f"loads.{j}" for j in range(p)], df, np.zeros((m, p)), np.zeros((m, p))
     raise ProblemError(f"sensitivity: unknown wrt {wrt!r}; choose one of {', '.join(WRT)}")
-
-
-class _SceneLoads:
-    """A stand-in scene holding one load (what the load assembly reads)."""
-
-    def __init__(self, scene, load) -> None:
-        self.loads = [load]
-        self.plate = scene.plate
-        self.triangles = scene.triangles
 
 
 def scaled_state(result) -> tuple[Scaled, np.ndarray, np.ndarray, np.ndarray]:

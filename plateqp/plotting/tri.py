@@ -154,6 +154,17 @@ def plot_mesh_tri(result: Result, units=None, *, sections=None, annotate: bool =
 
 
 # -- fields -----------------------------------------------------------------------------------
+def _contours_in_outline(ax, tri, field, lev, cmap, norm, result, linewidth):
+    """Filled contours of ``field`` with their lines, inside the plate's outline (drawn unfilled)."""
+    cf = ax.tricontourf(tri, field, levels=lev, cmap=cmap, norm=norm)
+    ax.tricontour(tri, field, levels=lev, colors="k", linewidths=linewidth)
+    _draw_outline(ax, result)
+    for p in ax.patches:
+        if p.get_gid() == "outline":
+            p.set_fill(False)
+    return cf
+
+
 def _contour_pair(result, two_sided, units, fields, levels, title, cbar_label, extra_handles=(), mark_max=None):
     from .marks import _draw_supports, _legend_handles
 
@@ -165,12 +176,7 @@ def _contour_pair(result, two_sided, units, fields, levels, title, cbar_label, e
     norm, cmap = _symmetric_or_not(lev[0], lev[-1])
     cf = None
     for ax, (r, sub), f in zip(axs, pairs, fields):
-        cf = ax.tricontourf(tri, f, levels=lev, cmap=cmap, norm=norm)
-        ax.tricontour(tri, f, levels=lev, colors="k", linewidths=0.4)
-        _draw_outline(ax, r)
-        for p in ax.patches:
-            if p.get_gid() == "outline":
-                p.set_fill(False)
+        cf = _contours_in_outline(ax, tri, f, lev, cmap, norm, r, 0.4)
         _draw_supports(ax, r, all_active=(r is not result), size=32)
         if mark_max is not None:
             mark_max(ax, r, f)
@@ -225,12 +231,7 @@ def plot_difference_tri(result: Result, two_sided: Result, units=None, *, levels
     lev = _levels([dW], levels)
     norm, cmap = _symmetric_or_not(lev[0], lev[-1])
     tri = _triangulation(result)
-    cf = ax.tricontourf(tri, dW, levels=lev, cmap=cmap, norm=norm)
-    ax.tricontour(tri, dW, levels=lev, colors="k", linewidths=0.35)
-    _draw_outline(ax, result)
-    for p in ax.patches:
-        if p.get_gid() == "outline":
-            p.set_fill(False)
+    cf = _contours_in_outline(ax, tri, dW, lev, cmap, norm, result, 0.35)
     _draw_supports(ax, result, size=40)
     cb = fig.colorbar(cf, ax=ax, shrink=0.85)
     cb.set_label(_lab("w one-sided − w two-sided", L) + ", positive down")

@@ -60,7 +60,8 @@ class RowStore:
 
     def _read(self) -> None:
         try:
-            lines = self.path.read_text(encoding="utf-8").splitlines()
+            text = self.path.read_text(encoding="utf-8")
+            lines = text.splitlines()
         except (OSError, UnicodeDecodeError) as exn:
             raise ProblemError(f"sweep store {self.path}: cannot be read ({exn})") from None
         try:
@@ -89,7 +90,7 @@ class RowStore:
                 raise ProblemError(f"sweep store {self.path}: line {k} names value {i} of {n}")
             self.done[i] = row
             kept.append(line)
-        if len(kept) < len(lines) or not self.path.read_bytes().endswith(b"\n"):
+        if len(kept) < len(lines) or not text.endswith("\n"):
             with open(self.path, "w", encoding="utf-8") as fh:  # drop the cut line before appending
                 fh.write("\n".join(kept) + "\n")
                 fh.flush()
