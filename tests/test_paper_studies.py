@@ -184,7 +184,7 @@ def test_demo_runs_the_studies(tmp_path, capsys):
 
 
 def test_demo_names_and_files():
-    assert demo.names_all()[-2:] == ["fig5", "fig6"]
+    assert demo.names_all()[-3:] == ["fig5", "fig6", "regulate"]
     files = demo.output_files(["fig6"])
     assert files == ["report.html", "fig6.json", "fig6-pressure.png", "fig6-uniformity.png"]
     with pytest.raises(pq.SceneError, match="no built-in scene or study 'fig7'"):

@@ -45,7 +45,7 @@ from ..plotting.data import support_spacing
 from ..scene import Scene
 
 #: The studies ``plateqp demo`` knows besides the scenes, and the figures each draws.
-STUDIES = {"fig5": ("schemes", "sections"), "fig6": ("pressure", "uniformity")}
+STUDIES = {"fig5": ("schemes", "sections"), "fig6": ("pressure", "uniformity"), "regulate": ("reactions",)}
 #: The paper's values (kgf/cm): the softest stiffness of figure 5, the most uniform of figure 6.
 PAPER_C_SOFTEST = 5.0
 PAPER_C_UNIFORM = 3.2
@@ -315,7 +315,8 @@ class StudyRun:
 
 
 TITLES = {"fig5": "Figure 5: the working scheme as the support stiffness falls (heaved supports 1, 2, 8)",
-          "fig6": "Figure 6: the contact pressure along an elastic contour, and its most uniform stiffness"}
+          "fig6": "Figure 6: the contact pressure along an elastic contour, and its most uniform stiffness",
+          "regulate": "Regulating the interaction forces by changing the gaps (the paper's third claim)"}
 
 
 def run_study(name: str, figures: bool = True, mesh: int | None = None, dpi: int = 100) -> StudyRun:
@@ -362,6 +363,27 @@ def run_study(name: str, figures: bool = True, mesh: int | None = None, dpi: int
                 "panel).", lambda: plot_scheme_sections([s.result for s in p.schemes],
                                                         [f"{j}: κ = {_k(s.kappa)}" for j, s in
                                                          enumerate(p.schemes, 1)], p.sections, units))
+    elif name == "regulate":
+        from .regulation import regulation, regulation_lines
+
+        st = regulation(_with_mesh(scenes.load("heave"), mesh))
+        lines = regulation_lines(st, units)
+        story = (f"The built-in scene 'heave' ({st.scene.mesh.nx} x {st.scene.mesh.ny} mesh): new gaps (shims) from "
+                 "plateqp.studies.design.regulate_gaps (plateqp regulate on the command line), each checked by "
+                 "solving the regulated scene's contact problem again. Module doc of plateqp.demo.regulation.")
+        ok = all(r.check.ok and r.error <= 1e-8 for r in st.runs)
+        data = {"before": st.before.reactions.tolist(), "level_ground": st.level.reactions.tolist(),
+                "regulations": [{"name": r.name, "supports": [int(i) + 1 for i in r.supports],
+                                 "target": r.target.tolist(), "gaps": r.gaps.tolist(),
+                                 "reactions_checked": r.check.reactions.tolist(), "largest_miss_of_load": r.error}
+                                for r in st.runs]}
+        if figures:
+            from ..plotting.studies import plot_regulation
+
+            put("reactions", "Reactions of the 25 supports as the heaved slab stands, after equalising the four "
+                "supports around the machine foot, and after re-levelling the supports that were not heaved "
+                "(hatched: the regulated supports); right: the gap changes (negative: a shim up).",
+                lambda: plot_regulation(st.before, st.runs, units))
     else:
         q = contour_pressure(mesh=mesh)
         lines = contour_lines(q, units)

@@ -14,6 +14,7 @@ import itertools
 import math
 from dataclasses import dataclass
 
+from ..errors import ProblemError
 from ..paths import as_number
 from .worker import Context, next_start, solve_value
 
@@ -27,6 +28,17 @@ class Bisection:
     floor: float  # absolute floor for linear bisection (a change at 0 still terminates)
     integer: bool
     max_steps: int = 200
+
+    def __post_init__(self) -> None:
+        # the user's tolerance: a bracket of width 0 never closes, and a NaN never compares
+        ok = isinstance(self.rtol, (int, float)) and not isinstance(self.rtol, bool)
+        if not ok or not (math.isfinite(self.rtol) and 0.0 < self.rtol < 1.0):
+            raise ProblemError(f"rtol: the relative width of a breakpoint's bracket must be a number in (0, 1) "
+                               f"(got {self.rtol!r})")
+        if self.rtol < 1e-14:
+            raise ProblemError(f"rtol: {self.rtol:g} is below what a bracket of floating-point numbers can "
+                               "reach (use 1e-14 or more; for a parameter that enters linearly, "
+                               "sweep --exact finds breakpoints to rounding)")
 
 
 def _close(b: Bisection, x1: float, x2: float) -> bool:
