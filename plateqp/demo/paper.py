@@ -26,6 +26,9 @@ supports along its edges, s = 50 cm): the reactions along the contour for severa
 uniformity measures (:func:`plateqp.studies.design.uniformity`) on a log grid of κ, and the κ
 that minimises each (:func:`plateqp.studies.design.most_uniform_stiffness` with ``measure=``).
 
+**"regulate"** lives in :mod:`plateqp.demo.regulation` (the paper's gap regulation on the
+``heave`` scene); :func:`run_study` runs it like the other two.
+
 This module computes; figures come from :mod:`plateqp.plotting.studies`, words from
 :func:`path_lines` and :func:`contour_lines`. Support numbers users read are 1-based.
 """
@@ -320,7 +323,7 @@ TITLES = {"fig5": "Figure 5: the working scheme as the support stiffness falls (
 
 
 def run_study(name: str, figures: bool = True, mesh: int | None = None, dpi: int = 100) -> StudyRun:
-    """Compute one study ("fig5" or "fig6"), its lines, JSON and (``figures``) its PNGs."""
+    """Compute one study ("fig5", "fig6" or "regulate"), its lines, JSON and (``figures``) its PNGs."""
     import time
 
     if name not in STUDIES:
