@@ -61,3 +61,19 @@ def test_demo_writes_the_regulation_study(tmp_path, capsys):
     rep = json.loads((tmp_path / "regulate.json").read_text())
     assert [r["name"] for r in rep["regulations"]] == ["equalise", "re-level"]
     assert rep["regulations"][0]["supports"] == [12, 13, 17, 18]
+
+
+def test_shim_tolerance_by_finite_differences(study):
+    """The study's dR/dg0 among the four regulated supports against re-solving the regulated
+    scene with one shim thinner (a finite difference, the contact set found again)."""
+    eq = study.runs[0]
+    foot = list(rg.FOOT)
+    h = 1e-5  # cm: small against the shims (1e-3 … 0.04 cm), far above rounding
+    base = pq.solve(set_param(study.scene, "supports.*.gap", eq.gaps), accuracy="high")
+    for j, k in enumerate(foot):
+        g = eq.gaps.copy()
+        g[k] += h
+        res = pq.solve(set_param(study.scene, "supports.*.gap", g), accuracy="high")
+        fd = (res.reactions[foot] - base.reactions[foot]) / h
+        np.testing.assert_allclose(eq.shim[:, j], fd, rtol=1e-6, atol=1e-6 * np.abs(eq.shim).max())
+    assert np.all(np.diag(eq.shim) < 0)  # a thinner shim unloads its own support

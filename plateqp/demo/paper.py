@@ -378,7 +378,8 @@ def run_study(name: str, figures: bool = True, mesh: int | None = None, dpi: int
         data = {"before": st.before.reactions.tolist(), "level_ground": st.level.reactions.tolist(),
                 "regulations": [{"name": r.name, "supports": [int(i) + 1 for i in r.supports],
                                  "target": r.target.tolist(), "gaps": r.gaps.tolist(),
-                                 "reactions_checked": r.check.reactions.tolist(), "largest_miss_of_load": r.error}
+                                 "reactions_checked": r.check.reactions.tolist(), "largest_miss_of_load": r.error,
+                                 "dR_dg0": None if r.shim is None else r.shim.tolist()}
                                 for r in st.runs]}
         if figures:
             from ..plotting.studies import plot_regulation

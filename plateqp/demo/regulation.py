@@ -41,6 +41,13 @@ class Regulation:
     gaps_before: np.ndarray  # every support's gap, scene order
     gaps: np.ndarray  # every support's regulated gap
     check: Result  # pq.solve of the regulated scene
+    shim: np.ndarray | None = None  # dR_i/dg0_j among the regulated supports, at the regulated scene
+
+    @property
+    def shim_tolerance(self) -> float:
+        """The largest change of a regulated reaction per unit error of one regulated shim
+        (max |dR_i/dg0_j|), the slope as the gap grows where a support is at lift-off."""
+        return float(np.abs(self.shim).max()) if self.shim is not None else float("nan")
 
     @property
     def error(self) -> float:
@@ -77,11 +84,22 @@ def regulation(scene: Scene | None = None) -> RegulationStudy:
     foot = np.array(FOOT)
     target = np.full(foot.size, before.reactions[foot].mean())
     r = regulate_gaps(scene, target, supports=foot.tolist())
-    runs.append(Regulation("equalise", foot, target, g0, r.gaps, _solve(r.scene)))
+    check = _solve(r.scene)
+    runs.append(Regulation("equalise", foot, target, g0, r.gaps, check, _shim(check, foot)))
     flat = np.flatnonzero(g0 == 0.0)
     r = regulate_gaps(scene, level.reactions[flat], supports=flat.tolist())
     runs.append(Regulation("re-level", flat, level.reactions[flat], g0, r.gaps, _solve(r.scene)))
     return RegulationStudy(scene, before, level, runs)
+
+
+def _shim(check: Result, reg: np.ndarray) -> np.ndarray:
+    """dR_i/dg0_j for i, j among the regulated supports, from the regulated scene's active set
+    (:func:`plateqp.sensitivity`; where a support sits at lift-off, the derivative as the gap
+    grows, i.e. a shim too thin)."""
+    from ..sensitivity import sensitivity
+
+    s = sensitivity(check, "gaps")
+    return s.increasing.reactions[np.ix_(reg, reg)]
 
 
 def _ids(idx) -> str:
@@ -100,6 +118,11 @@ def regulation_lines(st: RegulationStudy, units: tuple[str, str] | None = None) 
     out.append(f"  check (pq.solve of the regulated scene): each carries {eq.target[0]:.0f} {F}, "
                f"largest miss {eq.error:.1e} of the load; {int(eq.check.active.sum())} of "
                f"{eq.check.active.size} supports in contact ({int(st.before.active.sum())} before)")
+    if eq.shim is not None:
+        i, j = np.unravel_index(np.abs(eq.shim).argmax(), eq.shim.shape)
+        out.append(f"  shim tolerance (plateqp.sensitivity at the regulated scene): a shim 0.01 {L} too thin "
+                   f"under support {eq.supports[j] + 1} changes the reaction of support {eq.supports[i] + 1} by "
+                   f"{0.01 * eq.shim[i, j]:+.0f} {F}, the largest of the four by four".rstrip())
     touching = lv.supports[st.level.reactions[lv.supports] > 0]
     shift = lv.gaps[touching] - lv.gaps_before[touching]
     out.append(f"re-level: the {lv.supports.size} supports not heaved shimmed so each carries its level-ground "
