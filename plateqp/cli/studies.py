@@ -112,7 +112,23 @@ def _sweep_values(args) -> list:
     return [float(v) for v in np.linspace(a, b, n)]
 
 
-def _sweep_exact(scene, values, opts, args):
+def _executor(args, stack: contextlib.ExitStack) -> tuple:
+    """(executor, max_workers) of a sweep: a Dask client on ``--scheduler`` (closed when ``stack``
+    closes; the cluster keeps running), else local processes (``--workers``, default 2; 1: serial)."""
+    if args.scheduler is not None:
+        if args.workers is not None:
+            raise ProblemError("--workers and --scheduler: choose one (the cluster's workers run the sweep)")
+        if not args.scheduler_timeout > 0:
+            raise ProblemError(f"--scheduler-timeout: seconds > 0 (got {args.scheduler_timeout})")
+        from ..studies.parallel import connect
+
+        client = stack.enter_context(connect(args.scheduler, timeout=args.scheduler_timeout))
+        return client, 1
+    workers = 2 if args.workers is None else args.workers
+    return ("serial" if workers <= 1 else None), max(workers, 1)
+
+
+def _sweep_exact(scene, values, opts, args, executor, workers):
     """sweep --exact: the breakpoints of the exact path (:func:`plateqp.studies.exact_sweep`);
     a parameter that does not enter linearly is a ProblemError (exit 2) before any work."""
     from ..studies import exact_sweep
@@ -120,8 +136,7 @@ def _sweep_exact(scene, values, opts, args):
     if args.no_refine:
         raise ProblemError("--exact and --no-refine: choose one")
     return exact_sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
-                       accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
-                       max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                       accuracy=args.accuracy, options=opts, executor=executor, max_workers=workers,
                        warm_start=not args.no_warm_start, store=args.store)
 
 
@@ -139,16 +154,15 @@ def cmd_sweep(args) -> int:
 
         _optional("xarray")
         check_file(args.out, force=args.force, label=f"--out {args.out}", flag="--force")
-    with _sigterm_as_interrupt() as seen:
+    with _sigterm_as_interrupt() as seen, contextlib.ExitStack() as stack:
+        executor, workers = _executor(args, stack)
         try:
             with _stdout_to_stderr():
                 if args.exact:
-                    res = _sweep_exact(scene, values, opts, args)
+                    res = _sweep_exact(scene, values, opts, args, executor, workers)
                 else:
                     res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
-                                accuracy=args.accuracy, options=opts,
-                                executor="serial" if args.workers <= 1 else None,
-                                max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                                accuracy=args.accuracy, options=opts, executor=executor, max_workers=workers,
                                 refine_breakpoints=not args.no_refine, rtol=args.rtol,
                                 warm_start=not args.no_warm_start, store=args.store)
         except SweepInterrupted as exn:
