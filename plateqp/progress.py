@@ -15,12 +15,14 @@ from __future__ import annotations
 
 import os
 import sys
+import weakref
 from collections.abc import Iterable, Iterator
 
 #: Process-wide switch (:func:`set_enabled`).
 _ENABLED = True
-#: Bars drawn now (so that :func:`write` can keep them whole).
-_OPEN: list = []
+#: Bars drawn now (so that :func:`write` can keep them whole); a bar left open by an exception
+#: closes when it is dropped.
+_OPEN: weakref.WeakSet = weakref.WeakSet()
 
 
 def set_enabled(flag: bool) -> bool:
@@ -69,7 +71,7 @@ class Progress:
             self._line()
         else:
             self.bar = tqdm(total=total, desc=desc, file=self.stream, leave=False, dynamic_ncols=True)
-        _OPEN.append(self)
+        _OPEN.add(self)
 
     def _line(self):
         text = f"{self.desc}: {self.n}" + (f"/{self.total}" if self.total is not None else "")
@@ -103,13 +105,18 @@ class Progress:
         if not self.enabled:
             return
         self.enabled = False
-        if self in _OPEN:
-            _OPEN.remove(self)
+        _OPEN.discard(self)
         if self.bar is not None:
             self.bar.close()
         else:  # wipe the counter line
             self.stream.write("\r" + " " * self._width + "\r")
             self.stream.flush()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - at interpreter exit the stream may be gone
+            pass
 
     def __enter__(self) -> Progress:
         return self
@@ -143,11 +150,12 @@ def write(line: str) -> None:
 
         tqdm.write(line, file=sys.stderr)
         return
-    if _OPEN:  # a counter line: wipe it, write, redraw
-        for b in _OPEN:
+    bars = list(_OPEN)
+    if bars:  # a counter line: wipe it, write, redraw
+        for b in bars:
             b.stream.write("\r" + " " * b._width + "\r")
         sys.stderr.write(line + "\n")
-        for b in _OPEN:
+        for b in bars:
             b._line()
         sys.stderr.flush()
         return

@@ -15,6 +15,7 @@ import numpy as np
 from ..accuracy import Status
 from ..solving import solve
 from ..errors import PlateQPError, ProblemError
+from ..progress import Progress
 from .common import _options, _backend_name, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, _numbers
 
 
@@ -39,11 +40,13 @@ def cmd_regulate(args) -> int:
     if args.out:
         check_file(args.out, force=args.force, label=f"--out {args.out}", flag="--force")
     _backend_name(args.backend)
-    with warnings.catch_warnings(), _stdout_to_stderr():
+    with warnings.catch_warnings(), _stdout_to_stderr(), Progress(2, "regulate: gaps, then the check") as bar:
         warnings.simplefilter("ignore")
         reg = regulate_gaps(scene, target if len(target) > 1 else target[0], supports=chosen,
                             backend=args.backend, formulation=args.formulation)
+        bar.update()
         check = solve(reg.scene, backend=args.backend, formulation=args.formulation, accuracy="high")
+        bar.update()
     got = check.reactions[reg.supports]
     scale = max(float(np.abs(reg.reactions).max(initial=0.0)), float(np.abs(check.reactions).max(initial=0.0)), 1e-300)
     error = float(np.abs(got - reg.reactions).max(initial=0.0) / scale)
