@@ -1,5 +1,7 @@
 """Where the values of a sweep are solved: this process, local worker processes, any
-:class:`concurrent.futures.Executor` or a Dask ``distributed.Client``; and a progress bar.
+:class:`concurrent.futures.Executor` or a Dask ``distributed.Client`` (:func:`connect` makes
+one on an existing cluster from its scheduler's address). The progress bar is
+:class:`plateqp.progress.Progress` (importable from here too, its old home).
 
 Every runner has the same two calls: ``submit(fn, *args)`` and ``as_completed(tasks)``, which
 yields (task, future) pairs as they finish (in order for :class:`Serial`, which runs each task
