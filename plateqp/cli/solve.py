@@ -124,6 +124,8 @@ def cmd_solve(args) -> int:
         else:
             result = solve(scene, backend=args.backend, formulation=args.formulation, accuracy=args.accuracy,
                            options=opts)
+    log.info("%s: %s on the %s problem: %s in %.3g s", scene.name, result.backend, result.formulation,
+             result.status.value, result.times.get("total") or 0.0)
     if args.json:
         d = result.to_dict(args.probe)
         if args.target is not None:
