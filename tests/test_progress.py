@@ -167,3 +167,39 @@ def test_the_library_never_configures_logging():
         assert "basicConfig" not in text, f
         if f.parts[-2] != "cli":
             assert "addHandler" not in text and "logging.getLogger()" not in text, f
+
+
+def _convergence(sc):
+    from plateqp.studies import convergence
+
+    convergence(sc, meshes=(4, 8))
+
+
+def _exact(sc):
+    from plateqp.studies import exact_path
+
+    exact_path(sc, "supports.1.gap", -0.3, 0.1)
+
+
+def _uniform(sc):
+    from plateqp.studies import most_uniform_stiffness
+
+    most_uniform_stiffness(sc, (1e3, 1e5), scan=3, xatol=0.5)
+
+
+def _regulate(sc):
+    assert main(["regulate", "heave", "--target", "2000", "--supports", "1,2"]) in (0, 5)
+
+
+@pytest.mark.parametrize("run, line", [
+    (_convergence, "meshes: 2/2"),
+    (_exact, "exact path of supports.1.gap, % of the range: 100/100"),
+    (_uniform, "most uniform stiffness: solves: 3"),
+    (_regulate, "regulate: gaps, then the check: 2/2"),
+], ids=["convergence", "exact-path", "uniform-stiffness", "regulate"])
+def test_every_long_run_draws_a_bar_on_a_terminal(heave, monkeypatch, run, line):
+    monkeypatch.setitem(sys.modules, "tqdm", None)  # the counter line: its text is deterministic
+    tty = as_tty(monkeypatch)
+    run(heave)
+    assert line in tty.getvalue()
+    assert not progress._OPEN  # closed at the end
