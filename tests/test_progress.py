@@ -203,3 +203,9 @@ def test_every_long_run_draws_a_bar_on_a_terminal(heave, monkeypatch, run, line)
     run(heave)
     assert line in tty.getvalue()
     assert not progress._OPEN  # closed at the end
+
+
+def test_the_old_home_of_progress_still_imports():
+    from plateqp.studies.parallel import Progress
+
+    assert Progress is progress.Progress
