@@ -406,7 +406,8 @@ def main(argv=None) -> int:
     rows = []
     tmp = tempfile.mkdtemp(prefix="plateqp-bench-")
     threads = str(args.threads) if args.threads else f"default ({os.cpu_count()} cores)"
-    for el in args.elements:
+    from plateqp.progress import track  # a bar on a terminal only
+    for el in track(args.elements, "elements"):
         for n in args.sizes:
             rep = 1 if n >= args.single else args.repeat
             mpath = os.path.join(tmp, f"{el}{n}.npz")

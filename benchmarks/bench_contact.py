@@ -117,7 +117,8 @@ def main():
     if args.skip_cvxpy:
         names = [n for n in names if not n.startswith("cvxpy")]
     rows = []
-    for g in (int(v) for v in args.grids.split(",")):
+    from plateqp.progress import track  # a bar on a terminal only
+    for g in track([int(v) for v in args.grids.split(",")], "grids"):
         ref = run_case((args.mesh, g, "lemke", "condensed", "high"), 10 * args.timeout)
         R0 = np.array(ref["reactions"])
         print(f"\n### {args.mesh}×{args.mesh} ACM plate, {g}×{g} supports ({ref['active']} in contact); "

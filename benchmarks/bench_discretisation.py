@@ -93,7 +93,8 @@ def main(argv=None) -> int:
     meshes = [n for n in (8, 16, 32, 64, 128) if n <= args.max_mesh]
     fams = args.families.split(",")
     out_rows = []
-    for name in fams:
+    from plateqp.progress import track  # a bar on a terminal only
+    for name in track(fams, "families"):
         t0 = time.perf_counter()
         ref = run_in_subprocess(_solve_group, (name, REF_MESH, "pdas", "primal", (1e-12,)), 3 * args.timeout)
         if "rows" not in ref or "q" not in ref["rows"][0]:

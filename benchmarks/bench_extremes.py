@@ -513,13 +513,15 @@ def main():
         names = [n for n in names if not n.startswith("cvxpy")]
     t_start = time.time()
     refs = {}
-    for c in cases:
+    from plateqp.progress import track  # a bar on a terminal only
+    for c in track(cases, "references"):
         t0 = time.perf_counter()
         refs[c.name] = reference(c)
         print(f"reference {c.name}: {refs[c.name]['how']} {refs[c.name]['limit']} ({time.perf_counter() - t0:.1f} s)",
               flush=True)
     rows = []
-    for b in names:
+    from plateqp.progress import track  # a bar on a terminal only
+    for b in track(names, "backends"):
         tasks, limits, meta = [], [], []
         for c in cases:
             for f in formulations_for(b):

@@ -52,6 +52,7 @@ import plateqp as pq
 from plateqp import linalg
 from plateqp.assembly import build_model
 from plateqp.linalg import Factor
+from plateqp.progress import track  # bars on a terminal only
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
@@ -225,7 +226,7 @@ def main():
               "KKT worst | iterations | factorisations | solves |")
         print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         refs = {}
-        for kind in kinds:
+        for kind in track(kinds, "kinds"):
             scene = make_scene(kind, n)
             model = build_model(scene)
             for name in bindings:
@@ -252,7 +253,7 @@ def main():
         n = args.mesh
         names = [b for b in args.backends.split(",") if b]
         avail = set(pq.available_backends())
-        for kind in kinds:
+        for kind in track(kinds, "kinds"):
             cases = [(b, "primal") for b in names if b in avail]
             if kind == "grid":
                 cases.append(("lemke", "condensed"))
@@ -293,7 +294,7 @@ def main():
         print("| scene | mesh | dofs | rows | in contact | method | iterations | factorisations | solves | "
               "two-sided s | pdas s | ratio | KKT worst |")
         print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-        for kind in kinds:
+        for kind in track(kinds, "kinds"):
             for n in meshes:
                 scene = make_scene(kind, n)
                 model = build_model(scene)

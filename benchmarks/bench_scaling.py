@@ -184,7 +184,8 @@ def main():
     if "dofs" in parts:
         run_sweep("dofs", [(int(n), args.k) for n in args.sizes.split(",")], pairs, args, rows, out)
     if "contacts" in parts:
-        for n in (int(v) for v in args.meshes.split(",")):
+        from plateqp.progress import track  # a bar on a terminal only
+        for n in track([int(v) for v in args.meshes.split(",")], "meshes"):
             ks = [k if k == "all" else int(k) for k in args.ks.split(",")]
             run_sweep("contacts", [(n, k) for k in ks if k == "all" or k <= n - 1], pairs, args, rows, out)
     write_csv(rows, out)

@@ -100,7 +100,8 @@ def interleaved(backends, values, repeats: int, refine: bool) -> list[dict]:
     """Every (backend, mode) once per repeat, the order rotated from one repeat to the next."""
     cases = [(b, m) for b in backends for m in modes_for(b)]
     out = []
-    for k in range(repeats):
+    from plateqp.progress import track  # a bar on a terminal only
+    for k in track(range(repeats), "repeats"):
         for b, m in cases[k % len(cases):] + cases[: k % len(cases)]:
             res = run(b, m, values, refine)
             res["repeat"] = k

@@ -261,7 +261,8 @@ def main():
     pairs = [(b, f) for b in names for f in formulations_for(b)]
     rows = []
     t_start = time.perf_counter()
-    for n in (int(v) for v in args.sizes.split(",")):
+    from plateqp.progress import track  # a bar on a terminal only
+    for n in track([int(v) for v in args.sizes.split(",")], "sizes"):
         for fam in args.families.split(","):
             k = DEFAULT_K[fam]
             ref = reference(fam, n, k, args.lemke_max, 20 * args.timeout)

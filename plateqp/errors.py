@@ -59,3 +59,8 @@ class PlateQPWarning(UserWarning):
 
 class ExportError(PlateQPError, ValueError):
     """An export was asked for something it cannot do (bad name, existing output, bad file)."""
+
+
+class ClusterError(PlateQPError):
+    """A Dask cluster was asked for and cannot be used: dask.distributed is not installed, or
+    no scheduler answered at the address within the timeout."""

@@ -96,12 +96,13 @@ def test_compare_sees_lift_off():
     assert abs(c.s1_rel) < 0.1  # and sigma1 near the load almost the same
 
 
-def test_run_writes_report(tmp_path, capsys):
+def test_run_writes_report(tmp_path, capsys, caplog):
+    caplog.set_level("INFO", logger="plateqp.demo")
     code = demo.run(["heave"], tmp_path)
     out, err = capsys.readouterr()
     assert code == 0
     assert "heave" in out and "17/25" in out and "two-sided comparison" in out and "ok" in out
-    assert "plateqp demo: heave" in err  # progress on stderr
+    assert "heave: solving one-sided" in caplog.text  # progress: logged (INFO), a bar only on a terminal
     html = (tmp_path / "report.html").read_text()
     assert '<img src="data:image/png;base64,' in html
     pngs = sorted(p.name for p in tmp_path.glob("*.png"))
@@ -131,7 +132,7 @@ def test_run_unknown_scene_fails_before_work(tmp_path):
     assert not (tmp_path / "x").exists()
 
 
-def test_convergence_panel_and_its_fallback(monkeypatch, capsys):
+def test_convergence_panel_and_its_fallback(monkeypatch, caplog):
     sc = scenes.load("heave")
     one = pq.solve(sc)
     assert demo.characteristic_supports(one) == [12, 1]  # support 13 (most loaded), 2 (heaved, in contact)
@@ -141,16 +142,16 @@ def test_convergence_panel_and_its_fallback(monkeypatch, capsys):
         assert fig.axes[0].get_yscale() == "log" and "target" in caption
     monkeypatch.setitem(sys.modules, "plateqp.studies", None)  # as if it were missing
     assert demo.convergence_plot(sc, one) is None
-    assert "convergence study skipped" in capsys.readouterr().err
+    assert "convergence study skipped" in caplog.text  # a logged warning
 
 
-def test_run_without_matplotlib_writes_a_report_without_figures(tmp_path, monkeypatch, capsys):
+def test_run_without_matplotlib_writes_a_report_without_figures(tmp_path, monkeypatch, caplog):
     import importlib.util
 
     real = importlib.util.find_spec
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "matplotlib" else real(name, *a))
     assert demo.run(["slab"], tmp_path) == 0
-    assert "no figures" in capsys.readouterr().err
+    assert "no figures" in caplog.text
     assert not list(tmp_path.glob("*.png")) and "<img" not in (tmp_path / "report.html").read_text()
 
 
@@ -190,7 +191,7 @@ def test_convergence_plot_lets_a_plotting_bug_through(monkeypatch):
         demo.convergence_plot(sc, one)
 
 
-def test_convergence_plot_skips_a_scene_the_study_cannot_take(monkeypatch, capsys):
+def test_convergence_plot_skips_a_scene_the_study_cannot_take(monkeypatch, caplog):
     """A PlateQPError from the study (e.g. a mesh the scene cannot be built on) skips the panel with a note."""
     import plateqp.studies
 
@@ -198,7 +199,7 @@ def test_convergence_plot_skips_a_scene_the_study_cannot_take(monkeypatch, capsy
     one = pq.solve(sc)
     monkeypatch.setattr(plateqp.studies, "convergence", _raise(pq.SolverError("no mesh could be solved")))
     assert demo.convergence_plot(sc, one) is None
-    assert "convergence study skipped (SolverError: no mesh could be solved)" in capsys.readouterr().err
+    assert "convergence study skipped (SolverError: no mesh could be solved)" in caplog.text
 
 
 # -- plateqp demo --out DIR [--force]: checked before any work, nothing overwritten --------------

@@ -6,6 +6,9 @@ Errors go to stderr as one line (what is wrong and where) with exit code 2 for b
 workers and prints the rows done so far); 1 only for an internal error (a bug:
 the line says so; ``PLATEQP_DEBUG=1`` shows the traceback).
 
+``--quiet`` (errors only: no progress bar, note or warning) and ``--verbose`` (``-v``: the
+library's INFO messages, ``-vv``: DEBUG) go before or after the command's name. Progress bars
+and log messages go to standard error, bars only when it is a terminal (not under CI=true).
 While a command works, anything a solver prints on standard output (HiGHS's banner, OSQP's
 "Polishing not needed") is sent to standard error, so that ``--json`` output is JSON alone.
 Files are written only inside ``--out``, under names made safe from the scene's name, never
@@ -21,7 +24,7 @@ import sys
 
 from ..errors import NoEquilibriumError, PlateQPError, SolverError
 from ..io.files import safe_filename
-from .common import _accuracy, _out_dir, _probe, _target
+from .common import _accuracy, _out_dir, _output, _probe, _target
 from .solve import cmd_solve
 from .studies import cmd_regulate, cmd_sweep
 from .tools import cmd_backends, cmd_demo, cmd_export
@@ -47,8 +50,19 @@ def _negative_values_joined(argv: list[str]) -> list[str]:
     return out
 
 
+def _output_flags(p, here: bool) -> None:
+    """--quiet / --verbose on the main parser (``here``) and on each command (there the defaults are
+    SUPPRESS, so a flag given before the command's name is not reset by the command's parser)."""
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("-q", "--quiet", action="store_true", default=False if here else argparse.SUPPRESS,
+                   help="errors only: no progress bar, note or warning on standard error")
+    g.add_argument("-v", "--verbose", action="count", default=0 if here else argparse.SUPPRESS,
+                   help="the library's log messages on standard error (-v: INFO, -vv: DEBUG)")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="plateqp", description="Thin plates on one-sided supports, contact as a convex QP.")
+    _output_flags(ap, True)
     sub = ap.add_subparsers(dest="cmd", required=True)
     d = sub.add_parser("demo", help="solve a built-in scene and print a summary")
     from ..demo import names_all  # matplotlib stays unimported until a figure is drawn
@@ -95,7 +109,11 @@ def main(argv=None) -> int:
     w.add_argument("--exact", action="store_true",
                    help="breakpoints exactly, by parametric pivoting, for a parameter that enters linearly "
                         "(a gap, a load, a prescribed displacement); refused for a stiffness")
-    w.add_argument("--workers", type=int, default=2, help="local worker processes (1: serial)")
+    w.add_argument("--workers", type=int, default=None, help="local worker processes (default 2; 1: serial)")
+    w.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run the sweep on the existing Dask cluster "
+                   "whose scheduler is at this address (not with --workers)")
+    w.add_argument("--scheduler-timeout", type=float, default=10.0, metavar="S",
+                   help="--scheduler: seconds to wait for the scheduler to answer (default 10)")
     w.add_argument("--no-warm-start", action="store_true",
                    help="start each value's solve cold (warm starts: bpp and pdas, from the previous contact set)")
     w.add_argument("--max-values", type=int, default=10_000, metavar="N", help="most values a sweep takes")
@@ -127,11 +145,16 @@ def main(argv=None) -> int:
     r.add_argument("--force", action="store_true", help="--out: overwrite the file if it exists")
     b = sub.add_parser("backends", help="list the backends and the formulations each takes")
     b.add_argument("--json", action="store_true")
+    for p in sub.choices.values():
+        _output_flags(p, False)
     args = ap.parse_args(_negative_values_joined(sys.argv[1:] if argv is None else list(argv)))
+    if args.quiet and args.verbose:
+        ap.error("--quiet and --verbose: choose one")
     saved_limit = os.environ.get("PLATEQP_MAX_MEMORY")  # --max-memory holds for this command only
     try:
-        return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends,
-                "export": cmd_export, "regulate": cmd_regulate}[args.cmd](args)
+        with _output(args.quiet, args.verbose):
+            return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends,
+                    "export": cmd_export, "regulate": cmd_regulate}[args.cmd](args)
     except KeyboardInterrupt:
         print("plateqp: interrupted", file=sys.stderr)
         return 130

@@ -1,5 +1,6 @@
 """Helpers shared by the ``plateqp`` subcommands: argument parsing, ``--out`` checked before any
-work, solver output kept off standard output, the memory limit.
+work, solver output kept off standard output, the memory limit, and what goes to standard
+error (``--quiet`` / ``--verbose``: log messages, progress bars, warnings).
 """
 
 from __future__ import annotations
@@ -7,8 +8,10 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import logging
 import os
 import sys
+import warnings
 from pathlib import Path
 
 
@@ -17,6 +20,48 @@ from ..backends import get_backend
 from ..accuracy import accuracy_tol
 from ..errors import PlateQPError, ProblemError, SceneError, SolverError
 from ..scene import Scene
+from .. import progress
+
+#: The log of the command line itself (notes such as "meshio is not installed").
+log = logging.getLogger("plateqp.cli")
+
+
+class _StderrHandler(logging.Handler):
+    """Log records as lines on the standard error of the moment (tests and ``_stdout_to_stderr``
+    swap it), above any open progress bar."""
+
+    def emit(self, record):
+        try:
+            progress.write(self.format(record))
+        except Exception:  # noqa: BLE001 - logging must not break the command
+            self.handleError(record)
+
+
+@contextlib.contextmanager
+def _output(quiet: bool = False, verbose: int = 0):
+    """While a command runs: plateqp's log messages on standard error (WARNING and above; with
+    ``verbose`` 1 INFO, 2 or more DEBUG; with ``quiet`` ERROR only), progress bars on (off
+    with ``quiet``; they still show only on a terminal), Python warnings ignored with
+    ``quiet``. The library's own loggers are configured here, never the root logger; all is
+    restored afterwards."""
+    top = logging.getLogger("plateqp")
+    level = logging.ERROR if quiet else (logging.WARNING, logging.INFO)[verbose] if verbose < 2 else logging.DEBUG
+    handler = _StderrHandler(level)
+    handler.setFormatter(logging.Formatter("plateqp: %(levelname)s %(name)s: %(message)s" if verbose
+                                           else "plateqp: %(message)s"))
+    old_level = top.level
+    top.addHandler(handler)
+    top.setLevel(level)
+    was = progress.set_enabled(not quiet)
+    try:
+        with warnings.catch_warnings():
+            if quiet:
+                warnings.simplefilter("ignore")
+            yield
+    finally:
+        progress.set_enabled(was)
+        top.removeHandler(handler)
+        top.setLevel(old_level)
 
 
 def _probe(text: str) -> tuple[float, float]:

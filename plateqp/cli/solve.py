@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import json
-import sys
 import warnings
 
 import numpy as np
@@ -14,7 +13,7 @@ from ..solving import solve
 from ..errors import PlateQPError, ProblemError
 from ..io.files import safe_filename
 from ..io.vtk import vtu_files, write_vtu
-from .common import _options, _backend_name, _out_dir, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin
+from .common import _options, _backend_name, _out_dir, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, log
 
 
 def _check_probes(scene, probes) -> None:
@@ -102,7 +101,7 @@ def cmd_solve(args) -> int:
         raise ProblemError("--sensitivity: the scene has no one-sided supports (nothing to differentiate)")
     vtu = bool(args.out) and _have_meshio()
     if args.out and not vtu:
-        print("plateqp: meshio is not installed: no .vtu written (pip install 'plateqp[results]')", file=sys.stderr)
+        log.warning("meshio is not installed: no .vtu written (pip install 'plateqp[results]')")
     files = [f"{stem}.json", f"{stem}-w.npy"] + (vtu_files(stem) if vtu else [])
     out = _out_dir(args.out, files, args.force) if args.out else None
     reached = True
@@ -117,15 +116,16 @@ def cmd_solve(args) -> int:
                 raise PlateQPError("--target chooses the solver tolerance (a tenth of the target): drop --accuracy")
             tr = solve_to_target(scene, args.target, backend=args.backend, formulation=args.formulation,
                                  max_cells=args.max_mesh,
-                                 progress=None if args.json else lambda r: print(
-                                     f"  {r['mesh'][0]}x{r['mesh'][1]}: {r['status']} in {r['time']:.2f} s",
-                                     file=sys.stderr, flush=True))
+                                 progress=lambda r: log.info("--target: mesh %dx%d: %s in %.2f s", r["mesh"][0],
+                                                             r["mesh"][1], r["status"], r["time"]))
             reached, result = tr.reached, tr.result
             if result is None:
                 raise PlateQPError(f"--target: no mesh up to {args.max_mesh} cells a side could be solved")
         else:
             result = solve(scene, backend=args.backend, formulation=args.formulation, accuracy=args.accuracy,
                            options=opts)
+    log.info("%s: %s on the %s problem: %s in %.3g s", scene.name, result.backend, result.formulation,
+             result.status.value, result.times.get("total") or 0.0)
     if args.json:
         d = result.to_dict(args.probe)
         if args.target is not None:

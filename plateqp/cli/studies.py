@@ -15,6 +15,7 @@ import numpy as np
 from ..accuracy import Status
 from ..solving import solve
 from ..errors import PlateQPError, ProblemError
+from ..progress import Progress
 from .common import _options, _backend_name, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, _numbers
 
 
@@ -39,11 +40,13 @@ def cmd_regulate(args) -> int:
     if args.out:
         check_file(args.out, force=args.force, label=f"--out {args.out}", flag="--force")
     _backend_name(args.backend)
-    with warnings.catch_warnings(), _stdout_to_stderr():
+    with warnings.catch_warnings(), _stdout_to_stderr(), Progress(2, "regulate: gaps, then the check") as bar:
         warnings.simplefilter("ignore")
         reg = regulate_gaps(scene, target if len(target) > 1 else target[0], supports=chosen,
                             backend=args.backend, formulation=args.formulation)
+        bar.update()
         check = solve(reg.scene, backend=args.backend, formulation=args.formulation, accuracy="high")
+        bar.update()
     got = check.reactions[reg.supports]
     scale = max(float(np.abs(reg.reactions).max(initial=0.0)), float(np.abs(check.reactions).max(initial=0.0)), 1e-300)
     error = float(np.abs(got - reg.reactions).max(initial=0.0) / scale)
@@ -112,7 +115,23 @@ def _sweep_values(args) -> list:
     return [float(v) for v in np.linspace(a, b, n)]
 
 
-def _sweep_exact(scene, values, opts, args):
+def _executor(args, stack: contextlib.ExitStack) -> tuple:
+    """(executor, max_workers) of a sweep: a Dask client on ``--scheduler`` (closed when ``stack``
+    closes; the cluster keeps running), else local processes (``--workers``, default 2; 1: serial)."""
+    if args.scheduler is not None:
+        if args.workers is not None:
+            raise ProblemError("--workers and --scheduler: choose one (the cluster's workers run the sweep)")
+        if not args.scheduler_timeout > 0:
+            raise ProblemError(f"--scheduler-timeout: seconds > 0 (got {args.scheduler_timeout})")
+        from ..studies.parallel import connect
+
+        client = stack.enter_context(connect(args.scheduler, timeout=args.scheduler_timeout))
+        return client, 1
+    workers = 2 if args.workers is None else args.workers
+    return ("serial" if workers <= 1 else None), max(workers, 1)
+
+
+def _sweep_exact(scene, values, opts, args, executor, workers):
     """sweep --exact: the breakpoints of the exact path (:func:`plateqp.studies.exact_sweep`);
     a parameter that does not enter linearly is a ProblemError (exit 2) before any work."""
     from ..studies import exact_sweep
@@ -120,8 +139,7 @@ def _sweep_exact(scene, values, opts, args):
     if args.no_refine:
         raise ProblemError("--exact and --no-refine: choose one")
     return exact_sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
-                       accuracy=args.accuracy, options=opts, executor="serial" if args.workers <= 1 else None,
-                       max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                       accuracy=args.accuracy, options=opts, executor=executor, max_workers=workers,
                        warm_start=not args.no_warm_start, store=args.store)
 
 
@@ -139,16 +157,15 @@ def cmd_sweep(args) -> int:
 
         _optional("xarray")
         check_file(args.out, force=args.force, label=f"--out {args.out}", flag="--force")
-    with _sigterm_as_interrupt() as seen:
+    with _sigterm_as_interrupt() as seen, contextlib.ExitStack() as stack:
+        executor, workers = _executor(args, stack)
         try:
             with _stdout_to_stderr():
                 if args.exact:
-                    res = _sweep_exact(scene, values, opts, args)
+                    res = _sweep_exact(scene, values, opts, args, executor, workers)
                 else:
                     res = sweep(scene, args.param, values, backend=args.backend, formulation=args.formulation,
-                                accuracy=args.accuracy, options=opts,
-                                executor="serial" if args.workers <= 1 else None,
-                                max_workers=max(args.workers, 1), progress=sys.stderr.isatty(),
+                                accuracy=args.accuracy, options=opts, executor=executor, max_workers=workers,
                                 refine_breakpoints=not args.no_refine, rtol=args.rtol,
                                 warm_start=not args.no_warm_start, store=args.store)
         except SweepInterrupted as exn:

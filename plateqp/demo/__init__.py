@@ -6,7 +6,8 @@ scene has one-sided supports, the source paper's comparison (:func:`plateqp.solv
 every support made two-sided). Prints one summary line per scene to stdout, the paper's
 quantitative statements for our scenes (:func:`compare`), and writes the figures (PNG), one
 JSON file per scene and a self-contained ``report.html`` (figures embedded as base64 PNG)
-into the output folder. Progress goes to stderr. The figures come from
+into the output folder. Progress goes to stderr: a bar on a terminal (:mod:`plateqp.progress`),
+log messages (``logging``, logger ``plateqp.demo``; skipped parts as warnings). The figures come from
 :mod:`plateqp.plotting`, the summary table and the HTML from :mod:`plateqp.report`;
 :func:`output_files` lists every file a run may write, so that the command line can check
 the folder before any work and refuse to overwrite without ``--force``.
@@ -56,8 +57,8 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import logging
 import math
-import sys
 import time
 import warnings
 from dataclasses import asdict, dataclass, field
@@ -68,6 +69,7 @@ import numpy as np
 from .. import scenes
 from ..errors import PlateQPWarning, SceneError
 from ..plotting.data import support_spacing
+from ..progress import Progress
 from ..report import format_table, report_html, summary_row
 from .paper import STUDIES, TITLES, run_study
 
@@ -333,8 +335,7 @@ class SceneRun:
         return bool(self.one.ok and kkt_ok)
 
 
-def _progress(msg: str) -> None:
-    print(f"plateqp demo: {msg}", file=sys.stderr, flush=True)
+logger = logging.getLogger(__name__)
 
 
 def run_scene(name: str, figures: bool = True) -> SceneRun:
@@ -345,7 +346,7 @@ def run_scene(name: str, figures: bool = True) -> SceneRun:
 
     story, units = scene_notes(name)
     scene = scenes.load(name)
-    _progress(f"{name}: solving one-sided" + (" and two-sided" if scene.one_sided else ""))
+    logger.info(f"{name}: solving one-sided" + (" and two-sided" if scene.one_sided else ""))
     t0 = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PlateQPWarning)  # the status says it; the summary shows it
@@ -365,12 +366,12 @@ def run_scene(name: str, figures: bool = True) -> SceneRun:
         else:
             comp = compare(one, two)
     for part, why in skipped.items():
-        _progress(f"{name}: {part} skipped ({why})")
+        logger.info(f"{name}: {part} skipped ({why})")
     t2 = time.perf_counter()
     figs: dict[str, bytes] = {}
     caps: dict[str, str] = {}
     if figures:
-        _progress(f"{name}: drawing figures")
+        logger.info(f"{name}: drawing figures")
         secs = pl.default_sections(one)
 
         def put(stem, caption, make):
@@ -457,10 +458,10 @@ def convergence_plot(scene, one):
     try:
         from ..studies import convergence
     except ModuleNotFoundError as exn:  # plateqp.studies, or a package it needs, is not installed
-        _progress(f"{scene.name}: convergence study skipped ({type(exn).__name__}: {exn})")
+        logger.warning(f"{scene.name}: convergence study skipped ({type(exn).__name__}: {exn})")
         return None
     if importlib.util.find_spec("matplotlib") is None:
-        _progress(f"{scene.name}: convergence study skipped (matplotlib is not installed)")
+        logger.warning(f"{scene.name}: convergence study skipped (matplotlib is not installed)")
         return None
     idx = characteristic_supports(one)
     quantities = ["w_max"] + [f"reactions.{i}" for i in idx]
@@ -468,7 +469,7 @@ def convergence_plot(scene, one):
         tab = convergence(scene, meshes=CONVERGENCE_MESHES, quantities=quantities, target=CONVERGENCE_TARGET,
                           accuracy="high")
     except PlateQPError as exn:  # the scene cannot be studied on these meshes (one mesh failing is a row)
-        _progress(f"{scene.name}: convergence study skipped ({type(exn).__name__}: {exn})")
+        logger.warning(f"{scene.name}: convergence study skipped ({type(exn).__name__}: {exn})")
         return None
     labels = {"w_max": "w at max |w|"}
     for k, i in enumerate(idx):
@@ -536,12 +537,18 @@ def run(names: list[str] | None = None, out: Path | None = None, *, study_mesh: 
     t0 = time.perf_counter()
     figures = importlib.util.find_spec("matplotlib") is not None
     if not figures:
-        _progress("matplotlib is not installed (pip install 'plateqp[plot]'): the report will have no figures")
-    runs = [run_scene(n, figures=figures) for n in names]
-    studies = []
-    for n in study_names:
-        _progress(f"{n}: {TITLES[n]}")
-        studies.append(run_study(n, figures=figures, mesh=study_mesh, dpi=DPI))
+        logger.warning("matplotlib is not installed (pip install 'plateqp[plot]'): the report will have no figures")
+    runs, studies = [], []
+    with Progress(len(names) + len(study_names), "demo") as bar:
+        for n in names:
+            bar.describe(f"demo: {n}")
+            runs.append(run_scene(n, figures=figures))
+            bar.update()
+        for n in study_names:
+            bar.describe(f"demo: {n}")
+            logger.info(f"{n}: {TITLES[n]}")
+            studies.append(run_study(n, figures=figures, mesh=study_mesh, dpi=DPI))
+            bar.update()
     table = format_table([summary_row(r) for r in runs]) if runs else ""
     if table:
         print(table)

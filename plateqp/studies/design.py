@@ -34,6 +34,7 @@ minimisation.
 from __future__ import annotations
 
 import copy
+import logging
 import math
 import warnings
 from collections.abc import Sequence
@@ -47,9 +48,12 @@ from ..backends import LCP, get_backend
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError, SceneError
 from ..linalg import Factor, solve_saddle
 from ..paths import set_param
+from ..progress import Progress
 from ..scene import PointLoad, Scene
 from ..solving import solve
 from .reuse import adapt_model
+
+logger = logging.getLogger(__name__)
 
 # =============================================================================================
 # Regulating the interaction forces by the gaps
@@ -200,6 +204,7 @@ def regulate_gaps(scene: Scene, target_reactions, supports: Sequence[int] | None
     gaps = np.array([s.gap for s in scene.supports], dtype=float)
     gaps[reg] = w_reg - c.rho[reg] * R_reg
     new = set_param(scene, "supports.*.gap", gaps)
+    logger.info("regulate_gaps: %d supports regulated, relative distance to the target %.2e", reg.size, proj)
     return GapRegulation(gaps, new, reg, target, R_reg, R_other, proj)
 
 
@@ -286,6 +291,7 @@ def most_uniform_stiffness(scene: Scene, c_range: tuple[float, float], supports:
     sel = np.arange(len(scene.supports)) if supports is None else np.asarray(list(supports), dtype=int)
     base = build_model(scene)
     evals: list[tuple[float, float]] = []
+    bar = Progress(None, "most uniform stiffness: solves")  # a scan, then a bounded search: no known end
 
     def cv_at(logc: float) -> float:
         c = float(np.exp(logc))
@@ -296,6 +302,8 @@ def most_uniform_stiffness(scene: Scene, c_range: tuple[float, float], supports:
                         model=adapt_model(base, sc))
         v = uniformity(res.reactions[sel], measure)
         evals.append((c, v))
+        bar.update()
+        logger.debug("most uniform stiffness: c = %.6g, %s = %.6g", c, measure, v)
         return v
 
     grid = np.linspace(np.log(lo), np.log(hi), max(scan, 3))
@@ -303,7 +311,9 @@ def most_uniform_stiffness(scene: Scene, c_range: tuple[float, float], supports:
     k = int(np.argmin(cvs))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
     minimize_scalar(cv_at, bounds=(a, b), method="bounded", options={"xatol": xatol})  # records in evals
+    bar.close()
     best = min(evals, key=lambda e: e[1])
+    logger.info("most uniform stiffness: c = %.6g after %d solves (%s = %.6g)", best[0], len(evals), measure, best[1])
     sc = set_param(scene, "supports.*.stiffness", best[0])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PlateQPWarning)

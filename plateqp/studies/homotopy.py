@@ -28,6 +28,7 @@ agree and f, g0 be affine to rounding.
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass, field
 
@@ -37,11 +38,14 @@ from ..assembly import Model, build_model
 from ..contact.scaling import Scaled
 from ..errors import MechanismError, ProblemError
 from ..paths import as_number, get_param, set_param
+from ..progress import Progress
 from ..scene import Scene
 from ..sensitivity import MAX_DEGENERATE, classify, held_solve, one_direction
 from ..solving import solve
 from .reuse import adapt_model
 from .sweep import SweepResult, sweep
+
+logger = logging.getLogger(__name__)
 
 #: Relative agreement asked of K, B, ρ and of the affine f, g0 for a parameter to count as linear.
 LINEAR_RTOL = 1e-11
@@ -216,6 +220,7 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
     pieces, breaks, affine = [], [], []
     prev_contact = None
     steps_taken = 0
+    bar = Progress(100, f"exact path of {path}, % of the range")
     while True:
         steps_taken += 1
         if steps_taken > limit:  # counts every step (pieces that change nothing are merged)
@@ -250,6 +255,7 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
             off = sorted(set(prev_contact) - set(contact))
             breaks.append({"at": t, "before": prev_contact, "after": contact, "comes_into_contact": on,
                            "lifts_off": off})
+            logger.debug("exact path of %s: at %.12g comes into contact %s, lifts off %s", path, t, on, off)
         # the next event: a held reaction falls to zero, or an open gap closes
         remaining = abs(x1 - t)
         # slopes that move a reaction (a gap) by less than 1e-8 of the largest (of the deflection
@@ -270,6 +276,7 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
             pieces.append({"from": t, "to": t_next, "contact": contact, "unique": bool(unique)})
         affine.append((t, t_next, state_R, state_gap, state_u, slope.dR, slope.dgap, slope.du))
         prev_contact = contact
+        bar.moveto(int(100 * abs(t_next - x0) / max(abs(x1 - x0), 1e-300)))
         if step >= remaining:
             break
         events = np.flatnonzero(steps <= step * (1.0 + 1e-9) + 1e-300)
@@ -285,6 +292,8 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
         # force are held here, then released by the one-sided step if they open
         D = np.flatnonzero(deg)
         t = t_next
+    bar.close()
+    logger.info("exact path of %s from %g to %g: %d piece(s), %d step(s)", path, x0, x1, len(pieces), steps_taken)
     return ExactPath(path, x0, x1, breaks, pieces, _data=data, _model=model, _affine=affine, _dshift=dshift)
 
 

@@ -1,5 +1,7 @@
 """Where the values of a sweep are solved: this process, local worker processes, any
-:class:`concurrent.futures.Executor` or a Dask ``distributed.Client``; and a progress bar.
+:class:`concurrent.futures.Executor` or a Dask ``distributed.Client`` (:func:`connect` makes
+one on an existing cluster from its scheduler's address). The progress bar is
+:class:`plateqp.progress.Progress` (importable from here too, its old home).
 
 Every runner has the same two calls: ``submit(fn, *args)`` and ``as_completed(tasks)``, which
 yields (task, future) pairs as they finish (in order for :class:`Serial`, which runs each task
@@ -15,10 +17,12 @@ from __future__ import annotations
 import concurrent.futures as cf
 import pickle
 import signal
-import sys
-import warnings
+import logging
 
-from ..errors import PlateQPWarning, ProblemError
+from ..errors import ClusterError, ProblemError
+from ..progress import Progress  # noqa: F401 - its old home: importable from here too
+
+logger = logging.getLogger(__name__)
 
 #: ``executor=None`` runs fewer values than this in the calling process.
 SERIAL_BELOW = 8
@@ -70,7 +74,8 @@ class Futures:
         if self.dask:
             from distributed import as_completed
 
-            for f in as_completed(list(futs)):
+            # the client's own loop: without it Dask looks for a default client (there may be none)
+            for f in as_completed(list(futs), loop=self.ex.loop):
                 yield f, f
         else:
             for f in cf.as_completed(list(futs)):
@@ -121,6 +126,45 @@ def is_dask(executor) -> bool:
     return type(executor).__module__.split(".")[0] == "distributed" and hasattr(executor, "submit")
 
 
+#: Seconds :func:`connect` waits for a Dask scheduler to answer.
+CONNECT_TIMEOUT = 10.0
+
+
+def connect(address: str, timeout: float = CONNECT_TIMEOUT):
+    """A Dask ``distributed.Client`` on the existing cluster whose scheduler is at ``address``
+    (e.g. ``tcp://host:8786``), to pass as a sweep's ``executor`` (close it when done; the
+    cluster keeps running).
+
+    Raises
+    ------
+    ClusterError
+        dask.distributed is not installed, or no scheduler answered within ``timeout`` seconds.
+    """
+    try:
+        import distributed
+    except ImportError:
+        raise ClusterError(f"--scheduler {address}: dask.distributed is not installed "
+                           "(pip install 'dask[distributed]')") from None
+    if not isinstance(address, str) or not address.strip():
+        raise ClusterError(f"--scheduler: a scheduler address such as tcp://host:8786 (got {address!r})")
+    from distributed.comm import parse_address, parse_host_port
+
+    try:  # a malformed address fails here, before a Client exists (its cleanup would print at exit)
+        scheme, loc = parse_address(address)
+        if scheme in ("tcp", "tls", "ws", "wss"):
+            parse_host_port(loc)
+    except ValueError as exn:
+        raise ClusterError(f"--scheduler {address}: not a scheduler address such as tcp://host:8786 ({exn})") from None
+    logger.info("connecting to the Dask scheduler at %s (timeout %g s)", address, timeout)
+    try:
+        client = distributed.Client(address, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError) as exn:
+        why = str(exn).splitlines()[0] if str(exn) else type(exn).__name__
+        raise ClusterError(f"--scheduler {address}: no Dask scheduler answered within {timeout:g} s ({why})") from None
+    logger.info("connected: %d worker thread(s)", sum(client.nthreads().values()))
+    return client
+
+
 def make_runner(executor, n: int, max_workers: int, payload):
     """The runner for ``executor`` (see :func:`plateqp.studies.sweep.sweep`) and ``n`` tasks;
     ``payload``, what every task is sent, must pickle for local processes (else: this process)."""
@@ -130,8 +174,7 @@ def make_runner(executor, n: int, max_workers: int, payload):
         try:
             pickle.dumps(payload)
         except Exception:
-            warnings.warn("the scene cannot be pickled (a Python callable in it?): sweeping in this process",
-                          PlateQPWarning, stacklevel=3)
+            logger.warning("the scene cannot be pickled (a Python callable in it?): sweeping in this process")
             return Serial()
         return Futures(cf.ProcessPoolExecutor(max_workers=max_workers, mp_context=mp_context(),
                                               initializer=_ignore_sigint), True, False, max_workers)
@@ -147,41 +190,4 @@ def make_runner(executor, n: int, max_workers: int, payload):
                        f"dask distributed Client (got {executor!r})")
 
 
-class Progress:
-    """tqdm on stderr if installed, else one counter line that rewrites itself."""
-
-    def __init__(self, total: int, desc: str, enabled: bool):
-        self.total, self.desc, self.enabled, self.n = total, desc, enabled and total > 0, 0
-        self.bar = None
-        if self.enabled:
-            try:
-                from tqdm import tqdm
-
-                self.bar = tqdm(total=total, desc=desc, file=sys.stderr, leave=False)
-            except ImportError:
-                self._line()
-
-    def _line(self):
-        sys.stderr.write(f"\r{self.desc}: {self.n}/{self.total}")
-        sys.stderr.flush()
-
-    def update(self, k: int = 1):
-        self.n += k
-        if not self.enabled:
-            return
-        if self.bar is not None:
-            self.bar.update(k)
-        else:
-            self._line()
-
-    def close(self):
-        if not self.enabled:
-            return
-        if self.bar is not None:
-            self.bar.close()
-        else:
-            sys.stderr.write("\n")
-            sys.stderr.flush()
-
-
-__all__ = ["SERIAL_BELOW", "Futures", "Progress", "Serial", "is_dask", "make_runner", "mp_context"]
+__all__ = ["CONNECT_TIMEOUT", "SERIAL_BELOW", "connect", "Futures", "Progress", "Serial", "is_dask", "make_runner", "mp_context"]

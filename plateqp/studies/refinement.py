@@ -32,6 +32,7 @@ import numpy as np
 
 from ..accuracy import TOL_RANGE
 from ..errors import PlateQPError, PlateQPWarning, ProblemError, SceneError
+from ..progress import track
 from ..estimate import (COARSE_FAILURES, FRACTION, LOOSEST, ORDER, ErrorEstimate, Quantities, changes, quiet_solve,
                         richardson, with_mesh)
 from ..estimate import auto_tolerance as _auto_tolerance
@@ -65,7 +66,7 @@ def solve_on_meshes(scene: Scene, meshes: Iterable[tuple[int, int]], backend: st
     """
     if scene.triangles:
         with_mesh(scene, 1, 1)  # the one-line SceneError: refinement is not yet available on triangles
-    for nx, ny in meshes:
+    for nx, ny in track(meshes, "meshes"):  # a bar on a terminal (plateqp.progress)
         t0 = time.perf_counter()
         try:
             res = quiet_solve(solve, with_mesh(scene, nx, ny), backend, formulation, accuracy)

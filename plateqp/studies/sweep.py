@@ -16,6 +16,7 @@ re-use on; ``warm_start=False`` turns them off alone. Where the values are solve
 from __future__ import annotations
 
 import json
+import logging
 import math
 import time
 import uuid
@@ -28,8 +29,11 @@ from ..errors import ProblemError
 from ..paths import as_number, get_param, set_param
 from ..scene import Scene
 from .breakpoints import Bisection, contact_set, refine_bracket
-from .parallel import SERIAL_BELOW, Progress, make_runner
+from ..progress import Progress
+from .parallel import SERIAL_BELOW, make_runner
 from .worker import WARM_START_BACKENDS, Context, forget, next_start, run_chunk, solve_value
+
+logger = logging.getLogger(__name__)
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -172,7 +176,8 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
         :class:`concurrent.futures.Executor`, or a Dask ``distributed.Client``. Local
         processes start from a fresh interpreter (forkserver/spawn), so a script that sweeps
         with them needs the usual ``if __name__ == "__main__":`` guard.
-    progress : a progress bar on stderr (tqdm if installed, else a counter line)
+    progress : a progress bar on stderr, drawn only when stderr is a terminal and not under
+        CI (:mod:`plateqp.progress`; tqdm if installed, else a counter line)
     refine_breakpoints : bisect each change of the contact set between successive values
         until its bracket is within ``rtol`` relative
     reuse : build the model once and change only gaps, stiffnesses or loads in a copy (the
@@ -242,6 +247,8 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
             rows[i] = row
             actives[i] = tuple(row["active"]) if row.get("active") is not None else None
     todo = [i for i in range(n) if rows[i] is None]
+    logger.info("sweep of %s: %d values (%d from the store), executor %s with %d worker(s)", path, n, n - len(todo),
+                runner.kind, runner.workers)
     try:
         bar = Progress(len(todo), f"sweep {path}", progress)
         try:
