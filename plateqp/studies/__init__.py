@@ -8,7 +8,7 @@ module                 job
                        loosest solver tolerance for an estimated error)
 :mod:`.sweep`          :func:`sweep` of one scene field, with the breakpoints where the contact
                        set changes (:mod:`.breakpoints`), the work of a worker (:mod:`.worker`),
-                       executors and progress (:mod:`.parallel`)
+                       executors (:mod:`.parallel`; progress bars: :mod:`plateqp.progress`)
 :mod:`.reuse`          :func:`adapt_model`: a model for a scene that changes only gaps,
                        stiffnesses or loads, without re-assembly
 :mod:`.design`         :func:`regulate_gaps` (gaps for prescribed reactions) and
