@@ -13,16 +13,20 @@ import numpy as np, plateqp as pq
 from bench_contact import scene
 from plateqp.assembly import build_model
 from plateqp.contact import Scaled, formulate
-from plateqp.backends import lemke, bpp, pgs
+from plateqp.backends import get_backend
 from plateqp.backends.bpp import natural_residual
+
+lemke, bpp, pgs = (get_backend(b) for b in ("lemke", "bpp", "pgs"))  # the registered backends
+
 
 def lcp_of(sc):
     return formulate(Scaled.from_model(build_model(sc)), "condensed").lcp
-sc = scene(64, 30)
+N = int(sys.argv[1]) if len(sys.argv) > 1 else 64
+sc = scene(N, 30)
 lcp = lcp_of(sc)
-sc2 = scene(64, 30); sc2.loads = [pq.UniformLoad(20.0), pq.PointLoad(220.0, 0.7, 0.6)]   # +10 % point load
+sc2 = scene(N, 30); sc2.loads = [pq.UniformLoad(20.0), pq.PointLoad(220.0, 0.7, 0.6)]   # +10 % point load
 lcp2 = lcp_of(sc2)
-sc3 = scene(64, 30); sc3.loads = [pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.72, 0.6)]  # point load moved 0.02 a
+sc3 = scene(N, 30); sc3.loads = [pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.72, 0.6)]  # point load moved 0.02 a
 lcp3 = lcp_of(sc3)
 print("n =", lcp.n, flush=True)
 ref = lemke.solve(lcp, "high")
