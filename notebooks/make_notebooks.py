@@ -937,6 +937,18 @@ G_navier = np.array([[navier(*pi, *pj) for pj in posts] for pi in posts])
 print("G [mm/kN] (finite elements):\\n", (G * 1e6).round(5))
 print("relative difference to Navier's series:\\n", ((G - G_navier) / G_navier).round(4))
 assert np.all(np.abs(G - G_navier) <= 0.015 * G_navier)"""),
+md("""The difference is the discretisation error, not a mistake: on a mesh twice as fine (a sparse
+LU this time, 3 000 dofs) it falls about fourfold, as the element's h² convergence says (a
+little less on the diagonal, where the point force's logarithmic singularity sits)."""),
+code("""import dataclasses
+from scipy.sparse.linalg import splu
+fine = build_model(dataclasses.replace(scene, mesh=pq.MeshSpec(32, 32)))
+Bf = fine.contacts.B
+G_fine = Bf @ splu(fine.K.tocsc()).solve(Bf.T.toarray())
+err16, err32 = np.abs(G - G_navier) / G_navier, np.abs(G_fine - G_navier) / G_navier
+print(f"largest difference to Navier: {err16.max():.2%} at 16 x 16, {err32.max():.2%} at 32 x 32")
+print("ratio per entry:\\n", (err16 / err32).round(2))
+assert np.all(err32 < 0.004) and np.all(err16 > 3 * err32)"""),
 md("""## 4. The contact problem on the gaps, solved by Lemke
 
 With the posts settled by g0 the gaps left are z = g0 − u_c and the posts' reactions are
