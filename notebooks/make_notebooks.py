@@ -362,17 +362,21 @@ B = np.zeros((1, free.size)); B[0, list(free).index(2 * (nel // 2))] = 1.0   # w
 R_closed = max(0.0, (5 * q * L**4 / (384 * EI) - g) * 48 * EI / L**3)
 q_star = 384 * EI * g / (5 * L**4)
 print(f"free midspan deflection {5 * q * L**4 / (384 * EI) * 1e3:.3f} mm > gap {g * 1e3:.1f} mm")
-print(f"closed form: R = {R_closed:.3f} N,  lift-off load q* = {q_star:.1f} N/m")
-
-# the QP: the reaction is the multiplier of the constraint
-u = cp.Variable(free.size)
+print(f"closed form: R = {R_closed:.3f} N,  lift-off load q* = {q_star:.1f} N/m")"""),
+md("""### As a QP
+The obstacle is one linear inequality on the midspan deflection, B u ≤ g. The reaction is its
+multiplier, which cvxpy returns as the constraint's `dual_value`."""),
+code("""u = cp.Variable(free.size)
 contact = [B @ u <= g]
 cp.Problem(cp.Minimize(0.5 * cp.quad_form(u, cp.psd_wrap(K)) - f @ u), contact).solve(solver="CLARABEL")
 R_qp = contact[0].dual_value
 print(f"QP  (cvxpy):   R = {R_qp[0]:.6f} N")
-
-# the LCP in the reactions: gap = G R + d
-Kinv_Bt = np.linalg.solve(K, B.T)
+assert abs(R_qp[0] - R_closed) <= 1e-5 * R_closed              # interior point: to its tolerance"""),
+md("""### As an LCP
+Eliminating u leaves the reactions: the gap left is gap = G R + d with the flexibility
+G = B K⁻¹ Bᵀ and d the gap the beam would leave without the obstacle. Complementarity
+(R ≥ 0, gap ≥ 0, R·gap = 0) is the LCP that Lemke's method solves by pivoting, exactly."""),
+code("""Kinv_Bt = np.linalg.solve(K, B.T)
 G = B @ Kinv_Bt                         # flexibility: deflection at the obstacle per unit force there
 d = g - B @ np.linalg.solve(K, f)       # the gap the beam would leave without the obstacle
 R_lcp = lemke(G, d).x
@@ -380,8 +384,7 @@ print(f"LCP (Lemke):   R = {R_lcp[0]:.9f} N")
 print(f"G = {G[0, 0]:.6e} m/N,  L³/(48 EI) = {L**3 / (48 * EI):.6e} m/N")
 
 assert abs(G[0, 0] - L**3 / (48 * EI)) <= 1e-12 * G[0, 0]      # nodally exact flexibility
-assert abs(R_lcp[0] - R_closed) <= 1e-9 * R_closed             # exact method: to rounding
-assert abs(R_qp[0] - R_closed) <= 1e-5 * R_closed              # interior point: to its tolerance"""),
+assert abs(R_lcp[0] - R_closed) <= 1e-9 * R_closed             # exact method: to rounding"""),
 md("""## The reaction against the load: zero, then linear
 
 Below q* the obstacle carries nothing; above it R grows with slope 5L/8 (the share of the
@@ -420,9 +423,12 @@ R3 = lemke(G3, d3).x
 u_lcp = np.linalg.solve(K, f - B3.T @ R3)
 print("QP  reactions [N]:", np.round(c3[0].dual_value, 3))
 print("LCP reactions [N]:", np.round(R3, 6))
-print("gaps left [mm]:   ", np.round((g_obs - B3 @ u_lcp) * 1e3, 6))
-
-# closed forms (Euler-Bernoulli, simply supported): uniform load, and a point force P at a
+print("gaps left [mm]:   ", np.round((g_obs - B3 @ u_lcp) * 1e3, 6))"""),
+md("""### The contact set, checked by closed forms
+Deflection of a simply supported beam under the uniform load, and under a unit point force at
+a (Euler–Bernoulli): on the touching obstacles the gap is zero, which fixes their reactions;
+on the others the gap must come out non-negative."""),
+code("""# closed forms (Euler-Bernoulli, simply supported): uniform load, and a point force P at a
 def w_uniform(x):
     return q * x * (L**3 - 2 * L * x**2 + x**3) / (24 * EI)
 def w_point(x, a):              # deflection at x per unit force at a
@@ -438,9 +444,11 @@ print("superposition:   ", np.round(R_super, 6), " contact set", A.tolist())
 assert np.allclose(R3, R_super, rtol=0, atol=1e-9 * R_super.max())
 assert np.all(R_super >= 0) and np.all(gap_super >= -1e-12)        # a consistent contact set
 assert np.allclose(c3[0].dual_value, R_super, rtol=0, atol=1e-5 * R_super.max())
-assert np.allclose(G3, flex, rtol=1e-12)                           # the Hermite flexibility is exact
-
-# statics: the end reactions (from the full stiffness) and the obstacles carry the whole load
+assert np.allclose(G3, flex, rtol=1e-12)                           # the Hermite flexibility is exact"""),
+md("""### Statics
+The end supports' reactions come from the full stiffness (K u − f on the eliminated dofs);
+with the obstacles' they carry the whole load."""),
+code("""# statics: the end reactions (from the full stiffness) and the obstacles carry the whole load
 u_all = np.zeros(2 * (nel + 1)); u_all[free] = u_lcp
 ends = -(K_full @ u_all - f_full)[[0, 2 * nel]]     # upward forces (w is downward)
 print(f"end reactions {np.round(ends, 3)} N; total {ends.sum() + R3.sum():.6f} N = q L = {q * L:.1f} N")
@@ -493,8 +501,8 @@ lecture says about convex contact can be drawn:
 * at the optimum, −∇Π lies in the **normal cone** of the quadrant there, and the multipliers
   of z ≥ 0 are the components of ∇Π = M z + q: the **reactions**.
 
-The scene: a simply supported square plate with two one-sided posts under it, a uniform load
-and a point load off the centre line."""),
+The scene: a 10 mm steel plate, 1 m × 1 m, simply supported on its edges, with two one-sided
+posts under it, a uniform load and a point load off the centre line."""),
 code("""import numpy as np
 import matplotlib.pyplot as plt
 import plateqp as pq
@@ -503,9 +511,9 @@ from plateqp.contact import Scaled, formulate
 
 posts = [(0.375, 0.5), (0.625, 0.5)]
 def scene_with(gaps):
-    return pq.Scene(name="two-posts", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(16, 16),
+    return pq.Scene(name="two-posts", plate=pq.Plate(1.0, 1.0, 0.01, 2.1e11, 0.3), mesh=pq.MeshSpec(16, 16),
                     edges={k: "simple" for k in ("left", "right", "bottom", "top")},
-                    loads=[pq.UniformLoad(5.0), pq.PointLoad(20.0, 0.58, 0.45)],
+                    loads=[pq.UniformLoad(5000.0), pq.PointLoad(2000.0, 0.58, 0.45)],
                     supports=[pq.Support(x, y, gap=g) for (x, y), g in zip(posts, gaps)])
 
 # condense the plate onto the two support deflections (gaps zero), back in the user's units
@@ -514,8 +522,8 @@ lcp = formulate(data, "condensed").lcp
 M = lcp.M * data.F0 / data.W        # N/m: force at post i per unit gap at post j
 r = lcp.q * data.F0                 # N: the reactions if both posts were rigid and level
 w_free = np.linalg.solve(M, r)      # m: where the plate would sag without the posts
-print("M [N/mm] =\\n", (M / 1e3).round(4))
-print("reactions on level rigid posts r [N] =", r.round(4))
+print("M [kN/mm] =\\n", (M / 1e6).round(4))
+print("reactions on level rigid posts r [N] =", r.round(2))
 print("free deflection at the posts [mm] =", (w_free * 1e3).round(4))
 assert np.allclose(M, M.T) and np.all(np.linalg.eigvalsh(M) > 0)   # symmetric positive definite"""),
 md("""## Moving the gaps moves the ellipses
@@ -567,9 +575,28 @@ for name, g0 in cases.items():
     # statics: edge reactions (K u − f on the prescribed dofs) plus post reactions = total load
     mdl = res.model                                              # res.u: every dof, prescribed ones too
     edge = -(mdl.K_full @ res.u - mdl.f_full)[mdl.fixed]
-    total = 5.0 * 1.0 + 20.0
+    total = 5000.0 * 1.0 + 2000.0
     print(f"{name:20s} primal agrees; edges {edge.sum():.6f} N + posts {res.reactions.sum():.6f} N = {total} N")
-    assert abs(edge.sum() + res.reactions.sum() - total) <= 1e-8 * total"""),
+    assert abs(edge.sum() + res.reactions.sum() - total) <= 1e-7 * total   # to the solver's tolerance"""),
+md("""## The optimality condition: −∇Π in the normal cone
+
+The normal cone of the quadrant at z is the set of directions that point out of it there:
+v with vᵢ ≤ 0 where zᵢ = 0 (a post in contact) and vᵢ = 0 where zᵢ > 0 (a gap open). z is
+optimal exactly when −∇Π(z) = −(M z + q) lies in it; the components of ∇Π are the reactions,
+so this is R ≥ 0 on the posts in contact and R = 0 on the others. A descent direction that
+points out of the quadrant cannot be followed: the posts stop it, and the force they need is
+the multiplier."""),
+code("""def in_normal_cone(v, z, tol=1e-9 * np.abs(r).max()):
+    \"\"\"True if v is in the normal cone of {z >= 0} at z.\"\"\"
+    return bool(np.all(np.where(z > 0, np.abs(v) <= tol, v <= tol)))
+
+for name, (g0, z, R) in results.items():
+    grad = M @ z + q_of(g0)
+    print(f"{name:20s} ∇Π = {np.round(grad, 4)} N = R;  −∇Π in the normal cone: {in_normal_cone(-grad, z)}")
+    assert np.allclose(grad, R, rtol=0, atol=1e-9 * np.abs(r).max()) and in_normal_cone(-grad, z)
+    # any other point of the quadrant fails the test (e.g. the corner when a gap is open)
+    if np.any(z > 0):
+        assert not in_normal_cone(-q_of(g0), np.zeros(2))"""),
 md("""## The picture
 
 In each panel: the feasible quadrant (white; shaded where z < 0, penetration), the energy's
@@ -600,7 +627,7 @@ for ax, (name, (g0, z, R)) in zip(axes.ravel(), results.items()):
     ax.fill_between([lo[0], hi[0]], lo[1], 0, color="C3", alpha=0.08, lw=0)   # z2 < 0
     ax.fill_betweenx([lo[1], hi[1]], lo[0], 0, color="C3", alpha=0.08, lw=0)  # z1 < 0
     ax.axhline(0, color="k", lw=0.8); ax.axvline(0, color="k", lw=0.8)
-    # the normal cone of {z >= 0} at z: v_i <= 0 where z_i = 0, v_i = 0 where z_i > 0
+    # the normal cone at z (see in_normal_cone): the quarter-plane at the corner, a ray on a face
     zmm, big = z * 1e3, 3 * (hi - lo).max()
     touch = z <= 0
     if touch.all():
@@ -612,8 +639,8 @@ for ax, (name, (g0, z, R)) in zip(axes.ravel(), results.items()):
     scale = 0.3 * (hi - lo).max() / np.abs(r).max()              # mm per N
     if np.abs(R).max() > 0:
         ax.annotate("", xy=zmm - scale * R, xytext=zmm, arrowprops=dict(arrowstyle="-|>", color="C2", lw=1.5))
-        ax.text(*(zmm - scale * R), f"  −∇Π = −R\\n  R = ({R[0]:.2f}, {R[1]:.2f}) N", fontsize=7, color="C2",
-                va="top")
+        ax.annotate(f"R = ({R[0]:.0f}, {R[1]:.0f}) N", zmm, xytext=(6, 6), textcoords="offset points", fontsize=8,
+                    color="C2", bbox=dict(fc="w", ec="none", alpha=0.8))
     ax.plot(*(zs * 1e3), "kx", ms=8)
     ax.plot(*zmm, "o", color="C0", ms=7)
     ax.set_xlim(lo[0], hi[0]); ax.set_ylim(lo[1], hi[1]); ax.set_aspect("equal")
@@ -624,8 +651,9 @@ handles = [plt.Line2D([], [], color="0.6", lw=0.7, label="level sets of Π"),
            plt.Line2D([], [], color="k", marker="x", ls="", label="unconstrained minimum z*"),
            plt.Line2D([], [], color="C0", marker="o", ls="", label="optimum"),
            plt.Rectangle((0, 0), 1, 1, color="C2", alpha=0.3, label="normal cone at the optimum"),
+           plt.Line2D([], [], color="C2", marker=">", lw=1.5, label="−∇Π = −R (scaled)"),
            plt.Rectangle((0, 0), 1, 1, color="C3", alpha=0.1, label="z < 0: penetration")]
-fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=8)
+fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8)
 fig.tight_layout(rect=(0, 0.07, 1, 1))
 plt.show()"""),
 md("""**What the picture says.**
@@ -897,8 +925,8 @@ assert np.allclose(M_pq, S, rtol=0, atol=1e-10 * np.abs(S).max())
 assert np.allclose(q_pq, r - S @ g0, rtol=0, atol=1e-10 * np.abs(q_pq).max())"""),
 md("""## 3. Symmetric, positive definite, and what the entries mean
 
-* S is symmetric because K is, and positive definite because the held plate (K_oo with the
-  edges) cannot move without straining: a Cholesky factorisation of S succeeds.
+* S is symmetric because K is, and positive definite because K is (the simply supported
+  edges hold the plate: no motion is free of strain): a Cholesky factorisation of S succeeds.
 * **Sᵢⱼ** (a stiffness): the force at post i when post j is pushed down by a unit deflection and
   every other post is held at zero. Sⱼⱼ > 0; the nearest posts must pull down to stay put
   (negative entries), a far one may have to push (S₁₅ > 0 here: the plate bends back up
@@ -963,20 +991,23 @@ u = np.zeros(K.shape[0])
 u[c] = g0 - z
 u[o] = sla.cho_solve(chol, f[o] - K_oc @ u[c])
 for i, (p, gi, zi, Ri) in enumerate(zip(posts, g0, z, R)):
-    print(f"post {i + 1} at {p}: settled {gi * 1e3:.1f} mm, gap left {zi * 1e3:.4f} mm, R = {Ri:9.3f} N")
-
-# the KKT conditions of the full plate, by hand
+    print(f"post {i + 1} at {p}: settled {gi * 1e3:.1f} mm, gap left {zi * 1e3:.4f} mm, R = {Ri:9.3f} N")"""),
+md("""The KKT conditions of the whole plate, by hand: the recovered u with these reactions is in
+equilibrium, and gaps and reactions are non-negative and complementary."""),
+code("""# the KKT conditions of the full plate, by hand
 stat = np.abs(K @ u - f + B.T @ R).max() / np.abs(f).max()
 print(f"stationarity |K u − f + Bᵀ R| / |f| = {stat:.1e}")
-assert stat < 1e-10 and z.min() >= 0 and R.min() >= 0 and np.abs(z * R).max() < 1e-12 * np.abs(q).max()
-
-# against plateqp's primal formulation (no condensation at all) and statics
+assert stat < 1e-10 and z.min() >= 0 and R.min() >= 0 and np.abs(z * R).max() < 1e-12 * np.abs(q).max()"""),
+md("""And against plateqp: its `lemke` backend on its own condensed form, its `pdas` backend on the
+primal form (no condensation at all), and statics (edges plus posts carry the load)."""),
+code("""mine = pq.solve(scene, backend="lemke", formulation="condensed", accuracy="high")
 ref = pq.solve(scene, backend="pdas", formulation="primal", accuracy="high")
+np.testing.assert_allclose(R, mine.reactions, rtol=0, atol=1e-9 * np.abs(R).max())
 np.testing.assert_allclose(R, ref.reactions, rtol=0, atol=1e-8 * np.abs(R).max())
 edge = -(model.K_full @ ref.u - model.f_full)[model.fixed]  # the edges' reactions
 total = 5000.0 * plate.a * plate.b + 2000.0
-print(f"primal agrees; statics: edges {edge.sum():.3f} N + posts {R.sum():.3f} N = {total:.1f} N")
-assert abs(edge.sum() + R.sum() - total) <= 1e-9 * total"""),
+print(f"lemke and primal agree; statics: edges {edge.sum():.3f} N + posts {R.sum():.3f} N = {total:.1f} N")
+assert abs(edge.sum() + R.sum() - total) <= 1e-8 * total     # edges from the primal solve: to its tolerance"""),
 md("""## The picture: a flexibility column, and the matrices
 
 Left: the plate's deflection under a unit force at post 1 alone (only the edges holding it),
