@@ -753,7 +753,8 @@ assert np.all(p[~on] < 0)                                              # the pos
 md("""## The error against k, and the condition number
 
 For every k: the reaction error against the exact QP, and the condition number of the matrix
-the penalty method factorises (numpy's 2-norm condition number, K is small here). Two
+the penalty method factorises, K + k B_Aᵀ B_A with A the posts in contact (numpy's 2-norm
+condition number; K is small here). Two
 straight lines on a log-log plot are the whole story:
 
 * the **penalty error** ~ 1/k (the penetration R/k is the error in the gaps);
@@ -796,7 +797,7 @@ assert np.all((err[big] > rounding[big] / 20) & (err[big] < 20 * rounding[big]))
 bx.loglog(kD, cond, "o-", ms=4, color="C1")
 bx.loglog(kD, 1 / eps * np.ones_like(kD), "k:", lw=0.8)
 bx.text(kD[0], 1.5 / eps, "1/ε", fontsize=8)
-bx.set_xlabel("k  [D / L²]"); bx.set_ylabel("cond(K + k BᵀB)")
+bx.set_xlabel("k  [D / L²]"); bx.set_ylabel("cond(K + k B_Aᵀ B_A), A in contact")
 fig.tight_layout()
 plt.show()"""),
 md("""No k gives the exact answer, and the best k is a compromise found only by knowing the exact
@@ -900,8 +901,8 @@ md("""## 1–2. Partition and eliminate
 
 The posts sit on mesh nodes, so each row of B picks one deflection dof: those are c. For the
 others, the equilibrium rows K_oo u_o + K_oc u_c = f_o give u_o for any u_c; put back into
-the rows of c this leaves S u_c = r + (forces at the posts). One dense Cholesky factorisation
-of K_oo does it."""),
+the rows of c this leaves S u_c = r − R, R the posts' (upward) reactions. One dense Cholesky
+factorisation of K_oo does it."""),
 code("""c = np.argmax(np.abs(B), axis=1)                            # the contact dofs, in post order
 o = np.setdiff1d(np.arange(K.shape[0]), c)
 K_oo, K_oc, K_cc = K[np.ix_(o, o)], K[np.ix_(o, c)], K[np.ix_(c, c)]
@@ -947,6 +948,7 @@ print("eigenvalues of S [kN/mm]:", (np.linalg.eigvalsh(S) / 1e6).round(3))
 print(f"asymmetry of S: {np.abs(S - S.T).max() / np.abs(S).max():.1e}")
 assert np.all(np.linalg.eigvalsh(S) > 0) and np.allclose(S, S.T, rtol=0, atol=1e-12 * np.abs(S).max())
 assert np.all(np.diag(S) > 0) and np.all(S[2, [0, 1, 3, 4]] < 0)    # the centre post's neighbours pull
+assert S[0, 4] > 0                                                  # the far corner post pushes
 
 G = B @ np.linalg.solve(K, B.T)                             # m/N: unit forces at the posts
 G_dual = formulate(data, "dual").lcp.M * data.W / data.F0
