@@ -15,7 +15,6 @@ import pytest
 
 import plateqp as pq
 from plateqp.assembly import build_model
-from plateqp.studies import convergence
 
 pytest.importorskip("gmsh")
 
@@ -187,17 +186,6 @@ def test_moments_and_slopes_of_the_clamped_circular_plate():
     assert wx == pytest.approx(slope(0.5 * R, 0.0)[0], rel=0.005) and abs(wy) < 0.005 * abs(wx)
     node = res.model.grid.nodes[np.argmin(np.hypot(*(res.model.grid.nodes - [0.4, 0.3]).T))]
     assert np.allclose(res.slopes(*node), slope(*node), rtol=0.01)  # at a node: its own slope dofs
-
-
-@pytest.mark.parametrize("call, words", [
-    (lambda r: convergence(r.scene), "convergence"),
-    (lambda r: pq.solve(disc("simple", size=R / 4, supports=posts([0.0])), accuracy="auto"), "convergence"),
-], ids=["convergence", "auto-accuracy"])
-def test_not_yet_on_triangles_is_one_clear_line(call, words):
-    res = pq.solve(disc("clamped", size=R / 4))
-    with pytest.raises(pq.PlateQPError, match="not yet available on triangle meshes") as info:
-        call(res)
-    assert words in str(info.value) and "\n" not in str(info.value)
 
 
 def test_export_not_yet_on_triangles():
