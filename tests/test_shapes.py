@@ -188,13 +188,6 @@ def test_moments_and_slopes_of_the_clamped_circular_plate():
     assert np.allclose(res.slopes(*node), slope(*node), rtol=0.01)  # at a node: its own slope dofs
 
 
-def test_export_not_yet_on_triangles():
-    from plateqp.io.export import contact_qp
-
-    with pytest.raises(pq.ProblemError, match="export is not yet available on triangle meshes"):
-        contact_qp(disc("simple", size=R / 4, supports=posts([0.0])))
-
-
 def annulus_w(r, a, b, q, Dp, nu, kind):
     """Deflection of an annular plate (radii b < a) under uniform q with both edges clamped or both
     simply supported: the general axisymmetric solution w = A + B r² + C ln r + E r² ln r + q r⁴/64D
