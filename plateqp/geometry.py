@@ -223,15 +223,17 @@ def _disjoint(s: Shape, t: Shape) -> bool:
     return not (t.contains(*s.xy[0])[0] or s.contains(*t.xy[0])[0])
 
 
-def check_holes(outer: Shape, holes: list[Shape], fail: Fail) -> None:
-    """Every hole strictly inside the plate; no two holes overlapping or touching."""
+def check_holes(outer: Shape, holes: list[Shape], fail: Fail, names: list[str] | None = None) -> None:
+    """Every hole strictly inside the plate; no two holes overlapping or touching. ``names``:
+    each hole's field (default ``holes.I``)."""
+    names = names or [f"holes.{i}" for i in range(len(holes))]
     for i, h in enumerate(holes):
         if not _inside_strictly(h, outer):
-            fail(f"holes.{i}", "the hole is not inside the plate: it lies outside it, crosses or touches its boundary")
+            fail(names[i], "the hole is not inside the plate: it lies outside it, crosses or touches its boundary")
     for i, h in enumerate(holes):
         for j in range(i):
             if not _disjoint(h, holes[j]):
-                fail(f"holes.{i}", f"overlaps or touches holes.{j}; merge them into one hole or move them apart")
+                fail(names[i], f"overlaps or touches {names[j]}; merge them into one hole or move them apart")
 
 
 @dataclass(frozen=True)
@@ -269,13 +271,16 @@ TRI_ELEMENTS = ("dkt",)
 
 
 def scene_domain(scene) -> Domain:
-    """The Domain of a triangle-meshed scene: its shape (or the rectangle [0, a] × [0, b]) less its holes."""
+    """The Domain of a triangle-meshed scene: its shape (or the rectangle [0, a] × [0, b]) less its
+    holes, then its openings (each the rectangle [x0, x1] × [y0, y1] cut out exactly: holes
+    numbered after the ``[[holes]]``)."""
     def fail(where, what):
         scene._fail(where, what)
 
     p = scene.plate
     outer = parse_shape(p.shape, "plate.shape", fail) if p.shape is not None else rectangle(p.a, p.b)
     holes = tuple(parse_shape(h, f"holes.{i}", fail) for i, h in enumerate(scene.holes))
+    holes += tuple(Polygon(((o.x0, o.y0), (o.x1, o.y0), (o.x1, o.y1), (o.x0, o.y1))) for o in scene.openings)
     return Domain(outer, holes)
 
 
@@ -311,8 +316,8 @@ class Region:
 
 def validate_shaped(scene) -> Region:
     """The shape-specific checks of a scene with ``mesh.element`` a triangle element: the shape,
-    the holes, the edge names (:func:`edge_table`), the mesh
-    size, and what triangle meshes do not carry yet. Returns the Region for the point checks."""
+    the holes and openings, the edge names (:func:`edge_table`) and the mesh size. Returns the
+    Region for the point checks."""
     p, m = scene.plate, scene.mesh
     fail = scene._fail
     domain = scene_domain(scene)
@@ -320,7 +325,8 @@ def validate_shaped(scene) -> Region:
     if p.shape is not None:
         p.shape = domain.outer.to_dict() if isinstance(p.shape, (Polygon, Circle)) else p.shape
     scene.holes = [h.to_dict() if isinstance(h, (Polygon, Circle)) else h for h in scene.holes]
-    check_holes(domain.outer, list(domain.holes), fail)
+    check_holes(domain.outer, list(domain.holes), fail,
+                [f"holes.{i}" for i in range(len(scene.holes))] + [f"openings.{i}" for i in range(len(scene.openings))])
     if p.shape is not None:
         x0, x1, y0, y1 = domain.outer.bbox
         p.a, p.b = x1 - x0, y1 - y0  # the length scales of a shaped plate: its bounding box
@@ -335,11 +341,6 @@ def validate_shaped(scene) -> Region:
         n = domain.area / (0.433 * m.size**2)
         if n > 1e7:
             fail("mesh.size", f"{m.size!r} would make about {n:.1g} triangles, more than any plate needs")
-    if scene.openings:
-        fail("openings", "cut-outs of whole cells are for rectangle meshes; on a triangle mesh use [[holes]]")
-    for i, ld in enumerate(scene.loads):
-        if getattr(ld, "type", None) == "patch":
-            fail(f"loads.{i}", "a patch load is not yet available on triangle meshes (mesh.element = \"dkt\")")
     return Region(domain, mesh_size(scene))
 
 
@@ -348,6 +349,52 @@ def mesh_size(scene) -> float:
     one the larger cell side of its nx × ny grid."""
     m, p = scene.mesh, scene.plate
     return float(m.size) if m.size is not None else max(p.a / m.nx, p.b / m.ny)
+
+
+def clip_to_box(tris: np.ndarray, box) -> tuple[np.ndarray, np.ndarray]:
+    """Area and centroid of each triangle's part in the box [x0, x1] × [y0, y1].
+
+    ``tris``: (nt, 3, 2) vertices. Returns ((nt,) areas, (nt, 2) centroids; a triangle outside the
+    box has area 0 and its own centroid). Exact (Sutherland–Hodgman clipping of the triangle by
+    the box's four half-planes, then the polygon's area and centroid): a triangle wholly inside
+    keeps its area; only the triangles the box's outline cuts are clipped one by one.
+    """
+    x0, x1, y0, y1 = (float(v) for v in box)
+    tris = np.asarray(tris, dtype=float)
+    lo, hi = tris.min(axis=1), tris.max(axis=1)
+    p = tris
+    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                        - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    cent = p.mean(axis=1)
+    inside = (lo[:, 0] >= x0) & (hi[:, 0] <= x1) & (lo[:, 1] >= y0) & (hi[:, 1] <= y1)
+    outside = (hi[:, 0] <= x0) | (lo[:, 0] >= x1) | (hi[:, 1] <= y0) | (lo[:, 1] >= y1)
+    out_a = np.where(inside, area, 0.0)
+    out_c = cent.copy()
+    planes = ((0, x0, 1.0), (0, x1, -1.0), (1, y0, 1.0), (1, y1, -1.0))  # keep sign·(coord − value) ≥ 0
+    for t in np.flatnonzero(~inside & ~outside):
+        poly = [tuple(v) for v in tris[t]]
+        for axis, value, sign in planes:
+            new = []
+            for k, cur in enumerate(poly):
+                prev = poly[k - 1]
+                dc, dp = sign * (cur[axis] - value), sign * (prev[axis] - value)
+                if (dc >= 0) != (dp >= 0):  # the edge crosses the plane: its crossing point
+                    f = dp / (dp - dc)
+                    new.append((prev[0] + f * (cur[0] - prev[0]), prev[1] + f * (cur[1] - prev[1])))
+                if dc >= 0:
+                    new.append(cur)
+            poly = new
+            if not poly:
+                break
+        if len(poly) >= 3:
+            q = np.array(poly)
+            xs, ys = q[:, 0], q[:, 1]
+            cr = xs * np.roll(ys, -1) - np.roll(xs, -1) * ys
+            a2 = cr.sum()
+            if abs(a2) > 0.0:
+                out_a[t] = 0.5 * abs(a2)
+                out_c[t] = [((xs + np.roll(xs, -1)) * cr).sum() / (3 * a2), ((ys + np.roll(ys, -1)) * cr).sum() / (3 * a2)]
+    return out_a, out_c
 
 
 def mesh_cells(scene) -> tuple[int, int]:

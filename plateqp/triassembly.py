@@ -26,8 +26,8 @@ from scipy.sparse.csgraph import connected_components
 from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
 from .elements.dkt import DKT
 from .errors import ResourceError, SceneError
-from .geometry import edge_table, mesh_size, scene_domain
-from .scene import PointLoad, Scene, UniformLoad
+from .geometry import clip_to_box, edge_table, mesh_size, scene_domain
+from .scene import PatchLoad, PointLoad, Scene, UniformLoad
 from .trimesh import TriMesh, estimate_nodes, mesh_domain
 
 @dataclass
@@ -85,6 +85,21 @@ class TriModel(Model):
         return A
 
 
+def patch_weights(mesh: TriMesh, box) -> np.ndarray:
+    """(n_nodes,) each node's share of a unit pressure on the box [x0, x1] × [y0, y1]: over each
+    triangle's part A_t in the box, ∫ λ_i dA = |A_t| λ_i(centroid of A_t) (λ the triangle's
+    barycentric coordinates). The uniform load's lumping (area / 3 per vertex) where the box
+    covers a triangle; statically exact everywhere: the total is the area of the box on the
+    mesh, and the moment that of the pressure on it."""
+    from .trimesh import _barycentric
+
+    xy = mesh.nodes[mesh.triangles]
+    area, cent = clip_to_box(xy, box)
+    hit = np.flatnonzero(area > 0.0)
+    lam = _barycentric(xy[hit], cent[hit, 0], cent[hit, 1])
+    return np.bincount(mesh.triangles[hit].ravel(), weights=(area[hit, None] * lam).ravel(), minlength=mesh.n_nodes)
+
+
 def check_memory_tri(scene: Scene, h: float) -> None:
     """ResourceError before meshing if the triangle mesh would need more memory than allowed."""
     need = BYTES_PER_DOF * 3 * estimate_nodes(scene)
@@ -121,6 +136,8 @@ def build_tri_model(scene: Scene) -> TriModel:
             f_full += np.bincount(cell_dofs.ravel(), weights=(ld.q * el.load(xy)).ravel(), minlength=n_full)
         elif isinstance(ld, PointLoad):
             f_full += ld.P * np.asarray(model.interpolation(ld.x, ld.y).todense()).ravel()
+        elif isinstance(ld, PatchLoad):
+            f_full[0::3] += ld.q * patch_weights(mesh, (ld.x0, ld.x1, ld.y0, ld.y1))
     fixed, values = _prescribed(scene, mesh)
     free = np.setdiff1d(np.arange(n_full), fixed)
     u_c = np.zeros(n_full)

@@ -1,7 +1,7 @@
 r"""The contact problem of a scene exactly as plateqp's backends get it, in standard QP form.
 
-The problem exported (:func:`contact_qp`; rectangle grids and triangle meshes alike) is the nondimensional data of
-:class:`plateqp.contact.scaling.Scaled` (deflections by W, forces by F0, lengths by L),
+The problem exported (:func:`contact_qp`; rectangle grids and triangle meshes alike) is the
+nondimensional data of :class:`plateqp.contact.scaling.Scaled` (deflections by W, forces by F0, lengths by L),
 formulated as ``primal``, ``condensed`` or ``dual`` and taken in its QP form (the condensed and
 dual LCPs as the bound-constrained QPs ½ zᵀMz + qᵀz, z ≥ 0). The scales and the variables'
 names travel with it (:attr:`ExportedQP.meta`; the writers put them in QPS comment lines and
