@@ -397,6 +397,49 @@ def clip_to_box(tris: np.ndarray, box) -> tuple[np.ndarray, np.ndarray]:
     return out_a, out_c
 
 
+def _crossings(shape: Shape, p: np.ndarray, q: np.ndarray) -> list[float]:
+    """Parameters t in (0, 1) where the segment p + t (q − p) meets the boundary of ``shape``."""
+    d = q - p
+    out = []
+    if isinstance(shape, Circle):
+        f = p - (shape.xc, shape.yc)
+        a, b, c = d @ d, 2 * f @ d, f @ f - shape.r**2
+        disc = b * b - 4 * a * c
+        if disc > 0:
+            out += [(-b - math.sqrt(disc)) / (2 * a), (-b + math.sqrt(disc)) / (2 * a)]
+        return out
+    for s0, s1 in shape.segments():
+        e = s1 - s0
+        den = d[0] * e[1] - d[1] * e[0]
+        if abs(den) > 1e-14 * math.sqrt((d @ d) * (e @ e)):
+            w = s0 - p
+            t, u = (w[0] * e[1] - w[1] * e[0]) / den, (w[0] * d[1] - w[1] * d[0]) / den
+            if -1e-12 <= u <= 1 + 1e-12:
+                out.append(t)
+        else:  # parallel: the ends of a collinear overlap
+            out += [float((s0 - p) @ d / (d @ d)), float((s1 - p) @ d / (d @ d))]
+    return out
+
+
+def inner_segments(domain: Domain, outline: np.ndarray) -> list[tuple[tuple[float, float], tuple[float, float]]]:
+    """The pieces of a closed polygonal outline ((n, 2) vertices) that run strictly inside the
+    plate (off its boundaries: the outer one and the holes'), as segments: the lines a mesh must
+    follow for a region's edge to lie on element edges."""
+    out = []
+    tol = 1e-9 * domain.size
+    shapes = (domain.outer, *domain.holes)
+    for p, q in zip(outline, np.roll(outline, -1, axis=0)):
+        ts = sorted({0.0, 1.0, *(t for sh in shapes for t in _crossings(sh, p, q) if 0.0 < t < 1.0)})
+        for t0, t1 in zip(ts[:-1], ts[1:]):
+            if (t1 - t0) * np.hypot(*(q - p)) <= tol:
+                continue
+            m = p + 0.5 * (t0 + t1) * (q - p)
+            if domain.covers(*m)[0] and min(sh.distance(*m)[0] for sh in shapes) > tol:
+                a, b = p + t0 * (q - p), p + t1 * (q - p)
+                out.append(((float(a[0]), float(a[1])), (float(b[0]), float(b[1]))))
+    return out
+
+
 def mesh_cells(scene) -> tuple[int, int]:
     """The mesh of a scene as the studies by mesh halving count it: (nx, ny) of a grid; on
     triangles (n, n) with n = L / h rounded, L the plate's larger bounding-box side and h the

@@ -26,7 +26,7 @@ from scipy.sparse.csgraph import connected_components
 from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
 from .elements.dkt import DKT
 from .errors import ResourceError, SceneError
-from .geometry import clip_to_box, edge_table, mesh_size, scene_domain
+from .geometry import clip_to_box, edge_table, inner_segments, mesh_size, scene_domain
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
 from .trimesh import TriMesh, estimate_nodes, mesh_domain
 
@@ -40,18 +40,18 @@ class TriModel(Model):
 
     def bed_areas(self) -> np.ndarray:
         """(n_nodes,) each node's tributary area of the scene's tensionless bed: a third of every
-        triangle whose centroid lies in the bed's region (the whole plate without one)."""
+        triangle (the whole plate), or of each triangle's part in the bed's region, weighted as
+        a patch load is (:func:`patch_weights`). The region's outline is a line of the mesh
+        (:func:`bed_lines`), so the region is a union of whole triangles and the areas sum to
+        its area on the plate exactly."""
         mesh: TriMesh = self.grid
-        c = mesh.nodes[mesh.triangles].mean(axis=1)
-        inside = np.ones(len(c), dtype=bool)
-        if self.scene.foundation.region is not None:
-            x0, x1, y0, y1 = self.scene.foundation.region
-            inside = (c[:, 0] >= x0) & (c[:, 0] <= x1) & (c[:, 1] >= y0) & (c[:, 1] <= y1)
-        if not inside.any():
-            raise SceneError(f"foundation.region: {self.scene.foundation.region} holds the centroid of no triangle "
-                             "of the mesh; make it larger than mesh.size")
-        return np.bincount(mesh.triangles[inside].ravel(), weights=np.repeat(mesh.areas()[inside] / 3, 3),
-                           minlength=mesh.n_nodes)
+        region = self.scene.foundation.region
+        if region is None:
+            return np.bincount(mesh.triangles.ravel(), weights=np.repeat(mesh.areas() / 3, 3), minlength=mesh.n_nodes)
+        area = patch_weights(mesh, region)
+        if not area.any():
+            raise SceneError(f"foundation.region: {region} does not overlap the plate's mesh")
+        return area
 
     def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
         """(npts, n_full) sparse operator, from the full dofs, at points: w (the node's w at a node,
@@ -85,6 +85,14 @@ class TriModel(Model):
         return A
 
 
+def bed_lines(scene: Scene, domain) -> list:
+    """The segments of the bed region's outline inside the plate (mesh lines: :func:`mesh_domain`)."""
+    if scene.foundation is None or scene.foundation.region is None:
+        return []
+    x0, x1, y0, y1 = scene.foundation.region
+    return inner_segments(domain, np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float))
+
+
 def patch_weights(mesh: TriMesh, box) -> np.ndarray:
     """(n_nodes,) each node's share of a unit pressure on the box [x0, x1] × [y0, y1]: over each
     triangle's part A_t in the box, ∫ λ_i dA = |A_t| λ_i(centroid of A_t) (λ the triangle's
@@ -116,7 +124,7 @@ def build_tri_model(scene: Scene) -> TriModel:
     check_memory_tri(scene, h)
     points = [(s.x, s.y) for s in scene.supports] + [(ld.x, ld.y) for ld in scene.loads
                                                      if isinstance(ld, PointLoad)] + [(p.x, p.y) for p in scene.pins]
-    mesh = mesh_domain(domain, h, points)
+    mesh = mesh_domain(domain, h, points, bed_lines(scene, domain))
     el = DKT()
     p = scene.plate
     n_full = 3 * mesh.n_nodes
