@@ -3,7 +3,9 @@
 :func:`mesh_domain` meshes a :class:`~plateqp.geometry.Domain` with gmsh's Python API (the
 ``shapes`` extra: ``pip install plateqp[shapes]``): target size h, circles as true arcs (boundary
 nodes lie on the circle), given points (supports, point loads, pins) embedded as mesh nodes with
-the mesh refined around them (size h/4 at the point, growing to h at 2h away).
+the mesh refined around them (size h/4 at the point, growing to h at 2h away), and given line
+segments (a bed region's outline) followed by element edges: the boundary curves are split where
+such a line ends on them, so that the line's end is a point of the boundary.
 
 The mesh is deterministic: gmsh runs on one thread with fixed options (Frontal-Delaunay, no
 random factor changes, no configuration files read), so the same scene gives the same mesh. gmsh
@@ -355,11 +357,15 @@ def _curve_at(domain: Domain, curves_of, curve_geom, x: float, y: float, tol: fl
 
 def _outward_normals(nodes, tris, edges) -> np.ndarray:
     """Unit normals of boundary edges, pointing away from the triangle that holds each edge."""
-    key = {}
-    for t, tri in enumerate(tris):
-        for a, b in ((0, 1), (1, 2), (2, 0)):
-            key[(min(tri[a], tri[b]), max(tri[a], tri[b]))] = tri[3 - a - b]
-    third = np.array([key[(min(i, j), max(i, j))] for i, j in edges])
+    n = len(nodes)
+    ends = [(0, 1, 2), (1, 2, 0), (2, 0, 1)]  # each triangle edge (a, b) and its third vertex
+    a = np.concatenate([tris[:, i] for i, _, _ in ends])
+    b = np.concatenate([tris[:, j] for _, j, _ in ends])
+    opp = np.concatenate([tris[:, k] for _, _, k in ends])
+    key = np.minimum(a, b).astype(np.int64) * n + np.maximum(a, b)
+    order = np.argsort(key, kind="stable")
+    want = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * n + np.maximum(edges[:, 0], edges[:, 1])
+    third = opp[order[np.searchsorted(key[order], want)]]
     d = nodes[edges[:, 1]] - nodes[edges[:, 0]]
     n = np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None]
     inward = nodes[third] - nodes[edges[:, 0]]
