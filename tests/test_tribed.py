@@ -37,8 +37,7 @@ def straddles(model, region) -> int:
     n = 0
     for axis, v in ((0, x0), (0, x1), (1, y0), (1, y1)):
         c = p[:, :, axis]
-        inside_span = np.ones(len(p), dtype=bool)  # the line's extent along the other axis
-        o = p[:, :, 1 - axis].mean(axis=1)
+        o = p[:, :, 1 - axis].mean(axis=1)  # within the line's extent along the other axis
         lo, hi = (y0, y1) if axis == 0 else (x0, x1)
         inside_span = (o > lo) & (o < hi)
         n += int(np.sum(inside_span & (c.min(axis=1) < v - tol) & (c.max(axis=1) > v + tol)))
