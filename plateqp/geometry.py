@@ -351,50 +351,83 @@ def mesh_size(scene) -> float:
     return float(m.size) if m.size is not None else max(p.a / m.nx, p.b / m.ny)
 
 
-def clip_to_box(tris: np.ndarray, box) -> tuple[np.ndarray, np.ndarray]:
-    """Area and centroid of each triangle's part in the box [x0, x1] × [y0, y1].
+def clip_to_polygon(tris: np.ndarray, outline) -> tuple[np.ndarray, np.ndarray]:
+    """Area and centroid of each triangle's part in a simple polygon (``outline``: (n, 2)
+    vertices, either orientation; convex or not).
 
-    ``tris``: (nt, 3, 2) vertices. Returns ((nt,) areas, (nt, 2) centroids; a triangle outside the
-    box has area 0 and its own centroid). Exact (Sutherland–Hodgman clipping of the triangle by
-    the box's four half-planes, then the polygon's area and centroid): a triangle wholly inside
-    keeps its area; only the triangles the box's outline cuts are clipped one by one.
+    ``tris``: (nt, 3, 2) counter-clockwise vertices. Returns ((nt,) areas, (nt, 2) centroids; a
+    triangle outside has area 0 and its own centroid). Exact: a triangle farther from the outline
+    than its own size is wholly in or out (its centroid decides); the others are clipped one by
+    one (Sutherland–Hodgman: the polygon clipped by the triangle's three half-planes, the
+    triangle being convex), then the clipped polygon's area and centroid.
     """
-    x0, x1, y0, y1 = (float(v) for v in box)
     tris = np.asarray(tris, dtype=float)
-    lo, hi = tris.min(axis=1), tris.max(axis=1)
+    poly = Polygon(tuple(map(tuple, np.asarray(outline, dtype=float))))
     p = tris
     area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
                         - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
     cent = p.mean(axis=1)
-    inside = (lo[:, 0] >= x0) & (hi[:, 0] <= x1) & (lo[:, 1] >= y0) & (hi[:, 1] <= y1)
-    outside = (hi[:, 0] <= x0) | (lo[:, 0] >= x1) | (hi[:, 1] <= y0) | (lo[:, 1] >= y1)
-    out_a = np.where(inside, area, 0.0)
+    reach = np.hypot(*(p - cent[:, None]).transpose(2, 0, 1)).max(axis=1)
+    x0, x1, y0, y1 = poly.bbox
+    near_box = (cent[:, 0] >= x0 - reach) & (cent[:, 0] <= x1 + reach) & (cent[:, 1] >= y0 - reach) \
+        & (cent[:, 1] <= y1 + reach)
+    cut = np.zeros(len(p), dtype=bool)
+    cut[near_box] = poly.distance(cent[near_box, 0], cent[near_box, 1]) <= reach[near_box] * (1 + 1e-9)
+    whole = ~cut & poly.contains(cent[:, 0], cent[:, 1])
+    out_a = np.where(whole, area, 0.0)
     out_c = cent.copy()
-    planes = ((0, x0, 1.0), (0, x1, -1.0), (1, y0, 1.0), (1, y1, -1.0))  # keep sign·(coord − value) ≥ 0
-    for t in np.flatnonzero(~inside & ~outside):
-        poly = [tuple(v) for v in tris[t]]
-        for axis, value, sign in planes:
+    subject = [tuple(v) for v in poly.xy]
+    for t in np.flatnonzero(cut):
+        pts = subject
+        for k in range(3):  # keep the left of each counter-clockwise edge a → b
+            a, b = tris[t, k], tris[t, (k + 1) % 3]
+            side = lambda q: (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])  # noqa: E731
             new = []
-            for k, cur in enumerate(poly):
-                prev = poly[k - 1]
-                dc, dp = sign * (cur[axis] - value), sign * (prev[axis] - value)
-                if (dc >= 0) != (dp >= 0):  # the edge crosses the plane: its crossing point
+            for j, cur in enumerate(pts):
+                prev = pts[j - 1]
+                dc, dp = side(cur), side(prev)
+                if (dc >= 0) != (dp >= 0):
                     f = dp / (dp - dc)
                     new.append((prev[0] + f * (cur[0] - prev[0]), prev[1] + f * (cur[1] - prev[1])))
                 if dc >= 0:
                     new.append(cur)
-            poly = new
-            if not poly:
+            pts = new
+            if not pts:
                 break
-        if len(poly) >= 3:
-            q = np.array(poly)
+        if len(pts) >= 3:
+            q = np.array(pts)
             xs, ys = q[:, 0], q[:, 1]
             cr = xs * np.roll(ys, -1) - np.roll(xs, -1) * ys
             a2 = cr.sum()
-            if abs(a2) > 0.0:
-                out_a[t] = 0.5 * abs(a2)
+            if abs(a2) > 1e-12 * area[t]:  # not a sliver of round-off along a shared edge
+                out_a[t] = min(0.5 * abs(a2), area[t])
                 out_c[t] = [((xs + np.roll(xs, -1)) * cr).sum() / (3 * a2), ((ys + np.roll(ys, -1)) * cr).sum() / (3 * a2)]
     return out_a, out_c
+
+
+def box_outline(box) -> np.ndarray:
+    """The counter-clockwise outline (4, 2) of the box [x0, x1, y0, y1]."""
+    x0, x1, y0, y1 = (float(v) for v in box)
+    return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+
+
+def region_outline(region) -> np.ndarray:
+    """The outline of a bed region: a box [x0, x1, y0, y1] or a scene polygon {polygon = [...]}."""
+    if isinstance(region, dict):
+        return np.array(region["polygon"], dtype=float)
+    return box_outline(region)
+
+
+def check_polygon_region(scene, grid) -> None:
+    """A bed region given as a polygon (triangle meshes): a valid polygon that overlaps the plate."""
+    shape = parse_shape(scene.foundation.region, "foundation.region", scene._fail)
+    if not isinstance(shape, Polygon):
+        scene._fail("foundation.region", "must be a box [x0, x1, y0, y1] or { polygon = [[x, y], ...] }")
+    X, Y = np.meshgrid(np.linspace(*shape.bbox[:2], 33), np.linspace(*shape.bbox[2:], 33))
+    keep = shape.contains(X.ravel(), Y.ravel())  # the polygon sampled on a 33 × 33 lattice, and its vertices
+    xs, ys = np.concatenate([X.ravel()[keep], shape.xy[:, 0]]), np.concatenate([Y.ravel()[keep], shape.xy[:, 1]])
+    if not grid.domain.covers(xs, ys).any():
+        scene._fail("foundation.region", "the polygon does not overlap the plate: the bed would have no node")
 
 
 def _crossings(shape: Shape, p: np.ndarray, q: np.ndarray) -> list[float]:

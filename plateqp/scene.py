@@ -155,7 +155,8 @@ class Support:
 
 @dataclass
 class Foundation:
-    """Tensionless elastic bed of modulus k (force/length³) over ``region`` (whole plate if None).
+    """Tensionless elastic bed of modulus k (force/length³) over ``region`` (whole plate if None):
+    the box [x0, x1, y0, y1] or, on a triangle mesh, ``{polygon = [[x, y], ...]}``.
 
     ``gap``: a number, a dict profile (``{profile = "linear", g0, gx, gy}``,
     ``{profile = "trough" | "bump", x, y, radius, depth}``) or, in Python, any callable
@@ -163,7 +164,7 @@ class Foundation:
     """
 
     k: float
-    region: list[float] | None = None
+    region: list[float] | dict | None = None
     gap: float | dict | Callable = 0.0
 
     def gap_at(self, x, y):
@@ -379,9 +380,14 @@ class Scene:
         if self.foundation is not None:
             f = self.foundation
             self._num("foundation.k", f.k, positive=True, physical=True)
-            if f.region is not None:
+            if isinstance(f.region, dict) and self.triangles:  # a polygon region: plateqp.geometry
+                from .geometry import check_polygon_region
+
+                check_polygon_region(self, grid)
+            elif f.region is not None:
                 if not isinstance(f.region, (list, tuple)) or len(f.region) != 4:
-                    self._fail("foundation.region", f"must be [x0, x1, y0, y1] (got {_short(f.region)})")
+                    self._fail("foundation.region", f"must be [x0, x1, y0, y1]" + (" or { polygon = [[x, y], ...] }"
+                               if self.triangles else "") + f" (got {_short(f.region)})")
                 for j, v in enumerate(f.region):
                     self._num(f"foundation.region.{j}", v)
                 x0, x1, y0, y1 = f.region
@@ -535,7 +541,7 @@ class Scene:
                 raise SceneError("foundation.gap: a Python callable cannot be saved to TOML; use a profile")
             fd: dict[str, Any] = {"k": f.k, "gap": f.gap}
             if f.region is not None:
-                fd["region"] = list(f.region)
+                fd["region"] = dict(f.region) if isinstance(f.region, dict) else list(f.region)
             d["foundation"] = fd
         return d
 

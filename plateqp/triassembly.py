@@ -26,7 +26,7 @@ from scipy.sparse.csgraph import connected_components
 from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
 from .elements.dkt import DKT
 from .errors import ResourceError, SceneError
-from .geometry import clip_to_box, edge_table, inner_segments, mesh_size, scene_domain
+from .geometry import clip_to_polygon, edge_table, inner_segments, mesh_size, region_outline, scene_domain
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
 from .trimesh import TriMesh, estimate_nodes, mesh_domain
 
@@ -89,12 +89,12 @@ def bed_lines(scene: Scene, domain) -> list:
     """The segments of the bed region's outline inside the plate (mesh lines: :func:`mesh_domain`)."""
     if scene.foundation is None or scene.foundation.region is None:
         return []
-    x0, x1, y0, y1 = scene.foundation.region
-    return inner_segments(domain, np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float))
+    return inner_segments(domain, region_outline(scene.foundation.region))
 
 
 def patch_weights(mesh: TriMesh, box) -> np.ndarray:
-    """(n_nodes,) each node's share of a unit pressure on the box [x0, x1] × [y0, y1]: over each
+    """(n_nodes,) each node's share of a unit pressure on the box [x0, x1] × [y0, y1] (or a
+    polygon region, :func:`plateqp.geometry.region_outline`): over each
     triangle's part A_t in the box, ∫ λ_i dA = |A_t| λ_i(centroid of A_t) (λ the triangle's
     barycentric coordinates). The uniform load's lumping (area / 3 per vertex) where the box
     covers a triangle; statically exact everywhere: the total is the area of the box on the
@@ -102,7 +102,7 @@ def patch_weights(mesh: TriMesh, box) -> np.ndarray:
     from .trimesh import _barycentric
 
     xy = mesh.nodes[mesh.triangles]
-    area, cent = clip_to_box(xy, box)
+    area, cent = clip_to_polygon(xy, region_outline(box))
     hit = np.flatnonzero(area > 0.0)
     lam = _barycentric(xy[hit], cent[hit, 0], cent[hit, 1])
     return np.bincount(mesh.triangles[hit].ravel(), weights=(area[hit, None] * lam).ravel(), minlength=mesh.n_nodes)

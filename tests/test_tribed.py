@@ -113,3 +113,44 @@ def test_paths_refuse_bad_edge_names(path, words):
                  mesh=pq.MeshSpec(element="dkt", size=0.25), loads=[pq.UniformLoad(1.0)])
     with pytest.raises(pq.SceneError, match=words):
         set_param(L, path, "simple")
+
+
+# -- a bed under a polygon region ------------------------------------------------------------------
+
+L_REGION = [[-0.2, -0.2], [0.7, -0.2], [0.7, 0.3], [0.35, 0.3], [0.35, 0.8], [-0.2, 0.8]]  # over a corner
+
+
+def test_polygon_region_areas_and_outline():
+    """An L-shaped region over the square's corner: the areas sum to its part on the plate
+    (0.7 × 0.3 + 0.35 × 0.5) exactly, and no triangle is cut by it: the triangles whose centroid
+    lies in it (matplotlib's point-in-polygon) have that area too."""
+    from matplotlib.path import Path
+
+    region = {"polygon": L_REGION}
+    sc = bedded(region, supports=[pq.Support(0.9, 0.9)])
+    m = build_model(sc)
+    area = 0.7 * 0.3 + 0.35 * 0.5
+    assert m.bed_areas().sum() == pytest.approx(area, rel=1e-12)
+    g = m.grid
+    inside = Path(np.array(L_REGION)).contains_points(g.nodes[g.triangles].mean(axis=1))
+    assert g.areas()[inside].sum() == pytest.approx(area, rel=1e-12)
+    back = pq.Scene.from_dict(sc.to_dict())
+    assert back.foundation.region == region
+    res = pq.solve(sc)
+    assert res.kkt.ok and res.reactions.sum() == pytest.approx(1.0, rel=1e-8)  # statics
+
+
+@pytest.mark.parametrize("region, words", [
+    ({"polygon": [[2, 2], [3, 2], [3, 3]]}, "does not overlap the plate"),
+    ({"circle": [0.5, 0.5, 0.2]}, "polygon"),
+    ({"polygon": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "self-intersecting"),
+])
+def test_bad_polygon_regions(region, words):
+    with pytest.raises(pq.SceneError, match=f"foundation.region.*{words}"):
+        bedded(region)
+
+
+def test_polygon_region_needs_triangles():
+    with pytest.raises(pq.SceneError, match=r"foundation.region: must be \[x0, x1, y0, y1\] \(got"):
+        pq.Scene(mesh=pq.MeshSpec(8, 8), loads=[pq.UniformLoad(1.0)],
+                 foundation=pq.Foundation(k=1e3, region={"polygon": L_REGION}))
