@@ -15,6 +15,17 @@ Richardson estimate from the two coarser meshes, plateqp.estimate).
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_discretisation.py --families grid_rigid --max-mesh 64
 
 Writes benchmarks/results/discretisation.csv and benchmarks/figures/discretisation-<family>.png.
+
+``--elements``: the elements against each other instead (DKT triangles against the ACM and BFS
+rectangles): Navier's simply supported square under uniform load, w at the centre against the
+double series (0.00406235 q a⁴/D), on meshes of n cells a side (DKT: gmsh triangles of size
+a/n), error and CPU time (``time.process_time``: build = mesh + assembly, solve = the sparse
+factorisation and solve) against the number of free dofs; medians of ``--reps`` runs, the
+elements and meshes interleaved within each run.
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_discretisation.py --elements   # about 3 min
+
+Writes benchmarks/results/discretisation-elements.csv and figures/discretisation-elements.png.
 """
 
 from __future__ import annotations
@@ -78,14 +89,114 @@ def _solve_group(args, out):
     out.put({"rows": rows})
 
 
+def navier_centre(n_terms: int = 401) -> float:
+    """w D / (q a⁴) at the centre of a simply supported square under uniform q: Navier's series
+    16/π⁶ Σ_{m,n odd} (−1)^((m+n)/2−1) / (m n (m² + n²)²) (Timoshenko & Woinowsky-Krieger § 30)."""
+    m = np.arange(1, n_terms + 1, 2, dtype=float)[:, None]
+    k = np.arange(1, n_terms + 1, 2, dtype=float)[None, :]
+    sign = (-1.0) ** ((m - 1) / 2 + (k - 1) / 2)
+    return 16 / np.pi**6 * float(np.sum(sign / (m * k * (m**2 + k**2) ** 2)))
+
+
+def _element_scene(element: str, n: int):
+    import plateqp as pq
+
+    return pq.Scene(name=f"navier-{element}-{n}", plate=pq.Plate(a=1.0, b=1.0, h=0.01, E=1.0e7, nu=0.3),
+                    mesh=pq.MeshSpec(n, n, element, size=1.0 / n if element == "dkt" else None),
+                    edges={k: "simple" for k in ("left", "right", "bottom", "top")}, loads=[pq.UniformLoad(1.0)])
+
+
+def elements_study(meshes, reps: int, out: Path) -> list[dict]:
+    """DKT against ACM and BFS on Navier's square: error and CPU time against dofs (see the docstring)."""
+    import plateqp as pq
+    from plateqp.assembly import build_model
+    from plateqp.solving import solve_two_sided
+
+    ref_coef = navier_centre()
+    elements = ("acm", "bfs", "dkt")
+    times: dict[tuple[str, int], list[tuple[float, float]]] = {(e, n): [] for e in elements for n in meshes}
+    facts: dict[tuple[str, int], tuple[int, float]] = {}
+    build_model(_element_scene("dkt", 4))  # warm-up: imports, gmsh
+    for rep in range(reps):
+        for n in meshes:
+            for el in elements:
+                sc = _element_scene(el, n)
+                t0 = time.process_time()
+                model = build_model(sc)
+                t1 = time.process_time()
+                u, _, _ = solve_two_sided(model)
+                t2 = time.process_time()
+                times[(el, n)].append((t1 - t0, t2 - t1))
+                if rep == 0:
+                    res = pq.solve(sc, model=model)
+                    w = float(res.deflection(0.5, 0.5))
+                    facts[(el, n)] = (model.n_free, w * sc.plate.D / ref_coef - 1.0)
+        print(f"run {rep + 1}/{reps} done", flush=True)
+    rows = []
+    for el in elements:
+        for n in meshes:
+            t = np.array(times[(el, n)])
+            dofs, err = facts[(el, n)]
+            rows.append({"element": el, "mesh": n, "dofs": dofs, "err_w_centre": err,
+                         "build_cpu_s": float(np.median(t[:, 0])), "solve_cpu_s": float(np.median(t[:, 1])),
+                         "total_cpu_s": float(np.median(t.sum(axis=1))), "reps": reps})
+            r = rows[-1]
+            print(f"  {el:4s} {n:4d} dofs {dofs:7d} err {err:+.3e} build {r['build_cpu_s']:.4f} s "
+                  f"solve {r['solve_cpu_s']:.4f} s", flush=True)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    keys = list(rows[0])
+    with open(out, "w", newline="") as fh:
+        wr = csv.DictWriter(fh, keys)
+        wr.writeheader()
+        wr.writerows(rows)
+    _plot_elements(rows, elements)
+    return rows
+
+
+def _plot_elements(rows, elements):
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4.2))
+    for el in elements:
+        r = [x for x in rows if x["element"] == el]
+        d = [x["dofs"] for x in r]
+        a1.loglog(d, [abs(x["err_w_centre"]) for x in r], "o-", label=el.upper())
+        a2.loglog(d, [x["total_cpu_s"] for x in r], "o-", label=el.upper())
+    a1.set_xlabel("free dofs")
+    a1.set_ylabel("|w centre / Navier − 1|")
+    a2.set_xlabel("free dofs")
+    a2.set_ylabel("CPU s (build + solve, median)")
+    for a in (a1, a2):
+        a.legend()
+        a.grid(True, which="both", lw=0.3)
+    fig.suptitle("Simply supported square, uniform load: elements against Navier's series", fontsize=10)
+    fig.tight_layout()
+    (HERE / "figures").mkdir(exist_ok=True)
+    fig.savefig(HERE / "figures" / "discretisation-elements.png", dpi=90)
+    plt.close(fig)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--elements", action="store_true", help="DKT against ACM/BFS on Navier's square (see the docstring)")
+    ap.add_argument("--reps", type=int, default=5, help="--elements: runs per element and mesh (medians)")
     ap.add_argument("--families", default="grid_rigid,grid_elastic,floating,bed")
     ap.add_argument("--max-mesh", type=int, default=128)
     ap.add_argument("--backend", default="clarabel", help="the iterative backend (primal formulation)")
     ap.add_argument("--timeout", type=float, default=300.0, help="seconds per family × mesh × backend")
     ap.add_argument("--out", default=str(HERE / "results" / "discretisation.csv"))
     args = ap.parse_args(argv)
+    if args.elements:
+        meshes = [n for n in (4, 8, 16, 32, 64, 128) if n <= args.max_mesh]
+        out = Path(args.out) if args.out != str(HERE / "results" / "discretisation.csv") \
+            else HERE / "results" / "discretisation-elements.csv"
+        elements_study(meshes, args.reps, out)
+        return 0
     import plateqp as pq
     from plateqp.studies import auto_tolerance
     from plateqp.families import family

@@ -19,6 +19,9 @@ and uses it two ways:
   estimated error of max |w| and of the reactions is below REL, solving each mesh at a solver
   tolerance of a tenth of REL: the coarsest mesh and the loosest setting that reach it.
 
+On triangles a mesh of n cells a side has element size L / n (:func:`plateqp.geometry.mesh_cells`);
+the meshes are not nested, so the change of w is read from max |w| alone.
+
 The quantities are the ones engineers read: the largest deflection max |w|, and the
 reactions (discrete supports: the largest change of any support's reaction, relative to the
 largest reaction; a tensionless bed: the largest bed pressure). The order p defaults to 1.5:
@@ -36,6 +39,7 @@ import numpy as np
 
 from collections.abc import Callable
 
+from .geometry import mesh_cells, size_for_cells
 from .errors import MechanismError, PlateQPWarning, ProblemError, SceneError, SolverError
 from .results import Result
 from .scene import Scene
@@ -71,7 +75,7 @@ class Quantities:
             if sc.foundation is not None:  # pressure = k × compression of the bed
                 p = float(sc.foundation.k * np.asarray(res.compressions)[src == "bed"].max(initial=0.0))
         w = res.w_nodes()
-        return cls((sc.mesh.nx, sc.mesh.ny), float(np.nanmax(np.abs(w))), R, p, w)
+        return cls(mesh_cells(sc), float(np.nanmax(np.abs(w))), R, p, w)
 
 
 def changes(coarse: Quantities, fine: Quantities) -> dict[str, float]:
@@ -84,7 +88,9 @@ def changes(coarse: Quantities, fine: Quantities) -> dict[str, float]:
     """
     out = {"w": _rel(fine.w_max, coarse.w_max), "reactions": 0.0, "bed": 0.0}
     cw, fw = coarse.w_nodes, fine.w_nodes
-    if cw is not None and fw is not None and fw.shape == (2 * cw.shape[0] - 1, 2 * cw.shape[1] - 1):
+    # a grid's nodes are nodes of the grid with half the cells (a triangle mesh's are not: there max |w|)
+    if cw is not None and fw is not None and cw.ndim == fw.ndim == 2 \
+            and fw.shape == (2 * cw.shape[0] - 1, 2 * cw.shape[1] - 1):
         d = np.abs(fw[::2, ::2] - cw)
         out["w"] = max(out["w"], float(np.nanmax(d)) / max(fine.w_max, coarse.w_max, 1e-300))
     if fine.reactions.size and coarse.reactions.size == fine.reactions.size:
@@ -165,9 +171,12 @@ def confirm(est: ErrorEstimate, final: Result, order: float = ORDER) -> ErrorEst
 
 
 def with_mesh(scene: Scene, nx: int, ny: int) -> Scene:
-    if scene.triangles:
-        raise SceneError('convergence by mesh refinement is not yet available on triangle meshes (mesh.element = "dkt")')
+    """A validated copy of ``scene`` on an nx × ny grid; on triangles, of element size
+    h = L / nx (:func:`plateqp.geometry.size_for_cells`; ``mesh.nx`` and ``mesh.ny`` then say n)."""
     sc = copy.deepcopy(scene)
+    if scene.triangles:
+        sc.mesh.size = size_for_cells(scene, int(nx))
+        nx = ny = nx
     sc.mesh.nx, sc.mesh.ny = int(nx), int(ny)
     sc.validate()
     return sc
@@ -191,9 +200,7 @@ def auto_tolerance(scene: Scene, solve: Callable[..., Result], backend: str = "a
     twice (fewer than 4 cells a side), or coarse meshes that cannot be built or solved, give
     (:data:`LOOSEST`, None): on such a mesh the discretisation error dwarfs 1e-3 anyway.
     """
-    if scene.triangles:
-        with_mesh(scene, 1, 1)  # the one-line SceneError: refinement is not yet available on triangles
-    nx, ny = scene.mesh.nx, scene.mesh.ny
+    nx, ny = mesh_cells(scene)
     if min(nx, ny) < 4:
         return LOOSEST, None
     qs = []

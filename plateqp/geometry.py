@@ -223,15 +223,17 @@ def _disjoint(s: Shape, t: Shape) -> bool:
     return not (t.contains(*s.xy[0])[0] or s.contains(*t.xy[0])[0])
 
 
-def check_holes(outer: Shape, holes: list[Shape], fail: Fail) -> None:
-    """Every hole strictly inside the plate; no two holes overlapping or touching."""
+def check_holes(outer: Shape, holes: list[Shape], fail: Fail, names: list[str] | None = None) -> None:
+    """Every hole strictly inside the plate; no two holes overlapping or touching. ``names``:
+    each hole's field (default ``holes.I``)."""
+    names = names or [f"holes.{i}" for i in range(len(holes))]
     for i, h in enumerate(holes):
         if not _inside_strictly(h, outer):
-            fail(f"holes.{i}", "the hole is not inside the plate: it lies outside it, crosses or touches its boundary")
+            fail(names[i], "the hole is not inside the plate: it lies outside it, crosses or touches its boundary")
     for i, h in enumerate(holes):
         for j in range(i):
             if not _disjoint(h, holes[j]):
-                fail(f"holes.{i}", f"overlaps or touches holes.{j}; merge them into one hole or move them apart")
+                fail(names[i], f"overlaps or touches {names[j]}; merge them into one hole or move them apart")
 
 
 @dataclass(frozen=True)
@@ -269,13 +271,16 @@ TRI_ELEMENTS = ("dkt",)
 
 
 def scene_domain(scene) -> Domain:
-    """The Domain of a triangle-meshed scene: its shape (or the rectangle [0, a] × [0, b]) less its holes."""
+    """The Domain of a triangle-meshed scene: its shape (or the rectangle [0, a] × [0, b]) less its
+    holes, then its openings (each the rectangle [x0, x1] × [y0, y1] cut out exactly: holes
+    numbered after the ``[[holes]]``)."""
     def fail(where, what):
         scene._fail(where, what)
 
     p = scene.plate
     outer = parse_shape(p.shape, "plate.shape", fail) if p.shape is not None else rectangle(p.a, p.b)
     holes = tuple(parse_shape(h, f"holes.{i}", fail) for i, h in enumerate(scene.holes))
+    holes += tuple(Polygon(((o.x0, o.y0), (o.x1, o.y0), (o.x1, o.y1), (o.x0, o.y1))) for o in scene.openings)
     return Domain(outer, holes)
 
 
@@ -311,8 +316,8 @@ class Region:
 
 def validate_shaped(scene) -> Region:
     """The shape-specific checks of a scene with ``mesh.element`` a triangle element: the shape,
-    the holes, the edge names (:func:`edge_table`), the mesh
-    size, and what triangle meshes do not carry yet. Returns the Region for the point checks."""
+    the holes and openings, the edge names (:func:`edge_table`) and the mesh size. Returns the
+    Region for the point checks."""
     p, m = scene.plate, scene.mesh
     fail = scene._fail
     domain = scene_domain(scene)
@@ -320,7 +325,8 @@ def validate_shaped(scene) -> Region:
     if p.shape is not None:
         p.shape = domain.outer.to_dict() if isinstance(p.shape, (Polygon, Circle)) else p.shape
     scene.holes = [h.to_dict() if isinstance(h, (Polygon, Circle)) else h for h in scene.holes]
-    check_holes(domain.outer, list(domain.holes), fail)
+    check_holes(domain.outer, list(domain.holes), fail,
+                [f"holes.{i}" for i in range(len(scene.holes))] + [f"openings.{i}" for i in range(len(scene.openings))])
     if p.shape is not None:
         x0, x1, y0, y1 = domain.outer.bbox
         p.a, p.b = x1 - x0, y1 - y0  # the length scales of a shaped plate: its bounding box
@@ -335,11 +341,6 @@ def validate_shaped(scene) -> Region:
         n = domain.area / (0.433 * m.size**2)
         if n > 1e7:
             fail("mesh.size", f"{m.size!r} would make about {n:.1g} triangles, more than any plate needs")
-    if scene.openings:
-        fail("openings", "cut-outs of whole cells are for rectangle meshes; on a triangle mesh use [[holes]]")
-    for i, ld in enumerate(scene.loads):
-        if getattr(ld, "type", None) == "patch":
-            fail(f"loads.{i}", "a patch load is not yet available on triangle meshes (mesh.element = \"dkt\")")
     return Region(domain, mesh_size(scene))
 
 
@@ -348,6 +349,144 @@ def mesh_size(scene) -> float:
     one the larger cell side of its nx × ny grid."""
     m, p = scene.mesh, scene.plate
     return float(m.size) if m.size is not None else max(p.a / m.nx, p.b / m.ny)
+
+
+def clip_to_polygon(tris: np.ndarray, outline) -> tuple[np.ndarray, np.ndarray]:
+    """Area and centroid of each triangle's part in a simple polygon (``outline``: (n, 2)
+    vertices, either orientation; convex or not).
+
+    ``tris``: (nt, 3, 2) counter-clockwise vertices. Returns ((nt,) areas, (nt, 2) centroids; a
+    triangle outside has area 0 and its own centroid). Exact: a triangle farther from the outline
+    than its own size is wholly in or out (its centroid decides); the others are clipped one by
+    one (Sutherland–Hodgman: the polygon clipped by the triangle's three half-planes, the
+    triangle being convex), then the clipped polygon's area and centroid.
+    """
+    tris = np.asarray(tris, dtype=float)
+    poly = Polygon(tuple(map(tuple, np.asarray(outline, dtype=float))))
+    p = tris
+    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                        - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    cent = p.mean(axis=1)
+    reach = np.hypot(*(p - cent[:, None]).transpose(2, 0, 1)).max(axis=1)
+    x0, x1, y0, y1 = poly.bbox
+    near_box = (cent[:, 0] >= x0 - reach) & (cent[:, 0] <= x1 + reach) & (cent[:, 1] >= y0 - reach) \
+        & (cent[:, 1] <= y1 + reach)
+    cut = np.zeros(len(p), dtype=bool)
+    cut[near_box] = poly.distance(cent[near_box, 0], cent[near_box, 1]) <= reach[near_box] * (1 + 1e-9)
+    whole = ~cut & poly.contains(cent[:, 0], cent[:, 1])
+    out_a = np.where(whole, area, 0.0)
+    out_c = cent.copy()
+    subject = [tuple(v) for v in poly.xy]
+    for t in np.flatnonzero(cut):
+        pts = subject
+        for k in range(3):  # keep the left of each counter-clockwise edge a → b
+            a, b = tris[t, k], tris[t, (k + 1) % 3]
+            side = lambda q: (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])  # noqa: E731
+            new = []
+            for j, cur in enumerate(pts):
+                prev = pts[j - 1]
+                dc, dp = side(cur), side(prev)
+                if (dc >= 0) != (dp >= 0):
+                    f = dp / (dp - dc)
+                    new.append((prev[0] + f * (cur[0] - prev[0]), prev[1] + f * (cur[1] - prev[1])))
+                if dc >= 0:
+                    new.append(cur)
+            pts = new
+            if not pts:
+                break
+        if len(pts) >= 3:
+            q = np.array(pts)
+            xs, ys = q[:, 0], q[:, 1]
+            cr = xs * np.roll(ys, -1) - np.roll(xs, -1) * ys
+            a2 = cr.sum()
+            if abs(a2) > 1e-12 * area[t]:  # not a sliver of round-off along a shared edge
+                out_a[t] = min(0.5 * abs(a2), area[t])
+                out_c[t] = [((xs + np.roll(xs, -1)) * cr).sum() / (3 * a2), ((ys + np.roll(ys, -1)) * cr).sum() / (3 * a2)]
+    return out_a, out_c
+
+
+def box_outline(box) -> np.ndarray:
+    """The counter-clockwise outline (4, 2) of the box [x0, x1, y0, y1]."""
+    x0, x1, y0, y1 = (float(v) for v in box)
+    return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+
+
+def region_outline(region) -> np.ndarray:
+    """The outline of a bed region: a box [x0, x1, y0, y1] or a scene polygon {polygon = [...]}."""
+    if isinstance(region, dict):
+        return np.array(region["polygon"], dtype=float)
+    return box_outline(region)
+
+
+def check_polygon_region(scene, grid) -> None:
+    """A bed region given as a polygon (triangle meshes): a valid polygon that overlaps the plate."""
+    shape = parse_shape(scene.foundation.region, "foundation.region", scene._fail)
+    if not isinstance(shape, Polygon):
+        scene._fail("foundation.region", "must be a box [x0, x1, y0, y1] or { polygon = [[x, y], ...] }")
+    X, Y = np.meshgrid(np.linspace(*shape.bbox[:2], 33), np.linspace(*shape.bbox[2:], 33))
+    keep = shape.contains(X.ravel(), Y.ravel())  # the polygon sampled on a 33 × 33 lattice, and its vertices
+    xs, ys = np.concatenate([X.ravel()[keep], shape.xy[:, 0]]), np.concatenate([Y.ravel()[keep], shape.xy[:, 1]])
+    if not grid.domain.covers(xs, ys).any():
+        scene._fail("foundation.region", "the polygon does not overlap the plate: the bed would have no node")
+
+
+def _crossings(shape: Shape, p: np.ndarray, q: np.ndarray) -> list[float]:
+    """Parameters t in (0, 1) where the segment p + t (q − p) meets the boundary of ``shape``."""
+    d = q - p
+    out = []
+    if isinstance(shape, Circle):
+        f = p - (shape.xc, shape.yc)
+        a, b, c = d @ d, 2 * f @ d, f @ f - shape.r**2
+        disc = b * b - 4 * a * c
+        if disc > 0:
+            out += [(-b - math.sqrt(disc)) / (2 * a), (-b + math.sqrt(disc)) / (2 * a)]
+        return out
+    for s0, s1 in shape.segments():
+        e = s1 - s0
+        den = d[0] * e[1] - d[1] * e[0]
+        if abs(den) > 1e-14 * math.sqrt((d @ d) * (e @ e)):
+            w = s0 - p
+            t, u = (w[0] * e[1] - w[1] * e[0]) / den, (w[0] * d[1] - w[1] * d[0]) / den
+            if -1e-12 <= u <= 1 + 1e-12:
+                out.append(t)
+        else:  # parallel: the ends of a collinear overlap
+            out += [float((s0 - p) @ d / (d @ d)), float((s1 - p) @ d / (d @ d))]
+    return out
+
+
+def inner_segments(domain: Domain, outline: np.ndarray) -> list[tuple[tuple[float, float], tuple[float, float]]]:
+    """The pieces of a closed polygonal outline ((n, 2) vertices) that run strictly inside the
+    plate (off its boundaries: the outer one and the holes'), as segments: the lines a mesh must
+    follow for a region's edge to lie on element edges."""
+    out = []
+    tol = 1e-9 * domain.size
+    shapes = (domain.outer, *domain.holes)
+    for p, q in zip(outline, np.roll(outline, -1, axis=0)):
+        ts = sorted({0.0, 1.0, *(t for sh in shapes for t in _crossings(sh, p, q) if 0.0 < t < 1.0)})
+        for t0, t1 in zip(ts[:-1], ts[1:]):
+            if (t1 - t0) * np.hypot(*(q - p)) <= tol:
+                continue
+            m = p + 0.5 * (t0 + t1) * (q - p)
+            if domain.covers(*m)[0] and min(sh.distance(*m)[0] for sh in shapes) > tol:
+                a, b = p + t0 * (q - p), p + t1 * (q - p)
+                out.append(((float(a[0]), float(a[1])), (float(b[0]), float(b[1]))))
+    return out
+
+
+def mesh_cells(scene) -> tuple[int, int]:
+    """The mesh of a scene as the studies by mesh halving count it: (nx, ny) of a grid; on
+    triangles (n, n) with n = L / h rounded, L the plate's larger bounding-box side and h the
+    element size (halving h doubles n)."""
+    if not scene.triangles:
+        return scene.mesh.nx, scene.mesh.ny
+    n = max(1, round(scene_domain(scene).size / mesh_size(scene)))
+    return n, n
+
+
+def size_for_cells(scene, n: int) -> float:
+    """The element size h = L / n of a triangle-meshed scene's mesh of ``n`` cells a side
+    (:func:`mesh_cells`)."""
+    return scene_domain(scene).size / n
 
 
 def tidy_dict(scene, d: dict) -> None:

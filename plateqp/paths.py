@@ -2,7 +2,8 @@
 
 A PATH names a scene field with dots: ``plate.h``, ``mesh.nx``, ``loads.0.P``,
 ``supports.3.gap``, ``supports.*.stiffness`` (``*``: every item of a list), ``foundation.k``,
-``edges.left`` (``"free"``, ``"simple"``, ``"clamped"``). :func:`get_param` reads one,
+``edges.left`` (``"free"``, ``"simple"``, ``"clamped"``; on a triangle mesh also ``edges.all``,
+``edges.outer``, ``edges.outer_I-J``, ``edges.holeK``: :mod:`plateqp.geometry`). :func:`get_param` reads one,
 :func:`set_param` returns a validated deep copy with it changed. A support stiffness accepts
 ``"rigid"`` (also ``math.inf`` or ``"inf"``, stored as ``"rigid"``): the paper's stiffness study
 starts from c = ∞. A bad path or value is a :class:`~plateqp.errors.SceneError` that names the
@@ -20,6 +21,7 @@ from dataclasses import fields, is_dataclass
 import numpy as np
 
 from .errors import SceneError
+from .geometry import EDGE_KEY
 from .scene import EDGE_NAMES, Edge, Scene
 
 _TOP = ("name", "plate", "mesh", "edges", "openings", "pins", "loads", "supports", "foundation")
@@ -67,8 +69,9 @@ def _walk(obj, parts: list[str], where: str, create: bool):
                 yield obj, k, sub
         return
     if isinstance(obj, dict):  # edges
-        if key not in EDGE_NAMES:
-            raise SceneError(f"{here}: unknown edge; edges are {', '.join(EDGE_NAMES)}")
+        if key not in EDGE_NAMES and key != "all" and EDGE_KEY.match(key) is None:
+            raise SceneError(f"{here}: unknown edge; edges are {', '.join(EDGE_NAMES)} (on a triangle mesh also "
+                             "all, outer, outer_I, outer_I-J, holeK, holeK_I, holeK_I-J)")
         if key not in obj and create:
             obj[key] = Edge("free")
         if rest:

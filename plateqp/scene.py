@@ -155,7 +155,8 @@ class Support:
 
 @dataclass
 class Foundation:
-    """Tensionless elastic bed of modulus k (force/length³) over ``region`` (whole plate if None).
+    """Tensionless elastic bed of modulus k (force/length³) over ``region`` (whole plate if None):
+    the box [x0, x1, y0, y1] or, on a triangle mesh, ``{polygon = [[x, y], ...]}``.
 
     ``gap``: a number, a dict profile (``{profile = "linear", g0, gx, gy}``,
     ``{profile = "trough" | "bump", x, y, radius, depth}``) or, in Python, any callable
@@ -163,7 +164,7 @@ class Foundation:
     """
 
     k: float
-    region: list[float] | None = None
+    region: list[float] | dict | None = None
     gap: float | dict | Callable = 0.0
 
     def gap_at(self, x, y):
@@ -354,7 +355,7 @@ class Scene:
                     self._num(f"{where}.{k}", getattr(ld, k))
                 if not (ld.x0 < ld.x1 and ld.y0 < ld.y1):
                     self._fail(where, "needs x0 < x1 and y0 < y1")
-                if ld.x1 <= 0 or ld.x0 >= p.a or ld.y1 <= 0 or ld.y0 >= p.b:
+                if not self.triangles and (ld.x1 <= 0 or ld.x0 >= p.a or ld.y1 <= 0 or ld.y0 >= p.b):
                     self._fail(where, "the patch does not overlap the plate")
                 if not grid.covers_area(ld.x0, ld.x1, ld.y0, ld.y1):
                     self._fail(where, "the patch lies entirely in an opening (no plate there to load)")
@@ -379,9 +380,14 @@ class Scene:
         if self.foundation is not None:
             f = self.foundation
             self._num("foundation.k", f.k, positive=True, physical=True)
-            if f.region is not None:
+            if isinstance(f.region, dict) and self.triangles:  # a polygon region: plateqp.geometry
+                from .geometry import check_polygon_region
+
+                check_polygon_region(self, grid)
+            elif f.region is not None:
                 if not isinstance(f.region, (list, tuple)) or len(f.region) != 4:
-                    self._fail("foundation.region", f"must be [x0, x1, y0, y1] (got {_short(f.region)})")
+                    self._fail("foundation.region", f"must be [x0, x1, y0, y1]" + (" or { polygon = [[x, y], ...] }"
+                               if self.triangles else "") + f" (got {_short(f.region)})")
                 for j, v in enumerate(f.region):
                     self._num(f"foundation.region.{j}", v)
                 x0, x1, y0, y1 = f.region
@@ -413,39 +419,11 @@ class Scene:
         self._check_scales()
 
     def _check_scales(self) -> None:
-        """The bending stiffness D, the load's deflection scale 0.01 F L²/D and each spring's
-        flexibility relative to the plate's, D/(c L²), must lie in :data:`SAFE_DERIVED`
-        (computed in logarithms)."""
-        p = self.plate
-        lo, hi = math.log10(SAFE_DERIVED[0]), math.log10(SAFE_DERIVED[1])
-        logD = math.log10(p.E) + 3 * math.log10(p.h) - math.log10(12.0 * (1.0 - p.nu**2))
-        if not lo <= logD <= hi:
-            self._fail("plate", f"the bending stiffness D = E h³/12(1 − ν²) = 1e{logD:.0f} is outside "
-                       f"{SAFE_DERIVED[0]:.0e} … {SAFE_DERIVED[1]:.0e}; change units")
-        logL = math.log10(max(p.a, p.b))
-        for i, ld in enumerate(self.loads):
-            mag = abs(ld.P) if isinstance(ld, PointLoad) else abs(ld.q)
-            if mag == 0.0:
-                continue
-            if isinstance(ld, PatchLoad):
-                area = max(min(ld.x1, p.a) - max(ld.x0, 0.0), 1e-300) * max(min(ld.y1, p.b) - max(ld.y0, 0.0), 1e-300)
-                logF = math.log10(mag) + math.log10(area)
-            elif isinstance(ld, UniformLoad):
-                logF = math.log10(mag) + math.log10(p.a) + math.log10(p.b)
-            else:
-                logF = math.log10(mag)
-            logW = -2.0 + logF + 2 * logL - logD
-            if not lo <= logW <= hi:
-                self._fail(f"loads.{i}", f"deflects the plate by about 1e{logW:.0f} (0.01 F L²/D), outside "
-                           f"{SAFE_DERIVED[0]:.0e} … {SAFE_DERIVED[1]:.0e}; change units")
-        springs = [(f"supports.{i}.stiffness", s.stiffness) for i, s in enumerate(self.supports) if not s.rigid]
-        if self.foundation is not None:  # a node's spring is k × its area, about k h² on the finest mesh
-            springs.append(("foundation.k", self.foundation.k * (max(p.a, p.b) / max(self.mesh.nx, self.mesh.ny)) ** 2))
-        for where, c in springs:
-            logr = logD - math.log10(c) - 2 * logL
-            if not lo <= logr <= hi:
-                self._fail(where, f"is 1e{-logr:.0f} times the plate's own stiffness D/L², outside what "
-                           "double precision can weigh against it; make the support rigid, or remove it")
+        """D, each load's deflection scale and each spring's relative flexibility within
+        :data:`SAFE_DERIVED` (:func:`plateqp.scales.check_scales`)."""
+        from .scales import check_scales
+
+        check_scales(self, SAFE_DERIVED)
 
     # -- convenience ----------------------------------------------------------------------
     triangles = property(lambda self: self.mesh.element == "dkt", doc="True if meshed with triangles (DKT).")
@@ -563,7 +541,7 @@ class Scene:
                 raise SceneError("foundation.gap: a Python callable cannot be saved to TOML; use a profile")
             fd: dict[str, Any] = {"k": f.k, "gap": f.gap}
             if f.region is not None:
-                fd["region"] = list(f.region)
+                fd["region"] = dict(f.region) if isinstance(f.region, dict) else list(f.region)
             d["foundation"] = fd
         return d
 

@@ -26,8 +26,8 @@ from scipy.sparse.csgraph import connected_components
 from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
 from .elements.dkt import DKT
 from .errors import ResourceError, SceneError
-from .geometry import edge_table, mesh_size, scene_domain
-from .scene import PointLoad, Scene, UniformLoad
+from .geometry import clip_to_polygon, edge_table, inner_segments, mesh_size, region_outline, scene_domain
+from .scene import PatchLoad, PointLoad, Scene, UniformLoad
 from .trimesh import TriMesh, estimate_nodes, mesh_domain
 
 @dataclass
@@ -40,18 +40,18 @@ class TriModel(Model):
 
     def bed_areas(self) -> np.ndarray:
         """(n_nodes,) each node's tributary area of the scene's tensionless bed: a third of every
-        triangle whose centroid lies in the bed's region (the whole plate without one)."""
+        triangle (the whole plate), or of each triangle's part in the bed's region, weighted as
+        a patch load is (:func:`patch_weights`). The region's outline is a line of the mesh
+        (:func:`bed_lines`), so the region is a union of whole triangles and the areas sum to
+        its area on the plate exactly."""
         mesh: TriMesh = self.grid
-        c = mesh.nodes[mesh.triangles].mean(axis=1)
-        inside = np.ones(len(c), dtype=bool)
-        if self.scene.foundation.region is not None:
-            x0, x1, y0, y1 = self.scene.foundation.region
-            inside = (c[:, 0] >= x0) & (c[:, 0] <= x1) & (c[:, 1] >= y0) & (c[:, 1] <= y1)
-        if not inside.any():
-            raise SceneError(f"foundation.region: {self.scene.foundation.region} holds the centroid of no triangle "
-                             "of the mesh; make it larger than mesh.size")
-        return np.bincount(mesh.triangles[inside].ravel(), weights=np.repeat(mesh.areas()[inside] / 3, 3),
-                           minlength=mesh.n_nodes)
+        region = self.scene.foundation.region
+        if region is None:
+            return np.bincount(mesh.triangles.ravel(), weights=np.repeat(mesh.areas() / 3, 3), minlength=mesh.n_nodes)
+        area = patch_weights(mesh, region)
+        if not area.any():
+            raise SceneError(f"foundation.region: {region} does not overlap the plate's mesh")
+        return area
 
     def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
         """(npts, n_full) sparse operator, from the full dofs, at points: w (the node's w at a node,
@@ -85,6 +85,29 @@ class TriModel(Model):
         return A
 
 
+def bed_lines(scene: Scene, domain) -> list:
+    """The segments of the bed region's outline inside the plate (mesh lines: :func:`mesh_domain`)."""
+    if scene.foundation is None or scene.foundation.region is None:
+        return []
+    return inner_segments(domain, region_outline(scene.foundation.region))
+
+
+def patch_weights(mesh: TriMesh, box) -> np.ndarray:
+    """(n_nodes,) each node's share of a unit pressure on the box [x0, x1] × [y0, y1] (or a
+    polygon region, :func:`plateqp.geometry.region_outline`): over each
+    triangle's part A_t in the box, ∫ λ_i dA = |A_t| λ_i(centroid of A_t) (λ the triangle's
+    barycentric coordinates). The uniform load's lumping (area / 3 per vertex) where the box
+    covers a triangle; statically exact everywhere: the total is the area of the box on the
+    mesh, and the moment that of the pressure on it."""
+    from .trimesh import _barycentric
+
+    xy = mesh.nodes[mesh.triangles]
+    area, cent = clip_to_polygon(xy, region_outline(box))
+    hit = np.flatnonzero(area > 0.0)
+    lam = _barycentric(xy[hit], cent[hit, 0], cent[hit, 1])
+    return np.bincount(mesh.triangles[hit].ravel(), weights=(area[hit, None] * lam).ravel(), minlength=mesh.n_nodes)
+
+
 def check_memory_tri(scene: Scene, h: float) -> None:
     """ResourceError before meshing if the triangle mesh would need more memory than allowed."""
     need = BYTES_PER_DOF * 3 * estimate_nodes(scene)
@@ -101,7 +124,7 @@ def build_tri_model(scene: Scene) -> TriModel:
     check_memory_tri(scene, h)
     points = [(s.x, s.y) for s in scene.supports] + [(ld.x, ld.y) for ld in scene.loads
                                                      if isinstance(ld, PointLoad)] + [(p.x, p.y) for p in scene.pins]
-    mesh = mesh_domain(domain, h, points)
+    mesh = mesh_domain(domain, h, points, bed_lines(scene, domain))
     el = DKT()
     p = scene.plate
     n_full = 3 * mesh.n_nodes
@@ -121,6 +144,8 @@ def build_tri_model(scene: Scene) -> TriModel:
             f_full += np.bincount(cell_dofs.ravel(), weights=(ld.q * el.load(xy)).ravel(), minlength=n_full)
         elif isinstance(ld, PointLoad):
             f_full += ld.P * np.asarray(model.interpolation(ld.x, ld.y).todense()).ravel()
+        elif isinstance(ld, PatchLoad):
+            f_full[0::3] += ld.q * patch_weights(mesh, (ld.x0, ld.x1, ld.y0, ld.y1))
     fixed, values = _prescribed(scene, mesh)
     free = np.setdiff1d(np.arange(n_full), fixed)
     u_c = np.zeros(n_full)

@@ -3,7 +3,9 @@
 :func:`mesh_domain` meshes a :class:`~plateqp.geometry.Domain` with gmsh's Python API (the
 ``shapes`` extra: ``pip install plateqp[shapes]``): target size h, circles as true arcs (boundary
 nodes lie on the circle), given points (supports, point loads, pins) embedded as mesh nodes with
-the mesh refined around them (size h/4 at the point, growing to h at 2h away).
+the mesh refined around them (size h/4 at the point, growing to h at 2h away), and given line
+segments (a bed region's outline) followed by element edges: the boundary curves are split where
+such a line ends on them, so that the line's end is a point of the boundary.
 
 The mesh is deterministic: gmsh runs on one thread with fixed options (Frontal-Delaunay, no
 random factor changes, no configuration files read), so the same scene gives the same mesh. gmsh
@@ -24,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import SceneError
-from .geometry import Domain, Polygon
+from .geometry import Domain, Polygon, _point_segment
 
 #: refinement around embedded points: size REFINE·h at the point, h from 2h away
 REFINE = 0.25
@@ -158,11 +160,13 @@ def _barycentric(p, x, y):
     return np.column_stack([1.0 - l2 - l3, l2, l3])
 
 
-def mesh_domain(domain: Domain, size: float, points=()) -> TriMesh:
-    """Mesh ``domain`` with gmsh at target size ``size``; every point of ``points`` becomes a node.
+def mesh_domain(domain: Domain, size: float, points=(), lines=()) -> TriMesh:
+    """Mesh ``domain`` with gmsh at target size ``size``; every point of ``points`` becomes a node,
+    every segment of ``lines`` ((x0, y0), (x1, y1)) runs along element edges.
 
-    Points on the boundary are embedded in its curve, points inside in the surface; a point at a
-    polygon vertex is that vertex. Duplicates are merged.
+    Points on the boundary are embedded in its curve, points inside in the surface (or in a line
+    they lie on); a point at a polygon vertex is that vertex. Duplicates are merged. A line must
+    lie inside the plate (:func:`plateqp.geometry.inner_segments`); its ends may touch the boundary.
     """
     gmsh = import_gmsh()
     owner = not gmsh.isInitialized()
@@ -182,7 +186,7 @@ def mesh_domain(domain: Domain, size: float, points=()) -> TriMesh:
         gmsh.option.setNumber("Mesh.ElementOrder", 1)
         gmsh.model.add(name)
         try:
-            return _mesh(gmsh, domain, float(size), points)
+            return _mesh(gmsh, domain, float(size), points, lines)
         except Exception as exn:  # gmsh raises plain Exceptions with its own message
             raise SceneError(f"mesh: gmsh could not mesh the plate at size {size:g} ({str(exn).splitlines()[0]})") from exn
     finally:
@@ -193,31 +197,47 @@ def mesh_domain(domain: Domain, size: float, points=()) -> TriMesh:
             gmsh.model.remove()
 
 
-def _mesh(gmsh, domain: Domain, h: float, points) -> TriMesh:
+def _mesh(gmsh, domain: Domain, h: float, points, lines=()) -> TriMesh:
     geo = gmsh.model.geo
+    tol = 1e-9 * domain.size
     curve_owner: dict[int, tuple[int, int]] = {}  # curve tag -> (boundary, segment)
+    curve_geom: dict[int, tuple] = {}  # curve tag -> ("seg", p, q) or ("arc", a0, a1): for _curve_at
     curves_of: list[list[int]] = []
     vertex_tags: list[tuple[float, float, int]] = []
     loops = []
+    # the ends of the lines that lie on a boundary split its curves there (a line must end at a
+    # point of the boundary's own curves to be meshed conformingly)
+    ends = [e for seg in lines for e in seg]
     for k, shape in enumerate((domain.outer, *domain.holes)):
+        on = [e for e in ends if shape.distance(*e)[0] <= tol]
         tags = []
         if isinstance(shape, Polygon):
-            pts = [geo.addPoint(x, y, 0.0) for x, y in shape.vertices]
-            vertex_tags += [(x, y, t) for (x, y), t in zip(shape.vertices, pts)]
-            for i in range(len(pts)):
-                c = geo.addLine(pts[i], pts[(i + 1) % len(pts)])
+            verts = []
+            for i, (p0, p1) in enumerate(shape.segments()):
+                d = p1 - p0
+                cut = sorted({float((np.array(e) - p0) @ d / (d @ d)) for e in on
+                              if float(_point_segment(e[0], e[1], (p0, p1))) <= tol})
+                verts += [(tuple(p0), i)] + [(tuple(p0 + t * d), i) for t in cut if tol < t * np.hypot(*d) < np.hypot(*d) - tol]
+            pts = [geo.addPoint(x, y, 0.0) for (x, y), _ in verts]
+            vertex_tags += [(x, y, t) for ((x, y), _), t in zip(verts, pts)]
+            for n, ((xy, i), t) in enumerate(zip(verts, pts)):
+                nxt = (n + 1) % len(pts)
+                c = geo.addLine(t, pts[nxt])
                 curve_owner[c] = (k, i)
+                curve_geom[c] = ("seg", np.array(xy), np.array(verts[nxt][0]))
                 tags.append(c)
         else:
             centre = geo.addPoint(shape.xc, shape.yc, 0.0)
-            pts = [geo.addPoint(shape.xc + shape.r * math.cos(t), shape.yc + shape.r * math.sin(t), 0.0)
-                   for t in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)]
-            vertex_tags += [(x, y, t) for (x, y), t in zip(
-                [(shape.xc + shape.r, shape.yc), (shape.xc, shape.yc + shape.r),
-                 (shape.xc - shape.r, shape.yc), (shape.xc, shape.yc - shape.r)], pts)]
-            for i in range(4):
-                c = geo.addCircleArc(pts[i], centre, pts[(i + 1) % 4])
+            angles = sorted({0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi,
+                             *(math.atan2(y - shape.yc, x - shape.xc) % (2 * math.pi) for x, y in on)})
+            angles = [a_ for n, a_ in enumerate(angles) if n == 0 or a_ - angles[n - 1] > tol / shape.r]
+            xy = [(shape.xc + shape.r * math.cos(t), shape.yc + shape.r * math.sin(t)) for t in angles]
+            pts = [geo.addPoint(x, y, 0.0) for x, y in xy]
+            vertex_tags += [(x, y, t) for (x, y), t in zip(xy, pts)]
+            for i in range(len(pts)):
+                c = geo.addCircleArc(pts[i], centre, pts[(i + 1) % len(pts)])
                 curve_owner[c] = (k, 0)
+                curve_geom[c] = ("arc", angles[i], angles[i + 1] if i + 1 < len(angles) else 2 * math.pi)
                 tags.append(c)
         curves_of.append(tags)
         loop = geo.addCurveLoop(tags)
@@ -225,19 +245,23 @@ def _mesh(gmsh, domain: Domain, h: float, points) -> TriMesh:
     surf = geo.addPlaneSurface(loops)
     geo.synchronize()
 
-    tol = 1e-9 * domain.size
     embedded, seen = [], []
+    line_tags, line_ends = _lines(geo, vertex_tags, lines, tol)
     for x, y in points:
         if any(math.hypot(x - u, y - v) <= tol for u, v in seen):
             continue
         seen.append((x, y))
-        if any(math.hypot(x - u, y - v) <= tol for u, v, _ in vertex_tags):
+        if any(math.hypot(x - u, y - v) <= tol for u, v, _ in vertex_tags + line_ends):
             continue
-        on = _curve_at(domain, curves_of, x, y, tol)
+        on = _curve_at(domain, curves_of, curve_geom, x, y, tol)
+        if on is None:  # on an embedded line: a point of that line
+            on = next((c for c, (p, q) in line_tags if float(_point_segment(x, y, (p, q))) <= tol), None)
         # built-in kernel: new points after synchronize need another synchronize before embedding
         t = geo.addPoint(x, y, 0.0)
         embedded.append((t, on))
     geo.synchronize()
+    if line_tags:
+        gmsh.model.mesh.embed(1, [c for c, _ in line_tags], 2, surf)
     for t, on in embedded:
         if on is None:
             gmsh.model.mesh.embed(0, [t], 2, surf)
@@ -290,34 +314,58 @@ def _mesh(gmsh, domain: Domain, h: float, points) -> TriMesh:
     return TriMesh(nodes, tris, edges, normals, np.array(boundary), np.array(segment), h, domain)
 
 
-def _curve_at(domain: Domain, curves_of, x: float, y: float, tol: float):
+def _lines(geo, vertex_tags, lines, tol: float):
+    """gmsh lines for the segments ``lines``: [(tag, (p, q))], and their new end points [(x, y, tag)].
+    Ends shared by two segments or at a boundary curve's point (the boundary was split there)
+    are one gmsh point."""
+    ends: list[tuple[float, float, int]] = []
+    out = []
+
+    def point(x, y):
+        for u, v, t in vertex_tags + ends:
+            if math.hypot(x - u, y - v) <= tol:
+                return t
+        t = geo.addPoint(x, y, 0.0)
+        ends.append((x, y, t))
+        return t
+
+    for p, q in lines:
+        a, b = point(*p), point(*q)
+        if a != b:
+            out.append((geo.addLine(a, b), (p, q)))
+    return out, ends
+
+
+def _curve_at(domain: Domain, curves_of, curve_geom, x: float, y: float, tol: float):
     """The gmsh curve tag a point on the boundary lies on, or None for an interior point."""
     for k, shape in enumerate((domain.outer, *domain.holes)):
         if shape.distance(x, y)[0] > tol:
             continue
-        if isinstance(shape, Polygon):
-            seg = shape.segments()
-            d = [float(np.hypot(*_closest(s, x, y))) for s in seg]
-            return curves_of[k][int(np.argmin(d))]
-        angle = math.atan2(y - shape.yc, x - shape.xc) % (2 * math.pi)
-        return curves_of[k][min(int(angle // (0.5 * math.pi)), 3)]
+        best, where = None, math.inf
+        for c in curves_of[k]:
+            g = curve_geom[c]
+            if g[0] == "seg":
+                d = float(_point_segment(x, y, (g[1], g[2])))
+            else:
+                ang = math.atan2(y - shape.yc, x - shape.xc) % (2 * math.pi)
+                d = 0.0 if g[1] <= ang <= g[2] else math.inf
+            if d < where:
+                best, where = c, d
+        return best
     return None
-
-
-def _closest(seg, x, y):
-    (x0, y0), (x1, y1) = seg
-    dx, dy = x1 - x0, y1 - y0
-    t = min(max(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0.0), 1.0)
-    return x - x0 - t * dx, y - y0 - t * dy
 
 
 def _outward_normals(nodes, tris, edges) -> np.ndarray:
     """Unit normals of boundary edges, pointing away from the triangle that holds each edge."""
-    key = {}
-    for t, tri in enumerate(tris):
-        for a, b in ((0, 1), (1, 2), (2, 0)):
-            key[(min(tri[a], tri[b]), max(tri[a], tri[b]))] = tri[3 - a - b]
-    third = np.array([key[(min(i, j), max(i, j))] for i, j in edges])
+    n = len(nodes)
+    ends = [(0, 1, 2), (1, 2, 0), (2, 0, 1)]  # each triangle edge (a, b) and its third vertex
+    a = np.concatenate([tris[:, i] for i, _, _ in ends])
+    b = np.concatenate([tris[:, j] for _, j, _ in ends])
+    opp = np.concatenate([tris[:, k] for _, _, k in ends])
+    key = np.minimum(a, b).astype(np.int64) * n + np.maximum(a, b)
+    order = np.argsort(key, kind="stable")
+    want = np.minimum(edges[:, 0], edges[:, 1]).astype(np.int64) * n + np.maximum(edges[:, 0], edges[:, 1])
+    third = opp[order[np.searchsorted(key[order], want)]]
     d = nodes[edges[:, 1]] - nodes[edges[:, 0]]
     n = np.column_stack([d[:, 1], -d[:, 0]]) / np.hypot(d[:, 0], d[:, 1])[:, None]
     inward = nodes[third] - nodes[edges[:, 0]]

@@ -103,8 +103,10 @@ BAD = [
     ("support-in-notch", sub("x = 1.5\ny = 0.5", "x = 1.5\ny = 1.5"), "supports.0", "outside its shape"),
     ("bed-off-the-plate", lambda t: t + "\n[foundation]\nk = 100.0\nregion = [1.2, 1.8, 1.2, 1.8]\n",
      "foundation.region", "holds the centre of no cell"),
-    ("patch-on-triangles", lambda t: t + '\n[[loads]]\ntype = "patch"\nq = 1.0\nx0 = 0\nx1 = 1\ny0 = 0\ny1 = 1\n',
-     "loads.1", "not yet available"),
+    ("patch-off-the-shape", lambda t: t + '\n[[loads]]\ntype = "patch"\nq = 1.0\nx0 = 1.2\nx1 = 1.8\ny0 = 1.2\n'
+     'y1 = 1.8\n', "loads.1", "no plate there"),
+    ("opening-over-the-edge", lambda t: t + '\n[[openings]]\nx0 = 1.5\nx1 = 2.5\ny0 = 0.2\ny1 = 0.4\n',
+     "openings.0", "not inside the plate"),
 ]
 
 

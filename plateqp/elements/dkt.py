@@ -103,7 +103,7 @@ class DKT:
         B12[..., 1, 6:] = dN[..., 1]
         B12[..., 2, :6] = dN[..., 1]
         B12[..., 2, 6:] = dN[..., 0]
-        return np.einsum("tpij,tjk->tpik", B12, self.slope_transform(xy))
+        return B12 @ self.slope_transform(xy)[:, None]  # (nt, npts, 3, 12) @ (nt, 1, 12, 9)
 
     # -- element matrices -------------------------------------------------------------------
     def stiffness(self, xy, D: float, nu: float) -> np.ndarray:
@@ -111,7 +111,9 @@ class DKT:
         xy = _as_tris(xy)
         _, area = self._grad_l(xy)
         B = self.curvature_matrix(xy, MID_POINTS)
-        K = np.einsum("p,tpik,ij,tpjl->tkl", MID_WEIGHTS, B, bending_matrix(D, nu), B) * area[:, None, None]
+        # Σ_p w_p B_pᵀ D_b B_p by matrix products (a four-operand einsum runs unoptimised, 20× slower)
+        K = (np.swapaxes(B, 2, 3) * MID_WEIGHTS[None, :, None, None]) @ (bending_matrix(D, nu) @ B)
+        K = K.sum(axis=1) * area[:, None, None]
         return 0.5 * (K + np.swapaxes(K, 1, 2))
 
     def shape(self, xy, lam) -> np.ndarray:

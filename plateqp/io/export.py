@@ -1,7 +1,7 @@
 r"""The contact problem of a scene exactly as plateqp's backends get it, in standard QP form.
 
-The problem exported (:func:`contact_qp`) is the nondimensional data of
-:class:`plateqp.contact.scaling.Scaled` (deflections by W, forces by F0, lengths by L),
+The problem exported (:func:`contact_qp`; rectangle grids and triangle meshes alike) is the
+nondimensional data of :class:`plateqp.contact.scaling.Scaled` (deflections by W, forces by F0, lengths by L),
 formulated as ``primal``, ``condensed`` or ``dual`` and taken in its QP form (the condensed and
 dual LCPs as the bound-constrained QPs ½ zᵀMz + qᵀz, z ≥ 0). The scales and the variables'
 names travel with it (:attr:`ExportedQP.meta`; the writers put them in QPS comment lines and
@@ -117,8 +117,6 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
     if formulation not in FORMULATIONS:
         raise ProblemError(f"unknown formulation {formulation!r}; choose one of {FORMULATIONS}")
     model = scene_or_model if isinstance(scene_or_model, Model) else build_model(scene_or_model)
-    if model.scene.triangles:
-        raise ProblemError('export is not yet available on triangle meshes (mesh.element = "dkt")')
     if model.contacts is None or model.contacts.m == 0:
         raise ProblemError(f"scene {model.scene.name!r} has no one-sided supports: there is no contact problem to export")
     data = Scaled.from_model(model)
@@ -149,7 +147,9 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
         "scene": sc.name,
         "formulation": formulation,
         "plate": {"a": sc.plate.a, "b": sc.plate.b, "h": sc.plate.h, "E": sc.plate.E, "nu": sc.plate.nu},
-        "mesh": {"nx": sc.mesh.nx, "ny": sc.mesh.ny, "element": sc.mesh.element},
+        "mesh": ({"element": sc.mesh.element, "size": float(model.grid.size), "nodes": int(model.grid.n_nodes),
+                  "triangles": int(len(model.grid.triangles))} if sc.triangles else
+                 {"nx": sc.mesh.nx, "ny": sc.mesh.ny, "element": sc.mesh.element}),
         "n_dofs": int(data.n),
         "n_contacts": int(data.m),
         "n_elastic": int(np.count_nonzero(data.rho > 0)),

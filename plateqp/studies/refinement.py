@@ -18,6 +18,14 @@ REL, each mesh solved at a solver tolerance of a tenth of REL: the coarsest mesh
 loosest setting that reach it. The estimate is Richardson's (:mod:`plateqp.estimate`,
 :class:`~plateqp.estimate.Quantities`, :func:`~plateqp.estimate.richardson`), which is also
 what ``accuracy="auto"`` uses (:func:`auto_tolerance`).
+
+Triangle meshes
+---------------
+On a triangle-meshed scene (``mesh.element = "dkt"``) a mesh of n "cells a side" is the gmsh
+mesh of element size h = L / n, L the plate's larger bounding-box side
+(:func:`plateqp.geometry.mesh_cells`): halving the mesh halves h. The meshes are not nested,
+so the change on halving is read from max |w| (and the reactions), not from the field at the
+coarse mesh's nodes.
 """
 
 from __future__ import annotations
@@ -64,8 +72,6 @@ def solve_on_meshes(scene: Scene, meshes: Iterable[tuple[int, int]], backend: st
     without PlateQPWarnings (the result's status says it). A mesh that cannot be built or
     solved with an error of a class in ``skip`` is yielded with that error; others propagate.
     """
-    if scene.triangles:
-        with_mesh(scene, 1, 1)  # the one-line SceneError: refinement is not yet available on triangles
     for nx, ny in track(meshes, "meshes"):  # a bar on a terminal (plateqp.progress)
         t0 = time.perf_counter()
         try:
@@ -177,14 +183,14 @@ def convergence(scene: Scene, meshes: Sequence = (2, 4, 8, 16, 32),
     Parameters
     ----------
     meshes : cells a side (``n`` → nx = n, ny = n × the scene's ny/nx), or (nx, ny) pairs,
-        coarse to fine
+        coarse to fine; on triangles ``n`` is the element size L / n (see the module docstring)
     quantities : names understood by :func:`quantity`, or (name, callable(result) → float) pairs
     target : relative change under which a quantity counts as converged
 
     Supports off the nodes of a coarse mesh act through the element's interpolation; pins
     must lie on the nodes of every mesh (else that mesh's row records the SceneError).
     """
-    ratio = scene.mesh.ny / scene.mesh.nx
+    ratio = 1.0 if scene.triangles else scene.mesh.ny / scene.mesh.nx
     mesh_list = [(int(m[0]), int(m[1])) if isinstance(m, (tuple, list)) else (int(m), max(1, round(m * ratio)))
                  for m in meshes]
     names, funcs = [], []
@@ -251,14 +257,19 @@ class TargetResult:
             lines.append(f"{r['mesh'][0]:>4d}x{r['mesh'][1]:<4d} {r['w_max']:12.5g} {ew:>11s} {eR:>11s} "
                          f"{r['status']:>10s} {r['time']:7.2f}s")
         if self.reached:
-            lines.append(f"reached on {self.result.scene.mesh.nx}x{self.result.scene.mesh.ny}")
+            sc = self.result.scene
+            lines.append(f"reached on {sc.mesh.nx}x{sc.mesh.ny}" + (f" (element size {sc.mesh.size:g})"
+                                                                      if sc.triangles else ""))
         else:
             lines.append("NOT reached on the meshes tried: raise --max-mesh, or loosen the target")
         return "\n".join(lines)
 
 
 def start_mesh(scene: Scene, cells: int = 4) -> tuple[int, int]:
-    """``cells`` on the shorter side, the other in proportion to the scene's own mesh."""
+    """``cells`` on the shorter side, the other in proportion to the scene's own mesh (on
+    triangles: (cells, cells), element size L / cells)."""
+    if scene.triangles:
+        return cells, cells
     nx, ny = scene.mesh.nx, scene.mesh.ny
     if nx <= ny:
         return cells, max(cells, round(cells * ny / nx))
