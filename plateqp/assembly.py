@@ -300,9 +300,6 @@ def _csr_from_blocks(V, cnode, pos, ncol):
 
 
 def _loads(scene, grid, el, cells, cell_dofs, n_full) -> np.ndarray:
-    if scene.triangles:  # a model re-used with new loads (sweeps): rectangles only so far
-        raise SceneError('re-using a model with new loads (sweeps) is not yet available on triangle meshes '
-                         '(mesh.element = "dkt")')
     hx, hy = grid.hx, grid.hy
     f = np.zeros(n_full)
     for ld in scene.loads:

@@ -136,16 +136,9 @@ def build_tri_model(scene: Scene) -> TriModel:
     K_full = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(n_full, n_full))
     K_full.sum_duplicates()
 
-    f_full = np.zeros(n_full)
     model = TriModel(scene, mesh, el, None, None, None, None, None, n_full, cell_dofs,
-                     np.arange(len(cell_dofs)), f_full, K_full)
-    for ld in scene.loads:
-        if isinstance(ld, UniformLoad):
-            f_full += np.bincount(cell_dofs.ravel(), weights=(ld.q * el.load(xy)).ravel(), minlength=n_full)
-        elif isinstance(ld, PointLoad):
-            f_full += ld.P * np.asarray(model.interpolation(ld.x, ld.y).todense()).ravel()
-        elif isinstance(ld, PatchLoad):
-            f_full[0::3] += ld.q * patch_weights(mesh, (ld.x0, ld.x1, ld.y0, ld.y1))
+                     np.arange(len(cell_dofs)), None, K_full)
+    f_full = model.f_full = tri_loads(scene, model)
     fixed, values = _prescribed(scene, mesh)
     free = np.setdiff1d(np.arange(n_full), fixed)
     u_c = np.zeros(n_full)
@@ -155,6 +148,24 @@ def build_tri_model(scene: Scene) -> TriModel:
     model.free, model.fixed, model.values = free, fixed, values
     model.contacts = _contacts(scene, model)
     return model
+
+
+def tri_loads(scene: Scene, model: TriModel) -> np.ndarray:
+    """The load vector (all dofs) of ``scene.loads`` on ``model``'s mesh: uniform pressure by the
+    element's consistent load, point loads at their (embedded) points, patch loads integrated
+    exactly over the clipped triangles. Also used to re-use a model with new loads (sweeps)."""
+    mesh, el = model.grid, model.element
+    f_full = np.zeros(model.n_full)
+    xy = mesh.nodes[mesh.triangles]
+    for ld in scene.loads:
+        if isinstance(ld, UniformLoad):
+            f_full += np.bincount(model.cell_dofs.ravel(), weights=(ld.q * el.load(xy)).ravel(),
+                                  minlength=model.n_full)
+        elif isinstance(ld, PointLoad):
+            f_full += ld.P * np.asarray(model.interpolation(ld.x, ld.y).todense()).ravel()
+        elif isinstance(ld, PatchLoad):
+            f_full[0::3] += ld.q * patch_weights(mesh, (ld.x0, ld.x1, ld.y0, ld.y1))
+    return f_full
 
 
 def _prescribed(scene: Scene, mesh: TriMesh):

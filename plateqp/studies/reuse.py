@@ -18,14 +18,23 @@ from ..scene import Scene
 
 def same_structure(a: Scene, b: Scene) -> bool:
     """True if the two scenes have the same K and contact operator B (only gaps, stiffnesses,
-    bed modulus and gap field, or loads differ)."""
+    bed modulus and gap field, or loads differ; on a triangle mesh, whose nodes stand at the
+    point loads, a point load that moves changes the mesh)."""
     if (a.plate, a.mesh, a.edges, a.openings, a.pins) != (b.plate, b.mesh, b.edges, b.openings, b.pins):
         return False
     if [(s.x, s.y) for s in a.supports] != [(s.x, s.y) for s in b.supports]:
         return False
+    if a.triangles and _point_loads(a) != _point_loads(b):  # point loads are nodes of a triangle mesh
+        return False
     if (a.foundation is None) != (b.foundation is None):
         return False
     return a.foundation is None or a.foundation.region == b.foundation.region
+
+
+def _point_loads(scene: Scene) -> list:
+    from ..scene import PointLoad
+
+    return [(ld.x, ld.y) for ld in scene.loads if isinstance(ld, PointLoad)]
 
 
 def adapt_model(base: Model, scene: Scene) -> Model | None:
@@ -41,9 +50,14 @@ def adapt_model(base: Model, scene: Scene) -> Model | None:
         return None
     model = dataclasses.replace(base, scene=scene)
     if old.loads != scene.loads:
-        from ..assembly import _loads  # the load vector alone (no stiffness assembly)
+        if scene.triangles:
+            from ..triassembly import tri_loads  # the load vector alone, on the same mesh
 
-        f_full = _loads(scene, base.grid, base.element, base.cells, base.cell_dofs, base.n_full)
+            f_full = tri_loads(scene, base)
+        else:
+            from ..assembly import _loads  # the load vector alone (no stiffness assembly)
+
+            f_full = _loads(scene, base.grid, base.element, base.cells, base.cell_dofs, base.n_full)
         model.f_full = f_full
         model.f = f_full[base.free] - base.K_full[base.free][:, base.fixed] @ base.values
     c = base.contacts

@@ -1,7 +1,7 @@
 """The work of a sweep's worker: solve the scene with PATH = value, and record the row.
 
 A worker (this process or another) keeps, per sweep, the base model built once and the
-nodal operator of its mesh (:class:`plateqp.post.NodalOperator`); with re-use each value's
+nodal operator of its mesh (:func:`plateqp.post.nodal_operator`); with re-use each value's
 model is the base adapted to it (:func:`plateqp.studies.reuse.adapt_model`). Warm starts
 (``options={"active": ...}``: the previous solve's own final state, ``Result.extras["active"]``,
 else its contact set) go only to backends that take them (:data:`WARM_START_BACKENDS`).
@@ -20,7 +20,7 @@ import numpy as np
 from ..assembly import Model, build_model
 from ..errors import NoEquilibriumError, PlateQPWarning
 from ..paths import set_param
-from ..post import NodalOperator
+from ..post import NodalOperator, TriNodalOperator, nodal_operator
 from ..scene import Scene
 from ..solving import solve
 from .reuse import adapt_model
@@ -50,7 +50,7 @@ class Base:
     of the rows' nodal fields on its mesh (:class:`plateqp.post.NodalOperator`)."""
 
     model: Model
-    nodal: NodalOperator | None = None
+    nodal: NodalOperator | TriNodalOperator | None = None
 
 
 _MODELS: OrderedDict[str, Base] = OrderedDict()  # per process: the base of a sweep
@@ -102,7 +102,7 @@ def solve_value(ctx: Context, value, warm=None):
         row = {"value": value, **res.to_dict()}
         if model is not None:  # an adapted model shares the base's mesh: its operator serves
             if base.nodal is None:
-                base.nodal = NodalOperator(base.model)
+                base.nodal = nodal_operator(base.model)
             row["s1_max"] = float(np.nanmax(base.nodal(res.u, res.scene.plate, "s1")))
         else:
             row["s1_max"] = float(np.nanmax(res.nodal("s1")))
