@@ -351,7 +351,7 @@ def _prescribed(scene, grid, el):
     }
     # (tangential slope order, normal slope order, sign of ∂/∂n relative to the slope dof)
     geometry = {"left": (WY, WX, -1.0), "right": (WY, WX, 1.0), "bottom": (WX, WY, -1.0), "top": (WX, WY, 1.0)}
-    for name, e in scene.edges.items():
+    for name, e in scene.side_edges().items():
         if e.kind == "free":
             continue
         tang, normal, sign = geometry[name]

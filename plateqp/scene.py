@@ -217,6 +217,15 @@ class Scene:
                       for k, v in self.edges.items()}
         self.validate()
 
+    def side_edges(self) -> dict:
+        """The edges of a rectangle by side (left, right, bottom, top), ``edges.all`` filling the
+        sides not named (the most specific name holds); a shaped plate's edges are not sides: {}."""
+        if self.plate.shape is not None:
+            return {}
+        every = self.edges.get("all")
+        sides = {n: self.edges.get(n, every) for n in EDGE_NAMES}
+        return {n: e for n, e in sides.items() if e is not None}
+
     # -- validation -----------------------------------------------------------------------
     def _fail(self, where: str, what: str):
         prefix = f"{self.source}: " if self.source else ""
@@ -309,8 +318,8 @@ class Scene:
             self._fail("plate.shape" if self.plate.shape is not None else "holes" if self.holes else "mesh.size",
                        'needs a triangle mesh: set mesh.element = "dkt"')
         for name, e in self.edges.items():
-            if name not in EDGE_NAMES and not self.triangles:  # triangles: geometry.edge_table
-                self._fail(f"edges.{name}", f"unknown edge; edges are {EDGE_NAMES}")
+            if name not in EDGE_NAMES and name != "all" and not self.triangles:  # triangles: geometry.edge_table
+                self._fail(f"edges.{name}", f"unknown edge; edges are all, {', '.join(EDGE_NAMES)}")
             if e.kind not in EDGE_KINDS:
                 self._fail(f"edges.{name}", f"unknown kind {e.kind!r}; choose one of {EDGE_KINDS}")
             self._num(f"edges.{name}.w", e.w, physical=True)

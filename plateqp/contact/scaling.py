@@ -115,7 +115,7 @@ def contact_spacing(model: Model) -> np.ndarray:
     # an edge held along its length holds the plate between its nodes too: nearer than its nodes
     x, y = c.xy[:, 0], c.xy[:, 1]
     for name, dist in (("left", x), ("right", p.a - x), ("bottom", y), ("top", p.b - y)):
-        e = model.scene.edges.get(name)
+        e = model.scene.side_edges().get(name)
         if e is not None and e.kind != "free":
             s = np.where(dist > 0, np.minimum(s, dist), s)
     return s

@@ -76,7 +76,7 @@ def plot_mesh(result: Result, units=None, *, sections=None, annotate: bool = Tru
     edge_lines = {"left": ([0, 0], [0, g.b]), "right": ([g.a, g.a], [0, g.b]),
                   "bottom": ([0, g.a], [0, 0]), "top": ([0, g.a], [g.b, g.b])}
     seen = set()
-    for name, e in sc.edges.items():
+    for name, e in sc.side_edges().items():
         if e.kind == "free":
             continue
         style = {"simple": {"color": "tab:green", "lw": 4}, "clamped": {"color": "tab:purple", "lw": 6}}[e.kind]
