@@ -19,7 +19,7 @@ from ..errors import MechanismError, NoEquilibriumError, PlateQPWarning, Problem
 from ..linalg import solve_saddle
 from ..results import Result
 from .formulations import ContactSolution, Formulation, formulate
-from .kkt import kkt_report
+from .kkt import kkt_report, reaction_scale
 from .routing import choose, formulations_for
 from .scaling import Scaled
 from .statics import NO_EQUILIBRIUM, settle, supports_reach
@@ -131,7 +131,8 @@ def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, ba
     # settled by 1000 would call every support within tol · 1000 of touching in contact
     local = np.maximum.reduce([np.full(R.shape, data.w_load * data.W), np.abs(model.contacts.g0), np.abs(w),
                                np.abs(s)]) if R.size else np.zeros(0)
-    active = (R > tol * max(np.abs(R).max(initial=0.0), 1e-300)) | (np.abs(gaps) <= tol * np.maximum(local, 1e-300))
+    # (reactions all below tol of the load are zero to the asked accuracy: kkt.reaction_scale)
+    active = (c.R > tol * reaction_scale(c.R, data.f, tol)) | (np.abs(gaps) <= tol * np.maximum(local, 1e-300))
     return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
                   accuracy=acc.asked, reactions=R, gaps=gaps, compressions=s, active=active, residual=res,
                   deflection_unique=unique)
