@@ -102,7 +102,7 @@ KNOWN_GIVE_UP = {
     ("test_far_settled_support_does_not_set_the_deflection_scale", "clarabel", "condensed"): "inaccurate",
     ("test_far_settled_support_does_not_set_the_deflection_scale", "clarabel", "primal"): "error",
     ("test_far_settled_support_does_not_set_the_deflection_scale", "pgs", "condensed"): "inaccurate",
-    # PGS (iterative) when nothing touches
+    # PGS (iterative) when nothing touches and the gaps are 1e2 × the free deflection
     ("test_settlement_beyond_reach_gives_the_free_plate", "pgs", "condensed"): "inaccurate",
     # springs of 1e-8 D: soft rows the interior-point / ADMM solvers do not resolve to "high"
     ("test_soft_supports_tend_to_no_support", "clarabel", "condensed"): "inaccurate",
@@ -235,7 +235,14 @@ def test_settlement_beyond_reach_gives_the_free_plate(backend, formulation, gamm
     sc = grid_scene(gaps=gamma * W_FREE)
     res = run(sc, backend, formulation)
     free = free_plate(sc)
-    if backend == "pgs":  # iterative: must not claim a wrong answer; the exact ones must be exact
+    if backend == "pgs" and gamma == 1.0:
+        # iterative: its reactions are noise below tol of the load, zero to the accuracy asked
+        assert res.status == pq.Status.OPTIMAL and res.kkt.ok, res.kkt
+        assert not res.active.any()
+        load = sum(ld.q * sc.plate.a * sc.plate.b if isinstance(ld, pq.UniformLoad) else ld.P for ld in sc.loads)
+        np.testing.assert_allclose(res.reactions, 0.0, rtol=0, atol=1e-9 * load)
+        return
+    if backend == "pgs":  # at 1e2: negative reactions of 1e-7, flagged (KNOWN_GIVE_UP)
         check_claim(res, np.zeros(9))
         return
     assert res.status == pq.Status.OPTIMAL, res.kkt
