@@ -47,7 +47,7 @@ def graded_set(tmp_path_factory):
     items = list(graded_problems(meshes=(8,))) + list(graded_problems(meshes=(16,), gaps=("liftoff",)))
     problems = [e for e, _, _ in items]
     module = write_qpbenchmark(problems, out, name=NAME, references={e.name: r for e, r, _ in items},
-                               densify_max_n=200)
+                               densify_max_n=200, settings=("default", "high_accuracy"))
     return module, {e.name: e for e in problems}
 
 
@@ -130,9 +130,12 @@ class TestSet(abc.ABC):
     def title(self): ...
     def define_tolerances(self, runtime=10.0):
         self.tolerances = {name: runtime for name in ("default", "low_accuracy", "mid_accuracy", "high_accuracy")}
+    def define_solver_settings(self):
+        self.solver_settings = {name: {} for name in self.tolerances}
     def __init__(self):
         self.known_solver_issues, self.known_solver_timeouts = set(), {}
         self.define_tolerances()
+        self.define_solver_settings()
 '''
 
 CHILD = '''
@@ -148,6 +151,7 @@ import qpbenchmark
 assert isinstance(ts, qpbenchmark.TestSet)
 out = {"description": ts.description, "title": ts.title, "sparse_only": ts.sparse_only,
        "runtime": {k: getattr(v, "runtime", v) for k, v in ts.tolerances.items()},
+       "settings": sorted(ts.solver_settings),
        "issues": sorted(ts.known_solver_issues),
        "problems": [(p.name, FINGERPRINT(p.P, p.q, p.G, p.h, p.A, p.b, p.lb, p.ub)) for p in ts],
        "plateqp_loaded": any(m == "plateqp" or m.startswith("plateqp.") for m, v in sys.modules.items() if v)}
@@ -184,7 +188,10 @@ def test_module_is_a_testset_that_loads_without_plateqp(graded_set, tmp_path):
         assert fp == fingerprint(qp.P, qp.q, qp.G, qp.h, qp.A, qp.b, qp.lb, qp.ub), name
     assert got["sparse_only"] is False  # dense and sparse problems: every solver runs
     assert "primal" in got["description"] and "dual" in got["description"] and got["title"]
-    assert set(got["runtime"]) == set(QPBENCHMARK_TOLERANCES) and set(got["runtime"].values()) == {10.0}
+    # qpbenchmark's tolerances (and time limit) for the two settings kept, of its four
+    assert set(QPBENCHMARK_TOLERANCES) > {"default", "high_accuracy"}
+    assert set(got["runtime"]) == {"default", "high_accuracy"} and set(got["runtime"].values()) == {10.0}
+    assert got["settings"] == ["default", "high_accuracy"]
     # densify_max_n=200: the dense-only solvers are not given the primal problems with n > 200
     big = {n for n, e in exported.items() if e.formulation == "primal" and e.qp.n > 200}
     assert big and {p for p, _ in got["issues"]} == big and {s for _, s in got["issues"]} >= {"daqp", "quadprog"}
@@ -336,3 +343,6 @@ def test_write_qpbenchmark_refuses_non_empty_directory_and_missing_references(gr
     assert not (tmp_path / "other").exists()
     with pytest.raises(ExportError, match="identifier"):
         write_qpbenchmark([dual], tmp_path / "other", name="not-a-module")
+    with pytest.raises(ExportError, match="choose among"):
+        write_qpbenchmark([dual], tmp_path / "other", settings=("fast",))
+    assert not (tmp_path / "other").exists()

@@ -37,6 +37,8 @@ RUNTIME = 10.0
 #: solvers that densify a sparse problem are not given one with more variables (an n² dense P:
 #: 1.2 GB at 64²); the run records those as known solver issues
 DENSIFY_MAX_N = 5000
+#: qpbenchmark's settings the set runs: its default ones and high accuracy (the four take 40 min)
+SETTINGS = ("default", "high_accuracy")
 
 
 def qpsolvers_residuals(qp, ref) -> dict:
@@ -107,7 +109,7 @@ def main(argv=None) -> int:
              "nondimensional; named n<mesh>_<kind>_<gaps>_<form>. Reference solutions (plateqp's exact "
              "pdas / lemke / bpp, KKT-checked) in solutions/.")
     module = write_qpbenchmark(problems, out, name=args.name, title=title, description=descr, runtime=RUNTIME,
-                               references=refs, densify_max_n=DENSIFY_MAX_N, force=True)
+                               references=refs, densify_max_n=DENSIFY_MAX_N, settings=SETTINGS, force=True)
     print(f"wrote {module} ({len(problems)} problems)")
     (out / "results").mkdir(exist_ok=True)
     with open(out / "results" / "instances.csv", "w", newline="") as fh:

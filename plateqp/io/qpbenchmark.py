@@ -83,6 +83,8 @@ DENSIFYING_SOLVERS = {densifying!r}
 DENSIFY_MAX_N = {densify_max_n!r}
 #: (problem, solver, settings or "*") -> seconds: solvers known to overrun the time limit there
 KNOWN_TIMEOUTS = {known_timeouts!r}
+#: the settings of qpbenchmark's (default, low_accuracy, mid_accuracy, high_accuracy) this set runs
+SETTINGS = {settings!r}
 
 
 {reader}
@@ -127,6 +129,8 @@ class {cls}(TestSet):
 
     def __init__(self):
         super().__init__()
+        self.tolerances = {{k: v for k, v in self.tolerances.items() if k in SETTINGS}}
+        self.solver_settings = {{k: v for k, v in self.solver_settings.items() if k in SETTINGS}}
         self.known_solver_issues = {{(name, solver) for name, n, sparse in PROBLEMS if sparse and n > DENSIFY_MAX_N
                                     for solver in DENSIFYING_SOLVERS}}
         self.known_solver_timeouts = dict(KNOWN_TIMEOUTS)
@@ -182,7 +186,7 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
                       description: str | None = None, sparse_only: bool | None = None, runtime: float = 10.0,
                       data_dir: str = "data", references: dict | None = None, solutions_dir: str = "solutions",
                       densify_max_n: int | None = None, known_timeouts: dict | None = None,
-                      force: bool = False) -> Path:
+                      settings=tuple(QPBENCHMARK_TOLERANCES), force: bool = False) -> Path:
     """Write a qpbenchmark test set: ``directory/<name>.py``, ``directory/<data_dir>/*.npz`` (and
     ``directory/<solutions_dir>/*.npz`` with references).
 
@@ -202,6 +206,8 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
         run on a sparse problem with more variables (declared known solver issues); None: no limit
     known_timeouts : {(problem, solver, settings or "*"): seconds}, qpbenchmark's
         ``known_solver_timeouts`` (for solvers that overrun their time limit)
+    settings : which of qpbenchmark's settings the set keeps (its report covers every settings
+        the set defines, so a run of fewer settings needs a set of fewer)
     force : write into a non-empty directory (files of the same names are replaced)
 
     Everything is checked (:func:`check_testset_dir`) before anything is written. Returns the
@@ -214,6 +220,9 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
         raise ExportError(f"problem names must be unique (twice: {dup!r})")
+    settings = tuple(settings)
+    if not settings or not set(settings) <= set(QPBENCHMARK_TOLERANCES):
+        raise ExportError(f"settings {settings!r}: choose among {tuple(QPBENCHMARK_TOLERANCES)}")
     if references is not None:
         refs = {safe_name(k): v for k, v in references.items()}
         missing = [n for n in names if n not in refs]
@@ -241,7 +250,7 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
         problems="".join(f"    {(n, int(qp.n), bool(sp.issparse(qp.P)))!r},\n" for n, (qp, *_) in zip(names, qps)),
         sparse_only=bool(sparse_only), runtime=float(runtime), densifying=densifying,
         densify_max_n=None if densify_max_n is None else int(densify_max_n),
-        known_timeouts=dict(known_timeouts or {}), reader=textwrap.dedent(inspect.getsource(npz_arrays)))
+        known_timeouts=dict(known_timeouts or {}), settings=settings, reader=textwrap.dedent(inspect.getsource(npz_arrays)))
     text = text.replace("DENSIFY_MAX_N = None", "DENSIFY_MAX_N = float('inf')")
     module = directory / f"{name}.py"
     try:
