@@ -37,6 +37,12 @@ RUNTIME = 10.0
 #: solvers that densify a sparse problem are not given one with more variables (an n² dense P:
 #: 1.2 GB at 64²); the run records those as known solver issues
 DENSIFY_MAX_N = 5000
+#: HiGHS (1.16, through qpsolvers) does not stop at its time limit on the sparse primal problems
+#: from 32² on: on n32_rigid_zero_primal (n = 3 007) it had not returned after 300 s of wall time
+#: with time_limit = 10 s (the machine loaded), one call in qpbenchmark's run took 165 s. Those
+#: problems are declared qpbenchmark "known solver timeouts" of 300 s (skipped, counted as
+#: failures); the 64² primal problems (n ≈ 12 000) are declared by extension, not measured.
+HIGHS_TIMEOUT_N, HIGHS_TIMEOUT_S = 3000, 300.0
 #: qpbenchmark's settings the set runs: its default ones and high accuracy (the four take 40 min)
 SETTINGS = ("default", "high_accuracy")
 
@@ -108,8 +114,11 @@ def main(argv=None) -> int:
              "the condensed form (dense, gaps z >= 0) and the dual form (dense, reactions R >= 0), "
              "nondimensional; named n<mesh>_<kind>_<gaps>_<form>. Reference solutions (plateqp's exact "
              "pdas / lemke / bpp, KKT-checked) in solutions/.")
+    timeouts = {(e.name, "highs", "*"): HIGHS_TIMEOUT_S for e in problems
+                if e.formulation == "primal" and e.qp.n > HIGHS_TIMEOUT_N}
     module = write_qpbenchmark(problems, out, name=args.name, title=title, description=descr, runtime=RUNTIME,
-                               references=refs, densify_max_n=DENSIFY_MAX_N, settings=SETTINGS, force=True)
+                               references=refs, densify_max_n=DENSIFY_MAX_N, known_timeouts=timeouts,
+                               settings=SETTINGS, force=True)
     print(f"wrote {module} ({len(problems)} problems)")
     (out / "results").mkdir(exist_ok=True)
     with open(out / "results" / "instances.csv", "w", newline="") as fh:
