@@ -34,9 +34,11 @@ from plateqp.io.graded import FORMS, GAP_PATTERNS, MESHES, SUPPORT_KINDS, graded
 HERE = Path(__file__).resolve().parent
 #: the time limit (s) of every settings in the qpbenchmark run (its default is 10 s)
 RUNTIME = 10.0
-#: solvers that densify a sparse problem are not given one with more variables (an n² dense P:
-#: 1.2 GB at 64²); the run records those as known solver issues
-DENSIFY_MAX_N = 5000
+#: solvers that densify a sparse problem (daqp; quadprog refuses one) are not given one with more
+#: variables; the run records those as known solver issues. daqp took 82 and 85 s of wall time
+#: (limit 10 s; the machine loaded) on the densified n32_rigid_zero_primal (n = 3 007), and a 64²
+#: primal would be a 1.2 GB dense P; the 16² ones (n ≤ 960) take under a second
+DENSIFY_MAX_N = 2000
 #: HiGHS (1.16, through qpsolvers) does not stop at its time limit on the sparse primal problems
 #: from 32² on: on n32_rigid_zero_primal (n = 3 007) it had not returned after 300 s of wall time
 #: with time_limit = 10 s (the machine loaded), one call in qpbenchmark's run took 165 s. Those
