@@ -9,9 +9,11 @@ problem, solver and settings: the test set's own ``solver_settings``, through qp
 ``time_solve_problem``), takes the reactions from the solver's answer (primal: the multipliers
 z of the gap rows; condensed: P x + q; dual: x) and compares them with the reference's:
 ``reaction_error = max |R − R_ref| / max |R_ref|``. Calls qpbenchmark recorded as not found, or
-past the time limit, are graded as failures without a rerun. Writes ``grades.csv`` (one row per call) and ``grades.md`` (per
-solver and settings: the share of problems with the reactions right to 1e-6, by grade) beside the
-results CSV. Runs where qpbenchmark runs (numpy, qpsolvers, qpbenchmark); plateqp is not needed.
+past the time limit, are graded as failures without a rerun. Writes ``grades.csv`` (one row per
+call) and ``grades.md`` (per settings and solver: qpbenchmark's success and the share of problems
+with the reactions right to 1e-6, by grade) beside the results CSV; run again, it grades only the
+calls its ``grades.csv`` lacks. Runs where qpbenchmark runs (numpy, qpsolvers, qpbenchmark);
+plateqp is not needed.
 """
 
 from __future__ import annotations
@@ -54,6 +56,14 @@ def main(argv=None) -> int:
     settings = [s for s in args.settings.split(",") if s]
     with open(args.results, newline="") as fh:
         ran = {(r["problem"], r["solver"], r["settings"]): r for r in csv.DictReader(fh)}
+    out = Path(args.results).with_name("grades.csv")
+    done = {}
+    if out.exists():  # a second run grades only what the first did not
+        with open(out, newline="") as fh:
+            for r in csv.DictReader(fh):
+                r.update(mesh=int(r["mesh"]), reaction_error=float(r["reaction_error"]),
+                         qpbenchmark_success=r["qpbenchmark_success"] == "True")
+                done[(r["problem"], r["solver"], r["settings"])] = r
     rows = []
     for problem in test_set:
         ref = module.reference(problem.name)
@@ -63,6 +73,9 @@ def main(argv=None) -> int:
             for s in settings:
                 r = ran.get((problem.name, solver, s))
                 if r is None:
+                    continue
+                if (problem.name, solver, s) in done:
+                    rows.append(done[(problem.name, solver, s)])
                     continue
                 err = np.nan
                 # a call past the time limit failed by qpbenchmark's rule whatever its answer: not replayed
@@ -75,7 +88,6 @@ def main(argv=None) -> int:
                              "found": r["found"], "qpbenchmark_success": _success(r, test_set.tolerances[s]),
                              "reaction_error": err})
         print(f"{problem.name}: graded", flush=True)
-    out = Path(args.results).with_name("grades.csv")
     with open(out, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
