@@ -134,11 +134,21 @@ def summary(rows, settings) -> str:
                 lines.append("| " + " | ".join(cells) + " |")
             lines.append("")
         wrong = [r for r in sub if r["qpbenchmark_success"] and not r["reaction_error"] <= RIGHT]
-        lines.append(f"Claimed, wrong ({len(wrong)}): " + (", ".join(
-            f"{r['solver']} on {r['problem']} ({r['reaction_error']:.0e})" for r in sorted(
-                wrong, key=lambda r: (r["solver"], r["problem"]))) or "none") + ".")
+        lines.append(f"Claimed, wrong: {len(wrong)} calls" + ("." if not wrong else ", by solver (number; "
+                     "smallest … largest reaction error; gap patterns): " + "; ".join(
+            f"{solver} ({len(ws)}; {min(w['reaction_error'] for w in ws):.0e} … "
+            f"{max(w['reaction_error'] for w in ws):.0e}; "
+            + ", ".join(f"{g} {sum(w['gaps'] == g for w in ws)}" for g in axes["gaps"] if any(w["gaps"] == g for w in ws)) + ")"
+            for solver, ws in sorted(_group(wrong, "solver").items())) + "."))
         lines.append("")
     return "\n".join(lines)
+
+
+def _group(rows, key) -> dict:
+    out = defaultdict(list)
+    for r in rows:
+        out[r[key]].append(r)
+    return out
 
 
 if __name__ == "__main__":

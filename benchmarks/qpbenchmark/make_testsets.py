@@ -15,7 +15,7 @@ Every reference comes from plateqp's exact route (pdas on the primal, lemke on t
 and dual forms, bpp above 300 contacts), passes plateqp's KKT check at ``high``, and is
 checked here once more in qpsolvers' terms (primal residual, dual residual, duality gap: the
 numbers qpbenchmark grades solvers by) and against the other two forms' reactions. The data
-are not kept in git (about 200 MB); the script makes them again in a few minutes.
+are not kept in git (about 80 MB); the script makes them again in about 10 minutes.
 """
 
 from __future__ import annotations
