@@ -346,3 +346,22 @@ def test_write_qpbenchmark_refuses_non_empty_directory_and_missing_references(gr
     with pytest.raises(ExportError, match="choose among"):
         write_qpbenchmark([dual], tmp_path / "other", settings=("fast",))
     assert not (tmp_path / "other").exists()
+
+
+@pytest.mark.filterwarnings("ignore:Converted")  # qpsolvers: the dense forms handed to a sparse solver
+def test_an_outside_solver_reads_the_files_and_finds_the_reference(graded_set):
+    """Clarabel (through qpsolvers) on the stored problems of one non-degenerate instance, read
+    back independently: its reactions are the reference's, in every form."""
+    qpsolvers = pytest.importorskip("qpsolvers")
+    if "clarabel" not in qpsolvers.available_solvers:
+        pytest.skip("clarabel is not installed for qpsolvers")
+    module, _ = graded_set
+    for form in FORMS:
+        name = grade_name(8, "elastic", "mixed", form)
+        d = read_problem(module.parent / "data" / f"{name}.npz")
+        ref = read_reference(module.parent / "solutions" / f"{name}.npz")
+        sol = qpsolvers.solve_problem(qpsolvers.Problem(**d), solver="clarabel", tol_gap_abs=1e-12,
+                                      tol_gap_rel=1e-12, tol_feas=1e-12)
+        assert sol.found, name
+        R = sol.z if form == "primal" else (d["P"] @ sol.x + d["q"] if form == "condensed" else sol.x)
+        assert np.abs(R - ref["reactions"]).max() <= 1e-6 * np.abs(ref["reactions"]).max(), name
