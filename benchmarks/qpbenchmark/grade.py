@@ -138,7 +138,8 @@ def summary(rows, settings) -> str:
                      "smallest … largest reaction error; gap patterns): " + "; ".join(
             f"{solver} ({len(ws)}; {min(w['reaction_error'] for w in ws):.0e} … "
             f"{max(w['reaction_error'] for w in ws):.0e}; "
-            + ", ".join(f"{g} {sum(w['gaps'] == g for w in ws)}" for g in axes["gaps"] if any(w["gaps"] == g for w in ws)) + ")"
+            + ", ".join(f"{g} {sum(w['gaps'] == g for w in ws)}" for g in axes["gaps"]
+                        if any(w["gaps"] == g for w in ws)) + ")"
             for solver, ws in sorted(_group(wrong, "solver").items())) + "."))
         lines.append("")
     return "\n".join(lines)

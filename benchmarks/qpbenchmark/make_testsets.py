@@ -84,7 +84,8 @@ def main(argv=None) -> int:
         resid = qpsolvers_residuals(e.qp, ref)
         ref["meta"]["qpsolvers_residuals"] = resid
         scale = max(np.abs(ref["reactions"]).max(), 1e-300)
-        degenerate = int(np.count_nonzero((np.abs(res.gaps) <= 1e-9 * e.data.W) & (np.abs(res.reactions) <= 1e-9 * scale * e.data.F0)))
+        degenerate = int(np.count_nonzero((np.abs(res.gaps) <= 1e-9 * e.data.W)
+                                          & (np.abs(res.reactions) <= 1e-9 * scale * e.data.F0)))
         problems.append(e)
         refs[e.name] = ref
         qp = e.qp

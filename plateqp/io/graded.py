@@ -181,8 +181,9 @@ def graded_problems(meshes=MESHES, kinds=SUPPORT_KINDS, gaps=GAP_PATTERNS, forms
     """(ExportedQP, reference dict, plateqp Result) for every instance and form of the grid.
 
     Each reference comes from plateqp's exact route for the form (:func:`reference_route`),
-    asked for ``accuracy``, and its worst KKT residual must be at most :data:`REFERENCE_KKT`; its dict (:func:`reference_solution`) also
-    holds ``meta``: the grade, the route, its status and worst KKT residual, the contact count.
+    asked for ``accuracy``, and its worst KKT residual must be at most :data:`REFERENCE_KKT`; its
+    dict (:func:`reference_solution`) also holds ``meta``: the grade, the route, its status and
+    worst KKT residual, the contact count.
     """
     from ..assembly import build_model
     from ..solving import solve

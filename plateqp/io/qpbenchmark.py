@@ -250,7 +250,8 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
         problems="".join(f"    {(n, int(qp.n), bool(sp.issparse(qp.P)))!r},\n" for n, (qp, *_) in zip(names, qps)),
         sparse_only=bool(sparse_only), runtime=float(runtime), densifying=densifying,
         densify_max_n=None if densify_max_n is None else int(densify_max_n),
-        known_timeouts=dict(known_timeouts or {}), settings=settings, reader=textwrap.dedent(inspect.getsource(npz_arrays)))
+        known_timeouts=dict(known_timeouts or {}), settings=settings,
+        reader=textwrap.dedent(inspect.getsource(npz_arrays)))
     text = text.replace("DENSIFY_MAX_N = None", "DENSIFY_MAX_N = float('inf')")
     module = directory / f"{name}.py"
     try:
@@ -266,7 +267,8 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
                 _save_dense(qp, path)
             if references is not None:
                 ref = refs[pname]
-                _save_reference(ref, dict(meta or {}, **(ref.get("meta") or {})), directory / solutions_dir / f"{pname}.npz")
+                _save_reference(ref, dict(meta or {}, **(ref.get("meta") or {})),
+                                directory / solutions_dir / f"{pname}.npz")
         module.write_text(text)
     except OSError as exn:
         raise ExportError(f"{directory}: cannot write ({exn.strerror or exn})") from exn
