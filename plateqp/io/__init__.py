@@ -7,8 +7,10 @@ and plateqp's answers in the tools users already work with.
                            another solver's answer mapped back to a plateqp Result
 :mod:`.qps`                :func:`write_qps`, :func:`read_qps`, :class:`QPSInfo`: Maros–Meszaros QPS
 :mod:`.npz`                :func:`write_npz`, :func:`read_npz`: one problem per ``.npz``, never densified
-:mod:`.qpbenchmark`        :func:`write_qpbenchmark`: a qpbenchmark test set (the ``.npz`` files and a
-                           generated ``TestSet`` module that needs no plateqp)
+:mod:`.qpbenchmark`        :func:`write_qpbenchmark`: a qpbenchmark test set (the problems, their reference
+                           solutions and a generated ``TestSet`` module that needs no plateqp)
+:mod:`.graded`             the graded family of that test set: mesh × support kind × gap pattern, each
+                           instance in the three forms with an exact reference (``n08_rigid_heave_dual``)
 :mod:`.files`              where an export may write, checked before any work; safe file names
 :mod:`.fields`             :func:`to_xarray`, :func:`supports_frame`: a result's nodal fields as an
                            xarray Dataset, its supports as a pandas DataFrame (``Result.to_xarray``,
