@@ -127,8 +127,9 @@ def test_rectangle_with_triangles_keeps_named_edges(tmp_path):
     assert sc.triangles and sc.plate.a == 2.0
     with pytest.raises(pq.SceneError, match="holes: needs a triangle mesh"):
         pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), holes=[{"circle": [0.5, 0.5, 0.2]}])
-    with pytest.raises(pq.SceneError, match="edges.all: unknown edge"):
-        pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), edges={"all": pq.Edge("simple")})
+    with pytest.raises(pq.SceneError, match="edges.outer: unknown edge"):  # a triangle mesh's name
+        pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), edges={"outer": pq.Edge("simple")})
+    pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), edges={"all": pq.Edge("simple")})  # every side (test_scene)
 
 
 def test_edge_names_resolve_most_specific_first():
