@@ -28,6 +28,11 @@ Parts (``--parts``, comma-separated):
   formulation at accuracy 1e-6 and 1e-9, one run each in a fresh interpreter with
   ``--timeout``: solve time, × raw, the worst KKT residual reached, and the reaction error
   against pdas's (exact to rounding).
+* ``auto``: ``backend="auto"`` on a single cold solve (a new model each time, nothing cached)
+  of ``grid_rigid(n, k)`` for ``--auto-meshes`` × ``--auto-ks``, against every exact route
+  (pdas on the primal, bpp and lemke on the condensed, bpp on the dual) at accuracy 1e-10,
+  CPU time, medians of ``--auto-repeat`` interleaved; and a sweep of ``--sweep-values`` gaps
+  of one support (``plateqp.sweep``) through auto and through pdas.
 * ``mesh``: the grid scene's ``pq.solve`` ÷ raw for ``--scale-meshes`` (32,64,128,256,512;
   one run at 512²).
 
@@ -60,6 +65,7 @@ import plateqp as pq
 from plateqp.assembly import build_model
 from plateqp.families import grid_rigid
 from plateqp.linalg import Factor
+from plateqp.studies.sweep import sweep
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
@@ -232,6 +238,57 @@ def _other(args, q):
         q.put({"status": f"error: {type(exn).__name__}: {str(exn)[:80]}"})
 
 
+# ----------------------------------------------------------------------------- backend="auto"
+
+ROUTES = (("auto", "auto"), ("pdas", "primal"), ("bpp", "condensed"), ("lemke", "condensed"), ("bpp", "dual"))
+
+
+def auto_row(n: int, k: int, repeat: int) -> dict:
+    """Single cold solves of grid_rigid(n, k): auto and each exact route (CPU s, medians)."""
+    scene = grid_rigid(n, k)
+    times: dict[str, list[float]] = {f"{b}/{f}": [] for b, f in ROUTES}
+    chosen, kkt = None, {}
+    for r in range(repeat):
+        for i in range(len(ROUTES)):
+            b, f = ROUTES[(i + r) % len(ROUTES)]
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                try:
+                    dt, res = cpu(lambda: pq.solve(scene, backend=b, formulation=f, accuracy=ACCURACY))
+                except Exception:  # a route that does not apply here (recorded as missing)
+                    continue
+            if not res.status.solved:
+                continue
+            times[f"{b}/{f}"].append(dt)
+            kkt[f"{b}/{f}"] = kkt_worst(res)
+            if b == "auto":
+                chosen = f"{res.backend}/{res.formulation}"
+    med = {key: statistics.median(v) for key, v in times.items() if v}
+    exact = {key: v for key, v in med.items() if key != "auto/auto"}
+    best = min(exact, key=exact.get)
+    row = {"part": "auto", "scene": "grid", "mesh": n, "k": k, "rows": k * k, "auto_route": chosen,
+           "fastest_route": best, "auto_s": med.get("auto/auto"), "fastest_s": exact[best],
+           "auto_ratio": med["auto/auto"] / exact[best] if "auto/auto" in med else None}
+    for key, v in med.items():
+        row[f"{key}_s"] = v
+    return row
+
+
+def sweep_row(n: int, k: int, values: int) -> dict:
+    """One support's gap swept over ``values`` values: auto against pdas (CPU s, one run each)."""
+    scene = grid_rigid(n, k)
+    g0 = scene.supports[0].gap
+    vals = list(np.linspace(g0 - 0.002, g0 + 0.002, values))
+    out = {"part": "sweep", "scene": "grid", "mesh": n, "k": k, "rows": k * k, "values": values}
+    for backend in ("auto", "pdas"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            dt, _ = cpu(lambda: sweep(scene, "supports.0.gap", vals, backend=backend, accuracy=ACCURACY,
+                                      executor="serial", progress=False, refine_breakpoints=False))
+        out[f"{backend}_s"] = dt
+    return out
+
+
 # ----------------------------------------------------------------------------- output
 
 
@@ -261,6 +318,10 @@ def main():
     ap.add_argument("--accuracies", default="1e-6,1e-9", help="accuracies of the backends part")
     ap.add_argument("--backends", default=",".join(OTHERS))
     ap.add_argument("--scale-meshes", default="32,64,128,256,512")
+    ap.add_argument("--auto-meshes", default="32,64,128,256")
+    ap.add_argument("--auto-ks", default="3,5,7,10,15,30")
+    ap.add_argument("--auto-repeat", type=int, default=3)
+    ap.add_argument("--sweep-values", type=int, default=20)
     ap.add_argument("--timeout", type=float, default=300.0)
     ap.add_argument("--out", default=str(HERE / "results" / "fast.csv"))
     args = ap.parse_args()
@@ -320,6 +381,38 @@ def main():
                 print(f"| {backend} | {acc:g} | {row['status']} | {fmt(row['solve_s'])} | "
                       f"{fmt(row['solve_ratio'], '{:.1f}')} | {fmt(row['kkt_worst'], '{:.1e}')} | "
                       f"{fmt(row.get('reaction_error'), '{:.1e}')} |", flush=True)
+                write_csv(rows, args.out)
+
+    if "auto" in parts:
+        for b, f in ROUTES:  # first-call imports paid
+            try:
+                pq.solve(grid_rigid(8, 3), backend=b, formulation=f)
+            except Exception:
+                pass
+        print(f"\n### backend='auto' on a single cold solve of grid_rigid(n, k), accuracy {ACCURACY:g} "
+              f"(CPU s, medians of {args.auto_repeat} interleaved)\n")
+        print("| mesh | k | m | auto's route | auto s | fastest exact route | its s | auto ÷ fastest | "
+              "pdas/primal s | bpp/condensed s |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+        for n in (int(v) for v in args.auto_meshes.split(",")):
+            for k in (int(v) for v in args.auto_ks.split(",")):
+                if k > n - 1:
+                    continue
+                row = auto_row(n, k, args.auto_repeat)
+                rows.append(row)
+                print(f"| {n}² | {k} | {k * k} | {row['auto_route']} | {fmt(row['auto_s'])} | {row['fastest_route']} | "
+                      f"{fmt(row['fastest_s'])} | {fmt(row['auto_ratio'], '{:.2f}')} | "
+                      f"{fmt(row.get('pdas/primal_s'))} | {fmt(row.get('bpp/condensed_s'))} |", flush=True)
+                write_csv(rows, args.out)
+        print(f"\n### a sweep of {args.sweep_values} gaps of one support (plateqp.sweep; CPU s, one run)\n")
+        print("| mesh | k | m | auto s | pdas s | auto ÷ pdas |")
+        print("|---|---|---|---|---|---|")
+        for n in (int(v) for v in args.auto_meshes.split(",")):
+            for k in (3, 10):
+                row = sweep_row(n, k, args.sweep_values)
+                rows.append(row)
+                print(f"| {n}² | {k} | {k * k} | {row['auto_s']:.3g} | {row['pdas_s']:.3g} | "
+                      f"{row['auto_s'] / row['pdas_s']:.2f} |", flush=True)
                 write_csv(rows, args.out)
 
     if "mesh" in parts:
