@@ -244,9 +244,10 @@ def _other(args, q):
 ROUTES = (("auto", "auto"), ("pdas", "primal"), ("bpp", "condensed"), ("lemke", "condensed"), ("bpp", "dual"))
 
 
-def auto_row(n: int, k: int, repeat: int) -> dict:
+def auto_row(n: int, k: int, repeat: int, routes=ROUTES) -> dict:
     """Single cold solves of grid_rigid(n, k): auto and each exact route (CPU s, medians)."""
     scene = grid_rigid(n, k)
+    ROUTES = routes  # noqa: N806
     times: dict[str, list[float]] = {f"{b}/{f}": [] for b, f in ROUTES}
     chosen, kkt = None, {}
     for r in range(repeat):
@@ -322,6 +323,9 @@ def main():
     ap.add_argument("--auto-meshes", default="32,64,128,256")
     ap.add_argument("--auto-ks", default="3,5,7,10,15,30")
     ap.add_argument("--auto-repeat", type=int, default=3)
+    ap.add_argument("--auto-routes", default=",".join(f"{b}/{f}" for b, f in ROUTES),
+                    help="backend/formulation pairs of the auto part")
+    ap.add_argument("--no-sweep", action="store_true", help="auto part: skip the sweep")
     ap.add_argument("--sweep-values", type=int, default=20)
     ap.add_argument("--timeout", type=float, default=300.0)
     ap.add_argument("--out", default=str(HERE / "results" / "fast.csv"))
@@ -400,16 +404,19 @@ def main():
             for k in (int(v) for v in args.auto_ks.split(",")):
                 if k > n - 1:
                     continue
-                row = auto_row(n, k, args.auto_repeat)
+                routes = tuple(tuple(r.split("/")) for r in args.auto_routes.split(","))
+                row = auto_row(n, k, args.auto_repeat, routes)
                 rows.append(row)
                 print(f"| {n}² | {k} | {k * k} | {row['auto_route']} | {fmt(row['auto_s'])} | {row['fastest_route']} | "
                       f"{fmt(row['fastest_s'])} | {fmt(row['auto_ratio'], '{:.2f}')} | "
                       f"{fmt(row.get('pdas/primal_s'))} | {fmt(row.get('bpp/condensed_s'))} |", flush=True)
                 write_csv(rows, args.out)
+        if args.no_sweep:
+            args.auto_meshes = ""
         print(f"\n### a sweep of {args.sweep_values} gaps of one support (plateqp.sweep; CPU s, one run)\n")
         print("| mesh | k | m | auto s | pdas s | auto ÷ pdas |")
         print("|---|---|---|---|---|---|")
-        for n in (int(v) for v in args.auto_meshes.split(",")):
+        for n in (int(v) for v in args.auto_meshes.split(",") if v):
             for k in (3, 10):
                 row = sweep_row(n, k, args.sweep_values)
                 rows.append(row)

@@ -17,13 +17,14 @@ from .scaling import Scaled
 # "backend='auto'"): grid_rigid(n, k), n = 32…256, k = 3…30 (m = 9…900), accuracy 1e-10, CPU
 # time of the whole plateqp.solve on a single cold solve (a new model each time).
 # * backend="auto" on a single solve: PDAS on the sparse primal was the fastest exact route at
-#   every size measured; BPP on the condensed LCP, condensation included (one contacts-last
-#   factorisation, plateqp.linalg.SchurFactor), took 1.1–1.5× its time for m ≤ 100 and more
-#   above (3× at m = 900, 32²). So a single solve goes to PDAS whatever m.
+#   every size measured (32²–128², m = 9…900; Lemke on the condensed LCP and BPP on the dual
+#   never faster); BPP on the condensed LCP, condensation included (one contacts-last
+#   factorisation, plateqp.linalg.SchurFactor), took 1.08–1.54× PDAS's time for m ≤ 100 and
+#   up to 3× above (m = 900 at 32²). So a single solve goes to PDAS whatever m.
 # * repeated solves that share K and B (a sweep, plateqp.studies.sweep, inside
 #   :func:`repeated_solves`): the condensed route while m ≤ AUTO_LCP_MAX. Its condensation is
 #   cached and re-used by every solve that shares the model (a dense m × m solve per value
-#   instead of a factorisation), and BPP's answer did not depend on its warm start
+#   instead of a factorisation: a sweep of 10 gaps at 128² took 0.45× PDAS's time), and BPP's answer did not depend on its warm start
 #   (bit-identical serial and parallel sweeps in tests/test_parallel.py, where warm-started
 #   PDAS differed at 1e-13). A floating plate (K singular: PDAS's dense method does not
 #   apply) keeps the condensed route too while m ≤ AUTO_LCP_MAX (not re-measured).

@@ -2,9 +2,11 @@
 
 The one module of plateqp that imports them. :class:`Cholesky` is one sparse Cholesky factor
 ``A = L Lᵀ`` with the calls the rest of :mod:`plateqp.linalg` needs: a fill-reducing (AMD)
-order, the symbolic analysis (once; every numeric factorisation of the same pattern re-uses
-it), the numeric factorisation, solves with many right-hand sides, the trailing block
-``L[k:, k:]`` of the factor, and (scikit-sparse only) rank-k update and downdate. Matrices are
+order, the symbolic analysis (once, with CHOLMOD's ordering or a given one; every numeric
+factorisation of the same pattern re-uses it), the numeric factorisation, solves with many
+right-hand sides, whole or in halves (``forward``: ``L⁻¹ P b``; ``backward``: ``Pᵀ L⁻ᵀ y``),
+the trailing block ``L[k:, k:]`` of the factor, and (scikit-sparse only) rank-k update and
+downdate. Matrices are
 SciPy CSC holding the lower triangle, all CHOLMOD reads.
 
 Reading the factor: cvxopt's only call for it, ``cholmod.getfactor``, hands the numeric factor

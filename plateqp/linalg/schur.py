@@ -16,8 +16,11 @@ at all. Measured on a 128² plate with 900 such unknowns: the contacts-last fact
 1.5 plain factorisations, where the 900 columns ``K⁻¹ B_iᵀ`` (each about 1/50 of a
 factorisation, even solved in blocks) would cost 18.
 
-The same factor solves with ``K`` (:meth:`SchurFactor.solve`) and with ``K_oo``
-(:meth:`SchurFactor.solve_others`, two solves with ``K``). A matrix that is only semidefinite
+The same factor solves with ``K`` (:meth:`SchurFactor.solve`), in halves for a caller that
+needs only the trailing part of one (:meth:`SchurFactor.forward`, :meth:`SchurFactor.backward`,
+and the dense ``trailing_forward``/``trailing_backward`` for vectors on ``l``), and with ``K_oo``
+(:meth:`SchurFactor.solve_others`, two solves with ``K``). The fill-reducing order (AMD on the
+rest) is handed to CHOLMOD with the matrix itself: one pass over ``K``, one conversion. A matrix that is only semidefinite
 but whose block ``K_oo`` is definite is factorised with ``shift`` added to the trailing
 diagonal (``S + shift·I`` is definite); :meth:`SchurFactor.schur` takes it off again.
 
