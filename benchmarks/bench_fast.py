@@ -1,31 +1,43 @@
-"""The in-house fast solver (issue 6, part 1): pdas against one two-sided factorise-and-solve.
+"""The exact contact solve against one raw sparse Cholesky of the same plate (issue 11).
 
-Goal: KKT ≤ 1e-10 in at most 3× the time of one two-sided factorise-and-solve of the same
-plate (plateqp.linalg.Factor, the same library), on
+The floor ("raw") is one CHOLMOD symbolic analysis + numeric factorisation + solve of the
+plate's matrix, written directly against cvxopt's bindings (``cvxopt.cholmod``, the CHOLMOD
+of the default install), not through plateqp.linalg; the lower triangle is converted to a
+cvxopt matrix before the clock starts. The matrix is
 
-* grid: benchmarks/bench_contact.py's scene(n, 30), a simply supported ACM plate on a 30 × 30
-  grid of rigid one-sided supports with heave in one corner and settlement in the other;
-  two-sided: every support a pin holding w at its gap (Factor of the model's K);
+* grid: ``plateqp.families.grid_rigid(n, 30)`` (benchmarks/bench_contact.py's scene family:
+  an 8 m slab on four walls, a 30 × 30 grid of rigid one-sided posts with mixed gaps): the
+  plate's ``K``;
 * bed: a free ACM plate on a tensionless bed (k = 2·10⁴) whose surface falls away towards
-  (1, 1) (gap 0.004 x + 0.002 y), under a uniform load and an off-centre point load: about half
-  of the plate lifts off; two-sided: every spring acting both ways (Factor of K + Bᵀ C B).
+  (1, 1) (gap 0.004 x + 0.002 y), under a uniform load and an off-centre point load (about
+  half of the plate lifts off): ``K + Bᵀ C B``, every bed spring bonded.
 
 Parts (``--parts``, comma-separated):
 
-* ``goal``: pdas (``pq.solve(..., backend="pdas", formulation="primal", accuracy="high")``,
-  the backend's own solve time) against the two-sided factorise-and-solve, medians of
-  ``--repeat`` interleaved runs, at ``--mesh`` (default 128), once per library (``--bindings``:
-  CHOLMOD through scikit-sparse, CHOLMOD from cvxopt's wheels, SuperLU), both sides through
-  the same one (plateqp.linalg's flags switched for the run);
-* ``backends``: the same scenes through osqp, clarabel, qpsolvers:proxqp and qpsolvers:scs at
-  "high" on the primal formulation and Lemke on the condensed one (grid only), one run each
-  in a subprocess with ``--timeout``; reactions compared with Lemke's (grid: exact to
-  rounding) or with pdas's (bed: KKT at rounding; no other exact solver takes a 16 641-row bed);
-* ``mesh``: pdas iterations, factorisations, solves and time ratio for meshes 32² … 256²
-  (first library installed).
+* ``goal``: CPU time (``time.process_time``, BLAS on one thread), interleaved in one process,
+  medians of ``--repeat``, at ``--meshes`` (default 64,128,256): the whole
+  ``pq.solve(scene, accuracy=1e-10)`` call (assembly included; backend and formulation
+  "auto"; its KKT check must pass) ÷ raw, and plateqp's own two-sided solve
+  (``plateqp.linalg.Factor(K).solve(f)``: equilibrated, refined) ÷ raw; then, each in a fresh
+  interpreter, the peak resident memory of the solve above the memory held before it (the
+  model built; Linux VmHWM reset through /proc/self/clear_refs) against the raw
+  factorisation's, measured the same way. Goals: pq.solve ≤ 2.5× raw at 128² and 256² (≤ 3×
+  at 64²), the two-sided solve ≤ 1.1×, memory ≤ 2×.
+* ``backends``: at ``--mesh`` (128), the grid scene through pdas and the external QP
+  backends (clarabel, qpsolvers:piqp, qpsolvers:proxqp, qpsolvers:scs, osqp) on the primal
+  formulation at accuracy 1e-6 and 1e-9, one run each in a fresh interpreter with
+  ``--timeout`` (wall): CPU time of ``pq.solve`` on the built model (all threads), × raw, the worst KKT residual reached, and the reaction error
+  against pdas's (exact to rounding).
+* ``auto``: ``backend="auto"`` on a single cold solve (a new model each time, nothing cached)
+  of ``grid_rigid(n, k)`` for ``--auto-meshes`` × ``--auto-ks``, against every exact route
+  (pdas on the primal, bpp and lemke on the condensed, bpp on the dual) at accuracy 1e-10,
+  CPU time, medians of ``--auto-repeat`` interleaved; and a sweep of ``--sweep-values`` gaps
+  of one support (``plateqp.sweep``) through auto and through pdas.
+* ``mesh``: the grid scene's ``pq.solve`` ÷ raw for ``--scale-meshes`` (32,64,128,256,512;
+  one run at 512²).
 
-    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_fast.py
-    python benchmarks/bench_fast.py --parts goal --mesh 64 --repeat 5
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_fast.py --parts goal
+    python benchmarks/bench_fast.py --parts backends,mesh --scale-meshes 32,64,128,256
 
 Prints markdown tables, writes benchmarks/results/fast.csv (long format, one row per case).
 """
@@ -39,6 +51,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # b
 
 import argparse
 import csv
+import re
 import statistics
 import sys
 import time
@@ -49,18 +62,19 @@ import numpy as np
 import scipy.sparse as sp
 
 import plateqp as pq
-from plateqp import linalg
 from plateqp.assembly import build_model
+from plateqp.families import grid_rigid
 from plateqp.linalg import Factor
 from plateqp.progress import track  # bars on a terminal only
+from plateqp.studies.sweep import sweep
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 from bench_contact import run_in_subprocess
-from bench_contact import scene as grid_scene
 
 KKT_KEYS = ("stationarity", "spring", "primal", "dual", "complementarity", "natural")
-OTHERS = ("osqp", "clarabel", "qpsolvers:proxqp", "qpsolvers:scs")
+OTHERS = ("clarabel", "qpsolvers:piqp", "qpsolvers:proxqp", "qpsolvers:scs", "osqp")
+ACCURACY = 1e-10
 
 
 def bed_scene(n: int) -> pq.Scene:
@@ -71,112 +85,211 @@ def bed_scene(n: int) -> pq.Scene:
 
 
 def make_scene(kind: str, n: int) -> pq.Scene:
-    return grid_scene(n, 30) if kind == "grid" else bed_scene(n)
+    return grid_rigid(n, 30) if kind == "grid" else bed_scene(n)
 
 
-def two_sided(kind: str, n: int, scene: pq.Scene, model):
-    """The matrix and load of the same plate with every contact two-sided."""
-    if kind == "grid":  # each support a pin holding w at its gap
-        pins = pq.Scene(name="pins", plate=scene.plate, mesh=scene.mesh, edges=scene.edges, loads=scene.loads,
-                        pins=[pq.Pin(s.x, s.y, w=s.gap) for s in scene.supports])
-        m = build_model(pins)
-        return m.K, m.f
-    c = model.contacts  # every spring acting both ways: K + Bᵀ C B, f + Bᵀ C g0
+def plate_matrix(kind: str, model) -> tuple[sp.csc_matrix, np.ndarray]:
+    """The floor's matrix and load: the plate's K (grid), K + Bᵀ C B with every bed spring
+    bonded (bed)."""
+    if kind == "grid":
+        return sp.csc_matrix(model.K), np.asarray(model.f, dtype=float)
+    c = model.contacts
     C = sp.diags(1.0 / c.rho)
     return sp.csc_matrix(model.K + c.B.T @ C @ c.B), model.f + c.B.T @ (c.g0 / c.rho)
 
 
-def time_two_sided(K, f, method="auto") -> float:
-    t0 = time.perf_counter()
-    F = Factor(K, method=method)
-    F.solve(f)
-    return time.perf_counter() - t0
+def to_cvxopt(K: sp.csc_matrix):
+    """The lower triangle of K as a cvxopt sparse matrix (made before the clock starts)."""
+    from cvxopt import matrix, spmatrix
+
+    L = sp.tril(K, format="csc")
+    cols = np.repeat(np.arange(L.shape[0], dtype=np.int64), np.diff(L.indptr))
+    return spmatrix(matrix(L.data.astype(float)), matrix(L.indices.astype(np.int64)), matrix(cols), L.shape)
 
 
-#: The CHOLMOD bindings (or SuperLU) the goal is measured with: the two-sided solve and pdas
-#: both go through the same one (plateqp.linalg's flags switched for the run).
-BINDINGS = {
-    "sksparse": ({"HAVE_CHOLMOD": True}, "auto", None),
-    "cvxopt": ({"HAVE_CHOLMOD": False, "HAVE_CVXOPT": True}, "auto", None),
-    "superlu": ({"HAVE_CHOLMOD": False, "HAVE_CVXOPT": False}, "superlu", {"method": "sparse", "factor": "superlu"}),
-}
+def raw_cholmod(A, f: np.ndarray) -> np.ndarray:
+    """The floor: CHOLMOD's symbolic analysis (its default ordering), numeric factorisation and
+    one solve, straight through cvxopt."""
+    from cvxopt import cholmod, matrix
 
-
-def binding_available(name: str) -> bool:
-    return {"sksparse": linalg.HAVE_CHOLMOD, "cvxopt": getattr(linalg, "HAVE_CVXOPT", False)}.get(name, True)
-
-
-class use_binding:
-    """Switch plateqp.linalg's library flags for a block (restored after)."""
-
-    def __init__(self, name: str) -> None:
-        self.flags, self.method, self.options = BINDINGS[name]
-
-    def __enter__(self):
-        self.saved = {k: getattr(linalg, k, False) for k in self.flags}
-        for k, v in self.flags.items():
-            setattr(linalg, k, v)
-        return self
-
-    def __exit__(self, *exc):
-        for k, v in self.saved.items():
-            setattr(linalg, k, v)
+    F = cholmod.symbolic(A)
+    cholmod.numeric(A, F)
+    x = matrix(f.copy())
+    cholmod.solve(F, x)
+    return np.array(x).ravel()
 
 
 def kkt_worst(res) -> float:
     return max(getattr(res.kkt, k) for k in KKT_KEYS)
 
 
-def run_pdas(scene, model, options=None):
+def whole_solve(scene, accuracy=ACCURACY):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pq.PlateQPWarning)
-        return pq.solve(scene, backend="pdas", formulation="primal", accuracy="high", model=model, options=options)
+        return pq.solve(scene, accuracy=accuracy)
 
 
-def pdas_row(kind, n, scene, model, repeat, options=None, method="auto"):
-    """Medians of interleaved runs of the two-sided factorise-and-solve and pdas."""
-    K2, f2 = two_sided(kind, n, scene, model)
-    base, solve, total = [], [], []
-    res = None
-    for _ in range(repeat):
-        base.append(time_two_sided(K2, f2, method))
-        t0 = time.perf_counter()
-        res = run_pdas(scene, model, options)
-        total.append(time.perf_counter() - t0)
-        solve.append(res.times["solve"])
-    e = res.extras
-    b, s = statistics.median(base), statistics.median(solve)
-    return res, {
-        "scene": kind, "mesh": n, "dofs": model.n_free, "rows": int(model.contacts.m), "solver": "pdas",
-        "formulation": "primal", "status": res.status.value, "method": e.get("method"),
-        "two_sided_s": b, "solve_s": s, "ratio": s / b, "pq_solve_total_s": statistics.median(total),
-        "kkt_worst": kkt_worst(res), "iterations": res.iterations,
-        "factorisations": e.get("factorisations"), "solves": e.get("solves"), "updated_rows": e.get("updated_rows"),
-        "analyse_s": e.get("analyse_s"), "factor_s": e.get("factor_s"), "extract_s": e.get("extract_s"),
-        "update_s": e.get("update_s"), "dense_s": e.get("dense_s"), "triangular_solve_s": e.get("solve_s"),
-        "in_contact": int(res.active.sum()), "repeat": repeat, "cholmod": e.get("cholmod") or e.get("factor"),
+def cpu(fn):
+    t0 = time.process_time()
+    out = fn()
+    return time.process_time() - t0, out
+
+
+def goal_row(kind: str, n: int, repeat: int) -> dict:
+    """Medians of interleaved CPU times: raw CHOLMOD, plateqp's two-sided Factor, pq.solve."""
+    scene = make_scene(kind, n)
+    model = build_model(scene)
+    K, f = plate_matrix(kind, model)
+    A = to_cvxopt(K)
+    x_raw = raw_cholmod(A, f)
+    whole_solve(scene)  # first-call imports paid
+    steps = {
+        "raw": lambda: raw_cholmod(A, f),
+        "two_sided": lambda: Factor(K).solve(f),
+        "solve": lambda: whole_solve(scene),
     }
+    times: dict[str, list[float]] = {k: [] for k in steps}
+    res = x2 = None
+    for r in range(repeat):
+        names = list(steps)
+        names = names[r % 3:] + names[:r % 3]  # rotate the order of the three
+        for name in names:
+            dt, out = cpu(steps[name])
+            times[name].append(dt)
+            if name == "solve":
+                res = out
+            elif name == "two_sided":
+                x2 = out
+    med = {k: statistics.median(v) for k, v in times.items()}
+    e = res.extras
+    return {
+        "part": "goal", "scene": kind, "mesh": n, "dofs": model.n_free, "rows": int(model.contacts.m),
+        "backend": res.backend, "formulation": res.formulation, "method": e.get("method"),
+        "status": res.status.value, "kkt_worst": kkt_worst(res), "iterations": res.iterations,
+        "raw_s": med["raw"], "two_sided_s": med["two_sided"], "solve_s": med["solve"],
+        "two_sided_ratio": med["two_sided"] / med["raw"], "solve_ratio": med["solve"] / med["raw"],
+        "two_sided_vs_raw_diff": float(np.abs(x2 - x_raw).max() / np.abs(x_raw).max()),
+        "build_s": res.times.get("build"), "formulate_s": res.times.get("formulate"),
+        "backend_s": res.times.get("solve"), "recover_s": res.times.get("recover"),
+        "analyse_s": e.get("analyse_s"), "factor_s": e.get("factor_s"), "extract_s": e.get("extract_s"),
+        "dense_s": e.get("dense_s"), "solves": e.get("solves"), "solves_s": e.get("solve_s"),
+        "factorisations": e.get("factorisations"), "in_contact": int(res.active.sum()), "repeat": repeat,
+    }
+
+
+# ----------------------------------------------------------------------------- memory, in a fresh interpreter
+
+
+def _status_kb():
+    try:
+        s = open("/proc/self/status").read()
+        return tuple(int(re.search(k + r":\s+(\d+)", s).group(1)) for k in ("VmRSS", "VmHWM"))
+    except (OSError, AttributeError):
+        return None
+
+
+def _reset_peak() -> bool:
+    try:
+        with open("/proc/self/clear_refs", "w") as fh:
+            fh.write("5")
+        return True
+    except OSError:
+        return False
+
+
+def _memory(args, q):
+    """Peak resident memory (MB) of one step above what the process held before it."""
+    kind, n, what = args
+    warnings.simplefilter("ignore")
+    whole_solve(grid_rigid(8, 3))  # imports paid
+    scene = make_scene(kind, n)
+    model = build_model(scene)
+    K, f = plate_matrix(kind, model)
+    if what == "raw":
+        A = to_cvxopt(K)
+        step = lambda: raw_cholmod(A, f)  # noqa: E731
+    elif what == "two_sided":
+        step = lambda: Factor(K).solve(f)  # noqa: E731
+    else:
+        step = lambda: pq.solve(scene, accuracy=ACCURACY, model=model)  # noqa: E731
+    ok = _reset_peak()
+    before = _status_kb()
+    step()
+    after = _status_kb()
+    q.put({"mem_mb": (after[1] - before[0]) / 1024 if (ok and before) else None})
+
+
+def memory(kind: str, n: int, what: str, timeout: float) -> float | None:
+    return run_in_subprocess(_memory, (kind, n, what), timeout).get("mem_mb")
 
 
 # ----------------------------------------------------------------------------- other backends
 
 
 def _other(args, q):
-    kind, n, backend, formulation = args
+    n, backend, accuracy = args
     warnings.simplefilter("ignore")
-    scene = make_scene(kind, n)
+    scene = make_scene("grid", n)
     model = build_model(scene)
     try:
-        r = pq.solve(scene, backend=backend, formulation=formulation, accuracy="high", model=model)
-        q.put({"status": r.status.value, "solve_s": r.times["solve"], "build_s": r.times.get("formulate"),
-               "kkt_worst": kkt_worst(r), "reactions": r.reactions.tolist(), "iterations": r.iterations,
-               "in_contact": int(r.active.sum())})
+        t0 = time.process_time()
+        r = pq.solve(scene, backend=backend, formulation="primal", accuracy=accuracy, model=model)
+        q.put({"status": r.status.value, "solve_s": time.process_time() - t0, "formulate_s": r.times.get("formulate"),
+               "kkt_worst": kkt_worst(r), "reactions": r.reactions.tolist(), "iterations": r.iterations})
     except Exception as exn:  # recorded, not hidden
         q.put({"status": f"error: {type(exn).__name__}: {str(exn)[:80]}"})
 
 
-def run_other(args, timeout):
-    return run_in_subprocess(_other, args, timeout)
+# ----------------------------------------------------------------------------- backend="auto"
+
+ROUTES = (("auto", "auto"), ("pdas", "primal"), ("bpp", "condensed"), ("lemke", "condensed"), ("bpp", "dual"))
+
+
+def auto_row(n: int, k: int, repeat: int, routes=ROUTES) -> dict:
+    """Single cold solves of grid_rigid(n, k): auto and each exact route (CPU s, medians)."""
+    scene = grid_rigid(n, k)
+    ROUTES = routes  # noqa: N806
+    times: dict[str, list[float]] = {f"{b}/{f}": [] for b, f in ROUTES}
+    chosen, kkt = None, {}
+    for r in range(repeat):
+        for i in range(len(ROUTES)):
+            b, f = ROUTES[(i + r) % len(ROUTES)]
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                try:
+                    dt, res = cpu(lambda: pq.solve(scene, backend=b, formulation=f, accuracy=ACCURACY))
+                except Exception:  # a route that does not apply here (recorded as missing)
+                    continue
+            if not res.status.solved:
+                continue
+            times[f"{b}/{f}"].append(dt)
+            kkt[f"{b}/{f}"] = kkt_worst(res)
+            if b == "auto":
+                chosen = f"{res.backend}/{res.formulation}"
+    med = {key: statistics.median(v) for key, v in times.items() if v}
+    exact = {key: v for key, v in med.items() if key != "auto/auto"}
+    best = min(exact, key=exact.get)
+    row = {"part": "auto", "scene": "grid", "mesh": n, "k": k, "rows": k * k, "auto_route": chosen,
+           "fastest_route": best, "auto_s": med.get("auto/auto"), "fastest_s": exact[best],
+           "auto_ratio": med["auto/auto"] / exact[best] if "auto/auto" in med else None}
+    for key, v in med.items():
+        row[f"{key}_s"] = v
+    return row
+
+
+def sweep_row(n: int, k: int, values: int) -> dict:
+    """One support's gap swept over ``values`` values: auto against pdas (CPU s, one run each)."""
+    scene = grid_rigid(n, k)
+    g0 = scene.supports[0].gap
+    vals = list(np.linspace(g0 - 0.002, g0 + 0.002, values))
+    out = {"part": "sweep", "scene": "grid", "mesh": n, "k": k, "rows": k * k, "values": values}
+    for backend in ("auto", "pdas"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            dt, _ = cpu(lambda: sweep(scene, "supports.0.gap", vals, backend=backend, accuracy=ACCURACY,
+                                      executor="serial", progress=False, refine_breakpoints=False))
+        out[f"{backend}_s"] = dt
+    return out
 
 
 # ----------------------------------------------------------------------------- output
@@ -200,110 +313,130 @@ def write_csv(rows, path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--parts", default="goal,backends,mesh")
-    ap.add_argument("--mesh", type=int, default=128)
-    ap.add_argument("--meshes", default="32,64,128,256")
+    ap.add_argument("--meshes", default="64,128,256", help="meshes of the goal part")
     ap.add_argument("--scenes", default="grid,bed")
-    ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--timeout", type=float, default=120.0)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--memory", action=argparse.BooleanOptionalAction, default=True)
+    ap.add_argument("--mesh", type=int, default=128, help="mesh of the backends part")
+    ap.add_argument("--accuracies", default="1e-6,1e-9", help="accuracies of the backends part")
     ap.add_argument("--backends", default=",".join(OTHERS))
-    ap.add_argument("--bindings", default="sksparse,cvxopt,superlu",
-                    help="libraries for the goal part (the first installed is used for the rest)")
+    ap.add_argument("--scale-meshes", default="32,64,128,256,512")
+    ap.add_argument("--auto-meshes", default="32,64,128,256")
+    ap.add_argument("--auto-ks", default="3,5,7,10,15,30")
+    ap.add_argument("--auto-repeat", type=int, default=3)
+    ap.add_argument("--auto-routes", default=",".join(f"{b}/{f}" for b, f in ROUTES),
+                    help="backend/formulation pairs of the auto part")
+    ap.add_argument("--no-sweep", action="store_true", help="auto part: skip the sweep")
+    ap.add_argument("--sweep-values", type=int, default=20)
+    ap.add_argument("--timeout", type=float, default=300.0)
     ap.add_argument("--out", default=str(HERE / "results" / "fast.csv"))
     args = ap.parse_args()
     parts = args.parts.split(",")
     kinds = args.scenes.split(",")
     rows: list[dict] = []
     print(f"threads: OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}; "
-          f"CHOLMOD (scikit-sparse): {pq.linalg.HAVE_CHOLMOD}")
+          f"CHOLMOD bindings in plateqp.linalg: {pq.linalg.bindings() or 'none (SuperLU)'}")
 
-    if "goal" in parts or "backends" in parts:
-        n = args.mesh
-        bindings = [b for b in args.bindings.split(",") if b and binding_available(b)]
-        print(f"\n### {n}×{n} ACM plate: pdas against one two-sided factorise-and-solve (medians of {args.repeat})\n")
-        print("Both through the same library: plateqp.linalg.Factor for the two-sided solve, "
-              "plateqp.linalg's Cholesky / SchurFactor (or Factor's SuperLU) for pdas.\n")
-        print("| scene | library | dofs | contact rows | in contact | method | two-sided s | pdas s | ratio | "
-              "KKT worst | iterations | factorisations | solves |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-        refs = {}
-        for kind in track(kinds, "kinds"):
-            scene = make_scene(kind, n)
-            model = build_model(scene)
-            for name in bindings:
-                with use_binding(name) as bnd:
-                    res, row = pdas_row(kind, n, scene, model, args.repeat, bnd.options, bnd.method)
-                row.update(part="goal", library=name)
+    if "goal" in parts:
+        print(f"\n### pq.solve(scene, accuracy={ACCURACY:g}) and the two-sided solve ÷ raw CHOLMOD "
+              f"(CPU s, medians of {args.repeat} interleaved)\n")
+        print("| scene | mesh | dofs | rows | route | iterations | KKT worst | raw s | two-sided ÷ raw | "
+              "pq.solve s | **pq.solve ÷ raw** | memory MB (solve / raw) |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+        for n in track([int(v) for v in args.meshes.split(",")], "meshes"):
+            for kind in kinds:
+                row = goal_row(kind, n, args.repeat)
+                if args.memory:
+                    for what in ("raw", "two_sided", "solve"):
+                        row[f"mem_{what}_mb"] = memory(kind, n, what, args.timeout)
+                    if row["mem_raw_mb"] and row["mem_solve_mb"] is not None:
+                        row["mem_ratio"] = row["mem_solve_mb"] / row["mem_raw_mb"]
                 rows.append(row)
-                if name == bindings[0]:
-                    refs[kind] = res.reactions
-                print(f"| {kind} | {name} | {row['dofs']} | {row['rows']} | {row['in_contact']} | {row['method']} | "
-                      f"{row['two_sided_s']:.3f} | {row['solve_s']:.3f} | **{row['ratio']:.2f}** | "
-                      f"{row['kkt_worst']:.1e} | {row['iterations']} | {row['factorisations']} | {row['solves']} |",
+                print(f"| {kind} | {n}² | {row['dofs']} | {row['rows']} | {row['backend']}/{row['formulation']}"
+                      f" ({row['method']}) | {row['iterations']} | {row['kkt_worst']:.1e} | {row['raw_s']:.3f} | "
+                      f"{row['two_sided_ratio']:.2f} | {row['solve_s']:.3f} | **{row['solve_ratio']:.2f}** | "
+                      f"{fmt(row.get('mem_solve_mb'), '{:.0f}')} / {fmt(row.get('mem_raw_mb'), '{:.0f}')} |",
                       flush=True)
-        print("\nwhere the pdas time goes (seconds, last run):\n")
-        print("| scene | library | analyse | factorise | extract L_cc | updates | dense | solves |")
-        print("|---|---|---|---|---|---|---|---|")
-        for r in rows:
-            if r.get("part") == "goal":
-                print(f"| {r['scene']} | {r['library']} | {fmt(r['analyse_s'])} | {fmt(r['factor_s'])} | "
-                      f"{fmt(r['extract_s'])} | {fmt(r['update_s'])} | {fmt(r['dense_s'])} | "
-                      f"{fmt(r['triangular_solve_s'])} |")
+                write_csv(rows, args.out)
 
     if "backends" in parts:
         n = args.mesh
-        names = [b for b in args.backends.split(",") if b]
+        model = build_model(make_scene("grid", n))
+        K, f = plate_matrix("grid", model)
+        A = to_cvxopt(K)
+        raw = statistics.median(cpu(lambda: raw_cholmod(A, f))[0] for _ in range(3))
         avail = set(pq.available_backends())
-        for kind in track(kinds, "kinds"):
-            cases = [(b, "primal") for b in names if b in avail]
-            if kind == "grid":
-                cases.append(("lemke", "condensed"))
-            ref = refs[kind]
-            lemke = None
-            if kind == "grid":
-                lemke = run_other((kind, n, "lemke", "condensed"), 10 * args.timeout)
-                if "reactions" in lemke:
-                    ref = np.array(lemke["reactions"])
-            what = "Lemke on the condensed LCP" if kind == "grid" else "pdas"
-            print(f"\n### {n}×{n} {kind}: the QP backends at 'high' (one run each, {args.timeout:g} s limit); "
-                  f"reaction error against {what}\n")
-            print("| solver | formulation | status | build s | solve s | × two-sided | KKT worst | reaction error |")
-            print("|---|---|---|---|---|---|---|---|")
-            pd = next(r for r in rows if r.get("part") == "goal" and r["scene"] == kind)
-            b = pd["two_sided_s"]
-            err = float(np.abs(refs[kind] - ref).max() / np.abs(ref).max()) if kind == "grid" else 0.0
-            print(f"| pdas | primal | {pd['status']} | – | {pd['solve_s']:.3g} | {pd['ratio']:.2f} | "
-                  f"{pd['kkt_worst']:.1e} | {fmt(err if kind == 'grid' else None, '{:.1e}')} |")
-            for backend, form in cases:
-                r = lemke if (backend == "lemke" and lemke is not None) else run_other((kind, n, backend, form), args.timeout)
-                row = {"part": "backends", "scene": kind, "mesh": n, "solver": backend, "formulation": form,
-                       "status": r["status"], "solve_s": r.get("solve_s"), "build_s": r.get("build_s"),
-                       "two_sided_s": b, "ratio": r["solve_s"] / b if "solve_s" in r else None,
-                       "kkt_worst": r.get("kkt_worst"), "iterations": r.get("iterations"),
-                       "in_contact": r.get("in_contact")}
-                if "reactions" in r:
-                    row["reaction_error"] = float(np.abs(np.array(r["reactions"]) - ref).max() / np.abs(ref).max())
+        print(f"\n### {n}² grid_rigid({n}, 30), primal formulation: one run each in a fresh interpreter "
+              f"({args.timeout:g} s wall limit; CPU time of pq.solve on the built model, all threads; raw CHOLMOD "
+              f"{raw:.3f} s)\n")
+        print("| backend | accuracy | status | solve s | × raw | KKT worst | reaction error vs pdas |")
+        print("|---|---|---|---|---|---|---|")
+        for acc in (float(v) for v in args.accuracies.split(",")):
+            ref = run_in_subprocess(_other, (n, "pdas", acc), args.timeout)
+            for backend in ["pdas"] + [b for b in args.backends.split(",") if b]:
+                if backend != "pdas" and backend not in avail:
+                    continue
+                r = ref if backend == "pdas" else run_in_subprocess(_other, (n, backend, acc), args.timeout)
+                row = {"part": "backends", "scene": "grid", "mesh": n, "backend": backend, "formulation": "primal",
+                       "accuracy": acc, "status": r["status"], "solve_s": r.get("solve_s"), "raw_s": raw,
+                       "solve_ratio": r["solve_s"] / raw if r.get("solve_s") else None,
+                       "kkt_worst": r.get("kkt_worst"), "iterations": r.get("iterations")}
+                if "reactions" in r and "reactions" in ref:
+                    a, b = np.array(r["reactions"]), np.array(ref["reactions"])
+                    row["reaction_error"] = float(np.abs(a - b).max() / np.abs(b).max())
                 rows.append(row)
-                print(f"| {backend} | {form} | {row['status']} | {fmt(row['build_s'])} | {fmt(row['solve_s'])} | "
-                      f"{fmt(row['ratio'], '{:.1f}')} | "
-                      f"{fmt(row['kkt_worst'], '{:.1e}')} | {fmt(row.get('reaction_error'), '{:.1e}')} |", flush=True)
+                print(f"| {backend} | {acc:g} | {row['status']} | {fmt(row['solve_s'])} | "
+                      f"{fmt(row['solve_ratio'], '{:.1f}')} | {fmt(row['kkt_worst'], '{:.1e}')} | "
+                      f"{fmt(row.get('reaction_error'), '{:.1e}')} |", flush=True)
+                write_csv(rows, args.out)
+
+    if "auto" in parts:
+        for b, f in ROUTES:  # first-call imports paid
+            try:
+                pq.solve(grid_rigid(8, 3), backend=b, formulation=f)
+            except Exception:
+                pass
+        print(f"\n### backend='auto' on a single cold solve of grid_rigid(n, k), accuracy {ACCURACY:g} "
+              f"(CPU s, medians of {args.auto_repeat} interleaved)\n")
+        print("| mesh | k | m | auto's route | auto s | fastest exact route | its s | auto ÷ fastest | "
+              "pdas/primal s | bpp/condensed s |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+        for n in (int(v) for v in args.auto_meshes.split(",")):
+            for k in (int(v) for v in args.auto_ks.split(",")):
+                if k > n - 1:
+                    continue
+                routes = tuple(tuple(r.split("/")) for r in args.auto_routes.split(","))
+                row = auto_row(n, k, args.auto_repeat, routes)
+                rows.append(row)
+                print(f"| {n}² | {k} | {k * k} | {row['auto_route']} | {fmt(row['auto_s'])} | {row['fastest_route']} | "
+                      f"{fmt(row['fastest_s'])} | {fmt(row['auto_ratio'], '{:.2f}')} | "
+                      f"{fmt(row.get('pdas/primal_s'))} | {fmt(row.get('bpp/condensed_s'))} |", flush=True)
+                write_csv(rows, args.out)
+        if args.no_sweep:
+            args.auto_meshes = ""
+        print(f"\n### a sweep of {args.sweep_values} gaps of one support (plateqp.sweep; CPU s, one run)\n")
+        print("| mesh | k | m | auto s | pdas s | auto ÷ pdas |")
+        print("|---|---|---|---|---|---|")
+        for n in (int(v) for v in args.auto_meshes.split(",") if v):
+            for k in (3, 10):
+                row = sweep_row(n, k, args.sweep_values)
+                rows.append(row)
+                print(f"| {n}² | {k} | {k * k} | {row['auto_s']:.3g} | {row['pdas_s']:.3g} | "
+                      f"{row['auto_s'] / row['pdas_s']:.2f} |", flush=True)
+                write_csv(rows, args.out)
 
     if "mesh" in parts:
-        meshes = [int(v) for v in args.meshes.split(",")]
-        print(f"\n### pdas against mesh size (medians of {args.repeat}; iterations = active sets solved, "
-              "Newton–PCG steps included)\n")
-        print("| scene | mesh | dofs | rows | in contact | method | iterations | factorisations | solves | "
-              "two-sided s | pdas s | ratio | KKT worst |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-        for kind in track(kinds, "kinds"):
-            for n in meshes:
-                scene = make_scene(kind, n)
-                model = build_model(scene)
-                _, row = pdas_row(kind, n, scene, model, args.repeat if n < 256 else 1)
-                row["part"] = "mesh"
-                rows.append(row)
-                print(f"| {kind} | {n} | {row['dofs']} | {row['rows']} | {row['in_contact']} | {row['method']} | "
-                      f"{row['iterations']} | {row['factorisations']} | {row['solves']} | {row['two_sided_s']:.3f} | "
-                      f"{row['solve_s']:.3f} | {row['ratio']:.2f} | {row['kkt_worst']:.1e} |", flush=True)
+        print("\n### grid_rigid(n, 30): pq.solve ÷ raw CHOLMOD against the mesh (CPU, medians; one run from 512²)\n")
+        print("| mesh | dofs | route | iterations | KKT worst | raw s | two-sided ÷ raw | pq.solve s | pq.solve ÷ raw |")
+        print("|---|---|---|---|---|---|---|---|---|")
+        for n in (int(v) for v in args.scale_meshes.split(",")):
+            row = goal_row("grid", n, args.repeat if n < 512 else 1)
+            row["part"] = "mesh"
+            rows.append(row)
+            print(f"| {n}² | {row['dofs']} | {row['backend']}/{row['formulation']} ({row['method']}) | "
+                  f"{row['iterations']} | {row['kkt_worst']:.1e} | {row['raw_s']:.3f} | {row['two_sided_ratio']:.2f} | "
+                  f"{row['solve_s']:.3f} | {row['solve_ratio']:.2f} |", flush=True)
+            write_csv(rows, args.out)
 
     write_csv(rows, args.out)
     print(f"\nwritten {args.out}")

@@ -49,9 +49,10 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     Parameters
     ----------
     scene : the :class:`~plateqp.scene.Scene`
-    backend : a name from :func:`plateqp.available_backends` ("auto": bpp on the condensed
-        problem while there are at most 100 contact points, else pdas on the sparse primal;
-        the rule and its measurements: :mod:`plateqp.contact`, benchmarks/README.md "Scaling")
+    backend : a name from :func:`plateqp.available_backends` ("auto": pdas on the sparse
+        primal; bpp on the condensed problem for a floating plate with at most 100 contact
+        points, and in a sweep (which re-uses the condensation) with at most 100; the rule and
+        its measurements: :mod:`plateqp.contact.routing`, benchmarks/README.md)
     formulation : "primal", "condensed", "dual" or "auto" (with a named backend: the form it
         takes; with a QP backend that takes all, condensed while m ≤ 1 % of the dofs and ≤ 1000)
     accuracy : "low", "default" or "high" (KKT tolerance 1e-3, 1e-6, 1e-9), or a tolerance

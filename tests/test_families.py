@@ -180,10 +180,11 @@ def choice(scene, backend="auto", formulation="auto"):
 
 
 @pytest.mark.parametrize("scene,backend,expected", [
-    # backend="auto": BPP on the condensed LCP while m ≤ 100, then PDAS on the sparse primal
+    # backend="auto" on a single solve: PDAS on the sparse primal; a floating plate: BPP on
+    # the condensed LCP while m ≤ 100 (repeated solves: see test_auto_rule_for_repeated_solves)
     (lambda: F.floating(16, 5), "auto", ("bpp", "condensed")),  # m = 25
-    (lambda: F.grid_rigid(16, 7), "auto", ("bpp", "condensed")),  # m = 49
-    (lambda: F.grid_rigid(64, 9), "auto", ("bpp", "condensed")),  # m = 81
+    (lambda: F.grid_rigid(16, 7), "auto", ("pdas", "primal")),  # m = 49
+    (lambda: F.grid_rigid(64, 9), "auto", ("pdas", "primal")),  # m = 81
     (lambda: F.grid_rigid(32, 15), "auto", ("pdas", "primal")),  # m = 225
     (lambda: F.bed(16), "auto", ("pdas", "primal")),  # m = 289, every node
     # a named QP backend: condensed while m ≤ 1 % of the free dofs (and ≤ 1000)
@@ -201,6 +202,17 @@ def test_auto_rule(scene, backend, expected):
     assert choice(scene(), backend) == expected
 
 
+def test_auto_rule_for_repeated_solves():
+    """Solves that share K and B (a sweep): the condensed route while m ≤ 100."""
+    from plateqp.contact.routing import repeated_solves
+
+    with repeated_solves():
+        assert choice(F.grid_rigid(16, 7)) == ("bpp", "condensed")  # m = 49
+        assert choice(F.grid_rigid(64, 9)) == ("bpp", "condensed")  # m = 81
+        assert choice(F.grid_rigid(32, 15)) == ("pdas", "primal")  # m = 225
+    assert choice(F.grid_rigid(16, 7)) == ("pdas", "primal")
+
+
 def test_auto_backend_for_an_explicit_formulation():
     sc = F.grid_rigid(16, 7)
     assert choice(sc, "auto", "condensed") == ("bpp", "condensed")
@@ -210,9 +222,10 @@ def test_auto_backend_for_an_explicit_formulation():
 
 def test_auto_end_to_end_agrees_with_an_exact_solver():
     """pq.solve with both "auto" reports what it chose, and the answer is Lemke's."""
-    for sc in (F.grid_rigid(16, 7), F.grid_rigid(16, 15)):  # m = 49: condensed; m = 225: primal
+    for sc in (F.grid_rigid(16, 7), F.grid_rigid(16, 15), F.floating(16, 5)):  # m = 49, 225: primal; floating: condensed
         res = solve(sc, backend="auto", formulation="auto", accuracy="high")
         ref = solve(sc, "lemke", "condensed")
         assert res.status == pq.Status.OPTIMAL
-        assert (res.backend, res.formulation) == (("bpp", "condensed") if len(sc.supports) <= 100 else ("pdas", "primal"))
+        assert (res.backend, res.formulation) == (("bpp", "condensed") if sc.name.startswith("floating")
+                                                  else ("pdas", "primal"))
         np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())

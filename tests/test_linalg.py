@@ -97,6 +97,54 @@ def test_factor_refuses_singular_matrices(method):
     assert issubclass(SingularMatrixError, MechanismError)  # callers that know the matrix catch it as one
 
 
+def test_lower_is_the_scaled_lower_triangle():
+    """lower(K, s) (no order: K's own column order kept) and with an order, against dense numpy."""
+    K = spd(5)
+    s = 1.0 / np.sqrt(K.diagonal())
+    Kd = (s[:, None] * K.toarray()) * s[None, :]
+    assert rel(lower(K, s).toarray(), np.tril(Kd)) < 1e-15
+    p = np.random.default_rng(4).permutation(K.shape[0])
+    assert rel(lower(K, s, p).toarray(), np.tril(Kd[np.ix_(p, p)])) < 1e-15
+
+
+@pytest.mark.parametrize("method", ["cvxopt", "superlu"] if linalg.HAVE_CVXOPT else ["superlu"])
+def test_refinement_stops_once_a_step_no_longer_changes_the_answer(method):
+    """A moderately conditioned matrix (cond ~1e7): one refinement step takes the answer from
+    ~1e-10 to rounding and the next is predicted not to change it, so it is not taken (two raw
+    solves in all); an ill-conditioned one: refinement still gains digits."""
+    K = laplacian(8, 1e-6)
+    b = np.random.default_rng(5).standard_normal(K.shape[0])
+    fac = Factor(K, method=method)
+    calls = []
+    raw = fac._raw
+    fac._raw = lambda r: calls.append(1) or raw(r)
+    x = fac.solve(b)
+    assert len(calls) == 2
+    assert rel(x, dense_refined(K, b)) < 1e-13
+    # ill-conditioned even once equilibrated (cond ~1e10): the reference is a dense LU solve
+    # refined with long-double residuals (scipy, not plateqp); refinement gains two digits or more, to ~1e-12
+    d = 10.0 ** np.linspace(-6, 6, 64)
+    K2 = sp.csc_matrix(sp.diags(d) @ laplacian(8, 1e-8) @ sp.diags(d))
+    b2 = np.random.default_rng(6).standard_normal(64) * d
+    x_ref = dense_refined(K2, b2)
+    fac2 = Factor(K2, method=method)
+    assert rel(fac2.solve(b2), x_ref) < 1e-2 * rel(fac2.solve(b2, refine=0), x_ref)
+    assert rel(fac2.solve(b2), x_ref) < 1e-11
+
+
+def dense_refined(K, b, steps: int = 8) -> np.ndarray:
+    """A dense LU solve (SciPy) with ``steps`` refinement steps on long-double residuals."""
+    import scipy.linalg as sla
+
+    Kd = K.toarray()
+    lu = sla.lu_factor(Kd)
+    x = sla.lu_solve(lu, b)
+    KL = Kd.astype(np.longdouble)
+    for _ in range(steps):
+        x = x + sla.lu_solve(lu, (b.astype(np.longdouble) - KL @ x.astype(np.longdouble)).astype(float))
+    return x
+
+
 # --------------------------------------------------------------------------- CHOLMOD's trailing block
 
 
@@ -134,6 +182,32 @@ def test_schur_complement_is_the_dense_one(method):
     o = fac.others
     bo = rng.standard_normal(o.size)
     assert rel(fac.solve_others(bo), np.linalg.solve(K.toarray()[np.ix_(o, o)], bo)) < 1e-10
+
+
+@pytest.mark.parametrize("lib", LIBS)
+def test_solve_in_halves(lib):
+    """SchurFactor's forward/backward halves: backward(forward(b)) = K⁻¹ b; the trailing part of
+    K⁻¹ b from the forward half alone; forward of a vector on the last unknowns is zero on the
+    others and its trailing part is trailing_forward's (all against dense numpy)."""
+    K = spd()
+    n = K.shape[0]
+    last = np.random.default_rng(7).permutation(n)[:11]
+    fac = SchurFactor(K, last, method=lib)
+    assert fac.can_split
+    b = np.random.default_rng(8).standard_normal(n)
+    x = np.linalg.solve(K.toarray(), b)
+    y = fac.forward(b)
+    assert rel(fac.backward(y), x) < 1e-9
+    assert rel(fac.trailing_backward(y[fac.no:]), x[last]) < 1e-9
+    bl = np.random.default_rng(9).standard_normal(last.size)
+    full = np.zeros(n)
+    full[last] = bl
+    yl = fac.forward(full)
+    assert np.all(yl[:fac.no] == 0)
+    assert rel(yl[fac.no:], fac.trailing_forward(bl)) < 1e-12
+    assert rel(fac.backward(yl), np.linalg.solve(K.toarray(), full)) < 1e-9
+    with pytest.raises(ValueError):
+        SchurFactor(K, last, shift=1.0, method=lib).forward(b)
 
 
 @pytest.mark.parametrize("method", SCHUR_METHODS)

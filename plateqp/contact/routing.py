@@ -6,20 +6,28 @@ formulates.
 
 from __future__ import annotations
 
+import contextlib
+
 from ..backends import get_backend, registry
 from ..errors import ProblemError, SolverError
 from .formulations import FORMULATIONS
 from .scaling import Scaled
 
-# The "auto" rules, measured by benchmarks/bench_scaling.py (benchmarks/README.md, "Scaling":
-# grid_rigid scenes, n = 16…256, m = 25…3969, accuracy 1e-6, formulate + solve time).
-# * backend="auto": on a single solve PDAS on the sparse primal was the fastest exact route
-#   everywhere (BPP on the condensed LCP, condensation included: 1.5–4× slower for m ≤ 81,
-#   6–23× for m ≥ 225). The condensed route is kept while m ≤ AUTO_LCP_MAX all the same: its
-#   condensation is cached and re-used by every solve that shares the model (sweeps, gap
-#   regulation: a dense m × m solve per value instead of a factorisation), and BPP's answer
-#   did not depend on its warm start (bit-identical serial and parallel sweeps in
-#   tests/test_studies.py, where warm-started PDAS differed at 1e-13).
+# The "auto" rules, measured by benchmarks/bench_fast.py --parts auto (benchmarks/README.md,
+# "backend='auto'"): grid_rigid(n, k), n = 32…256, k = 3…30 (m = 9…900), accuracy 1e-10, CPU
+# time of the whole plateqp.solve on a single cold solve (a new model each time).
+# * backend="auto" on a single solve: PDAS on the sparse primal was the fastest exact route at
+#   every size measured (32²–128², m = 9…900; Lemke on the condensed LCP and BPP on the dual
+#   never faster); BPP on the condensed LCP, condensation included (one contacts-last
+#   factorisation, plateqp.linalg.SchurFactor), took 1.08–1.54× PDAS's time for m ≤ 100 and
+#   up to 3× above (m = 900 at 32²). So a single solve goes to PDAS whatever m.
+# * repeated solves that share K and B (a sweep, plateqp.studies.sweep, inside
+#   :func:`repeated_solves`): the condensed route while m ≤ AUTO_LCP_MAX. Its condensation is
+#   cached and re-used by every solve that shares the model (a dense m × m solve per value
+#   instead of a factorisation: a sweep of 10 gaps at 128² took 0.45× PDAS's time), and BPP's answer did not depend on its warm start
+#   (bit-identical serial and parallel sweeps in tests/test_parallel.py, where warm-started
+#   PDAS differed at 1e-13). A floating plate (K singular: PDAS's dense method does not
+#   apply) keeps the condensed route too while m ≤ AUTO_LCP_MAX (not re-measured).
 # * which backend, read from the declared capabilities (plateqp.backends.base.Backend): an
 #   exact one that takes the formulation (answers exact to rounding at any tolerance), the
 #   warm-startable ones first (sweeps re-use their final active set; of the exact LCP solvers
@@ -37,15 +45,29 @@ AUTO_CONDENSED_FRACTION = 0.01
 AUTO_CONDENSED_MAX = 1000
 AUTO_QP_BACKENDS = ("clarabel", "qpsolvers:clarabel", "osqp", "cvxpy")
 
+_REPEATED = [0]  # depth of repeated_solves() blocks in this process
+
+
+@contextlib.contextmanager
+def repeated_solves():
+    """Within this block, backend="auto" counts on solves that share K and B (a sweep): it
+    condenses while m ≤ AUTO_LCP_MAX, so that the condensation is paid once."""
+    _REPEATED[0] += 1
+    try:
+        yield
+    finally:
+        _REPEATED[0] -= 1
+
 
 def condensed_pays(data: Scaled, backend: str = "auto") -> bool:
-    """True where formulation="auto" condenses: few contact points (see the rules above).
+    """True where formulation="auto" condenses (see the rules above).
 
-    ``backend="auto"``: m ≤ AUTO_LCP_MAX; a named QP backend: m ≤ AUTO_CONDENSED_FRACTION ×
-    free dofs and m ≤ AUTO_CONDENSED_MAX.
+    ``backend="auto"``: m ≤ AUTO_LCP_MAX for repeated solves (:func:`repeated_solves`) or a
+    floating plate, else never; a named QP backend: m ≤ AUTO_CONDENSED_FRACTION × free dofs
+    and m ≤ AUTO_CONDENSED_MAX.
     """
     if backend == "auto":
-        return data.m <= AUTO_LCP_MAX
+        return data.m <= AUTO_LCP_MAX and (_REPEATED[0] > 0 or data.floating)
     return data.m <= min(AUTO_CONDENSED_MAX, AUTO_CONDENSED_FRACTION * data.n)
 
 

@@ -2,9 +2,11 @@
 
 The one module of plateqp that imports them. :class:`Cholesky` is one sparse Cholesky factor
 ``A = L Lᵀ`` with the calls the rest of :mod:`plateqp.linalg` needs: a fill-reducing (AMD)
-order, the symbolic analysis (once; every numeric factorisation of the same pattern re-uses
-it), the numeric factorisation, solves with many right-hand sides, the trailing block
-``L[k:, k:]`` of the factor, and (scikit-sparse only) rank-k update and downdate. Matrices are
+order, the symbolic analysis (once, with CHOLMOD's ordering or a given one; every numeric
+factorisation of the same pattern re-uses it), the numeric factorisation, solves with many
+right-hand sides, whole or in halves (``forward``: ``L⁻¹ P b``; ``backward``: ``Pᵀ L⁻ᵀ y``),
+the trailing block ``L[k:, k:]`` of the factor, and (scikit-sparse only) rank-k update and
+downdate. Matrices are
 SciPy CSC holding the lower triangle, all CHOLMOD reads.
 
 Reading the factor: cvxopt's only call for it, ``cholmod.getfactor``, hands the numeric factor
@@ -67,22 +69,40 @@ def _sk_quiet():
 
 
 def lower(K: sp.spmatrix, s: np.ndarray | None = None, perm: np.ndarray | None = None) -> sp.csc_matrix:
-    """Lower triangle of ``(S K S)[perm][:, perm]``, ``S = diag(s)``, in O(nnz) (CSC)."""
+    """Lower triangle of ``(S K S)[perm][:, perm]``, ``S = diag(s)``, in O(nnz) (CSC); ``K``
+    symmetric. Without ``perm`` the entries are kept in ``K``'s own column order (no sort)."""
     K = sp.csc_matrix(K)
     n = K.shape[0]
     col = np.repeat(np.arange(n), np.diff(K.indptr))
     row = K.indices
-    if perm is not None:
-        inv = np.empty(n, dtype=np.int64)
-        inv[perm] = np.arange(n)
-        r, c = inv[row], inv[col]
-    else:
-        r, c = row, col
+    if perm is None:
+        keep = row >= col
+        data = K.data[keep]
+        if s is not None:
+            data = data * (s[row[keep]] * s[col[keep]])
+        indptr = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum(np.bincount(col[keep], minlength=n), out=indptr[1:])
+        out = sp.csc_matrix((data, row[keep], indptr), shape=(n, n))
+        out.has_sorted_indices = K.has_sorted_indices
+        return out
+    inv = np.empty(n, dtype=np.int64)
+    inv[perm] = np.arange(n)
+    r, c = inv[row], inv[col]
     keep = r >= c
     data = K.data[keep]
     if s is not None:
         data = data * s[row[keep]] * s[col[keep]]
     return sp.csc_matrix((data, (r[keep], c[keep])), shape=(n, n))
+
+
+def permute_lower(A: sp.csc_matrix, perm: np.ndarray) -> sp.csc_matrix:
+    """The lower triangle of ``P (A + Aᵀ − diag A) Pᵀ`` from the lower triangle ``A``."""
+    A = A.tocoo()
+    n = A.shape[0]
+    inv = np.empty(n, dtype=np.int64)
+    inv[perm] = np.arange(n)
+    r, c = inv[A.row], inv[A.col]
+    return sp.csc_matrix((A.data, (np.maximum(r, c), np.minimum(r, c))), shape=(n, n))
 
 
 class Cholesky:
@@ -105,6 +125,7 @@ class Cholesky:
         self.sym = None  # scikit-sparse: the analysis; cvxopt: the factor object itself
         self.F = None
         self.spent = False  # cvxopt: the numeric factor was handed to getfactor (no more solves)
+        self.given = None  # scikit-sparse: an order given to analyse (applied to A and b here)
         self._last = (None, None)  # cvxopt: the last matrix converted, and its conversion
 
     @property
@@ -121,6 +142,9 @@ class Cholesky:
         self._last = (A, out)
         return out
 
+    def _sk_matrix(self, A: sp.csc_matrix) -> sp.csc_matrix:
+        return A if self.given is None else permute_lower(A, self.given)
+
     def order(self, A: sp.csc_matrix) -> np.ndarray:
         """A fill-reducing (AMD) order of the pattern of ``A`` (lower triangle)."""
         if self.lib == "sksparse":
@@ -128,18 +152,25 @@ class Cholesky:
                 return _sk.analyze(A, mode="supernodal", ordering_method="amd").P()
         return np.array(_cvx_amd.order(self._cvx(A), uplo="L"), dtype=np.int64).ravel()
 
-    def analyse(self, A: sp.csc_matrix, natural: bool = False) -> None:
-        """Symbolic analysis of the pattern of ``A``: CHOLMOD's own ordering, or with
-        ``natural`` the order ``A`` comes in (for an order given by permuting ``A``)."""
+    def analyse(self, A: sp.csc_matrix, natural: bool = False, order: np.ndarray | None = None) -> None:
+        """Symbolic analysis of the pattern of ``A``: CHOLMOD's own ordering; with ``natural``
+        the order ``A`` comes in (for an order given by permuting ``A``); with ``order`` that
+        order, exactly (no postordering): the factor is of ``A[order][:, order]`` while the
+        solves take and give vectors in ``A``'s own order."""
         n = A.shape[0]
-        self.F, self.spent = None, False
+        self.F, self.spent, self.given = None, False, None
+        if order is not None:
+            order = np.asarray(order, dtype=np.int64)
         if self.lib == "sksparse":
+            self.given = order
             with _sk_quiet():
-                self.sym = _sk.analyze(A, mode="supernodal", ordering_method="natural" if natural else "default")
+                self.sym = _sk.analyze(self._sk_matrix(A), mode="supernodal",
+                                       ordering_method="natural" if (natural or order is not None) else "default")
             return
-        if natural:  # CHOLMOD would postorder even a given order
+        if natural or order is not None:  # CHOLMOD would postorder even a given order
+            p = np.arange(n, dtype=np.int64) if order is None else order
             with _cvx_options(nmethods=1, postorder=False):
-                self.sym = _cvx_cholmod.symbolic(self._cvx(A), p=_cvx_matrix(np.arange(n, dtype=np.int64)))
+                self.sym = _cvx_cholmod.symbolic(self._cvx(A), p=_cvx_matrix(p))
         else:
             self.sym = _cvx_cholmod.symbolic(self._cvx(A))
 
@@ -151,7 +182,7 @@ class Cholesky:
         if self.lib == "sksparse":
             try:
                 with _sk_quiet():
-                    self.F = self.sym.cholesky(A)
+                    self.F = self.sym.cholesky(self._sk_matrix(A))
             except _sk.CholmodNotPositiveDefiniteError as exn:
                 col = getattr(exn, "column", None)
                 raise SingularMatrixError(f"the matrix is not positive definite ({exn})", col) from exn
@@ -163,24 +194,60 @@ class Cholesky:
             raise SingularMatrixError(f"the matrix is not positive definite (CHOLMOD stopped at column {exn} "
                                       "of its elimination order)", col) from exn
         self.F, self.spent = self.sym, False
+        self._last = (None, None)  # the conversion is not needed any more
+
+    def _check(self) -> None:
+        if self.spent:
+            raise RuntimeError("this cvxopt factor was read by getfactor and no longer solves")
+
+    def _cvx_solve(self, b: np.ndarray, systems) -> np.ndarray:
+        b = np.asarray(b, dtype=float)
+        B = _cvx_matrix(b.reshape(b.shape[0], -1).copy())
+        for sys_ in systems:
+            _cvx_cholmod.solve(self.F, B, sys=sys_)
+        return np.array(B).reshape(b.shape)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """``A⁻¹ b`` for ``b`` of shape (n,) or (n, k) (the factor's permutation applied inside)."""
-        if self.spent:
-            raise RuntimeError("this cvxopt factor was read by getfactor and no longer solves")
+        self._check()
         if self.lib == "sksparse":
+            if self.given is not None:
+                x = np.empty_like(b, dtype=float)
+                with _sk_quiet():
+                    x[self.given] = self.F.solve_A(np.asarray(b, dtype=float)[self.given])
+                return x
             with _sk_quiet():
                 return self.F.solve_A(b)
-        b = np.asarray(b, dtype=float)
-        B = _cvx_matrix(b.reshape(b.shape[0], -1).copy())
-        _cvx_cholmod.solve(self.F, B)
-        return np.array(B).reshape(b.shape)
+        return self._cvx_solve(b, (0,))
+
+    def forward(self, b: np.ndarray) -> np.ndarray:
+        """``y = L⁻¹ P b`` (``A = Pᵀ L Lᵀ P``): half a solve, ``y`` in the factor's order."""
+        self._check()
+        if self.lib == "sksparse":
+            b = np.asarray(b, dtype=float)
+            with _sk_quiet():
+                pb = self.F.apply_P(b if self.given is None else b[self.given])
+                return self.F.solve_L(pb, use_LDLt_decomposition=False)
+        return self._cvx_solve(b, (7, 4))  # cvxopt's sys: 7 P, 4 L
+
+    def backward(self, y: np.ndarray) -> np.ndarray:
+        """``x = Pᵀ L⁻ᵀ y``: the other half; ``backward(forward(b)) = A⁻¹ b``."""
+        self._check()
+        if self.lib == "sksparse":
+            with _sk_quiet():
+                x = self.F.apply_Pt(self.F.solve_Lt(np.asarray(y, dtype=float), use_LDLt_decomposition=False))
+            if self.given is None:
+                return x
+            out = np.empty_like(x)
+            out[self.given] = x
+            return out
+        return self._cvx_solve(y, (5, 8))  # 5 Lᵀ, 8 Pᵀ
 
     def trailing(self, no: int) -> np.ndarray:
-        """The trailing block ``L[no:, no:]`` of the factor ``A = L Lᵀ``, dense (only meaningful
-        after a natural-order analysis). With cvxopt it is copied out of the factor, which then
-        still solves; only if that copy fails its check is the factor read by ``getfactor``
-        and spent."""
+        """The trailing block ``L[no:, no:]`` of the factor ``A = L Lᵀ`` (in the factor's order:
+        after a natural-order analysis or with a given order), dense. With cvxopt it is copied
+        out of the factor, which then still solves; only if that copy fails its check is the
+        factor read by ``getfactor`` and spent."""
         if self.lib == "sksparse":
             return self.F.L()[no:, no:].toarray()
         try:
@@ -200,19 +267,18 @@ class Cholesky:
         return out
 
     def _trailing_checks(self, T: np.ndarray, no: int) -> bool:
-        """A solve with the factor agrees with the block read: for ``x = A⁻¹ (0, v)``,
-        ``T Tᵀ x_trailing = v`` (the trailing block is the Schur complement's factor)."""
+        """The factor's own forward solve agrees with the block read: in the factor's order,
+        ``L⁻¹ (0, v) = (0, T⁻¹ v)`` (the trailing block is the Schur complement's factor)."""
         k = T.shape[0]
         if k == 0:
             return True
         if not np.all(np.isfinite(T)) or np.any(np.diagonal(T) <= 0):
             return False
-        n = no + k
         v = np.random.default_rng(0).standard_normal(k)
-        x = self.solve(np.concatenate([np.zeros(no), v]))[no:]
-        r = T @ (T.T @ x) - v
-        scale = np.abs(T) @ (np.abs(T.T) @ np.abs(x)) + np.abs(v)
-        return n > 0 and bool(np.all(np.abs(r) <= 1e-8 * scale.max()))
+        y = self._cvx_solve(np.concatenate([np.zeros(no), v]), (4,))  # cvxopt's sys 4: L alone
+        r = T @ y[no:] - v
+        scale = np.abs(T) @ np.abs(y[no:]) + np.abs(v)
+        return bool(np.all(np.abs(y[:no]) == 0) and np.all(np.abs(r) <= 1e-10 * scale.max()))
 
     def update(self, C: sp.csc_matrix, subtract: bool) -> None:
         """``A ± C Cᵀ`` in place (scikit-sparse)."""

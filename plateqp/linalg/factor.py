@@ -65,23 +65,31 @@ class Refined:
     def solve(self, b, refine: int = 3) -> np.ndarray:
         """Solve K x = b (b may have several columns), with up to ``refine`` refinement steps.
 
-        Refinement stops when the correction no longer halves or falls below ~eps·‖x‖
-        (the residual itself is at its rounding floor long before x stops improving).
+        A step is taken only while it still changes the answer: refinement converges linearly,
+        each correction about ρ times the one before (``ρ``: the last two corrections' ratio;
+        for the first, the correction against the solution itself, the solve's own error), so
+        it stops when the next correction is predicted below eps·‖x‖, when a correction falls
+        below ~eps·‖x‖, or when a correction no longer halves (the residual itself is at its
+        rounding floor long before x stops improving). On a 128² plate (cond ~1e8) one step
+        takes the forward error from 3e-9 to rounding; a second changes x by 1e-14 (noise).
         """
         b = np.asarray(b, dtype=float)
         x = self._raw(b)
         if b.ndim == 1:
             x = x.reshape(-1)
         eps = np.finfo(np.float64).eps
-        prev = np.inf
-        for _ in range(refine):
+        prev = np.linalg.norm(x, axis=0)  # the first "correction": x itself, from zero
+        for k in range(refine):
             dx = self._raw(self._residual(b, x))
             ndx = np.linalg.norm(dx, axis=0)
-            if np.all(ndx >= 0.5 * prev):  # no longer converging: keep x
+            if k and np.all(ndx >= 0.5 * prev):  # no longer converging: keep x
                 break
             x = x + dx
+            nx = np.linalg.norm(x, axis=0)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                nxt = np.where(prev > 0, ndx * ndx / prev, 0.0)  # the next correction, predicted
             prev = ndx
-            if np.all(ndx <= 4 * eps * np.linalg.norm(x, axis=0)):
+            if np.all((ndx <= 4 * eps * nx) | (nxt <= eps * nx)):
                 break
         return x
 

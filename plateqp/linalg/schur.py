@@ -16,8 +16,11 @@ at all. Measured on a 128² plate with 900 such unknowns: the contacts-last fact
 1.5 plain factorisations, where the 900 columns ``K⁻¹ B_iᵀ`` (each about 1/50 of a
 factorisation, even solved in blocks) would cost 18.
 
-The same factor solves with ``K`` (:meth:`SchurFactor.solve`) and with ``K_oo``
-(:meth:`SchurFactor.solve_others`, two solves with ``K``). A matrix that is only semidefinite
+The same factor solves with ``K`` (:meth:`SchurFactor.solve`), in halves for a caller that
+needs only the trailing part of one (:meth:`SchurFactor.forward`, :meth:`SchurFactor.backward`,
+and the dense ``trailing_forward``/``trailing_backward`` for vectors on ``l``), and with ``K_oo``
+(:meth:`SchurFactor.solve_others`, two solves with ``K``). The fill-reducing order (AMD on the
+rest) is handed to CHOLMOD with the matrix itself: one pass over ``K``, one conversion. A matrix that is only semidefinite
 but whose block ``K_oo`` is definite is factorised with ``shift`` added to the trailing
 diagonal (``S + shift·I`` is definite); :meth:`SchurFactor.schur` takes it off again.
 
@@ -114,12 +117,13 @@ class SchurFactor:
     def _by_trailing_block(self, lib: str) -> None:
         t0 = time.perf_counter()
         chol = Cholesky(lib)
-        order = chol.order(lower(self.K, self.s))
+        A = lower(self.K, self.s)  # one pass over K, one conversion: the order is given to CHOLMOD
+        order = chol.order(A)
         self.perm = np.concatenate([order[~self._mask[order]], self.last])
-        A = lower(self.K, self.s, self.perm)
         if self.shift:
-            A = A + sp.diags(np.concatenate([np.zeros(self.no), np.full(self.nl, self.shift)]), format="csc")
-        chol.analyse(A, natural=True)
+            A = A + sp.diags(np.where(self._mask, self.shift, 0.0), format="csc")
+            A.sort_indices()
+        chol.analyse(A, order=self.perm)
         t1 = time.perf_counter()
         chol.factor(A)
         t2 = time.perf_counter()
@@ -211,12 +215,51 @@ class SchurFactor:
     def _raw_full(self, b: np.ndarray) -> np.ndarray:
         """``K̂⁻¹ b`` with the factor itself (``K̂ = K`` + the shift on the trailing diagonal)."""
         t0 = time.perf_counter()
-        p = self.perm
-        s = self.s[p] if b.ndim == 1 else self.s[p][:, None]
-        x = np.empty_like(b, dtype=float)
-        x[p] = s * self.chol.solve(s * b[p])
+        s = self.s if b.ndim == 1 else self.s[:, None]
+        x = s * self.chol.solve(s * b)
         self._count(t0)
         return x
+
+    # the two halves of a solve with ``K = D⁻¹ Pᵀ L Lᵀ P D⁻¹`` (``D = diag(s)``), for a caller
+    # that needs only the trailing part of one half: ``y = L⁻¹ P D b`` is in the factor's order,
+    # its last ``nl`` entries belong to ``last``; ``(K⁻¹ b)_last = D_l L_ll⁻ᵀ y_l``
+
+    def forward(self, b: np.ndarray) -> np.ndarray:
+        """``y = L⁻¹ P D b`` (half a solve with ``K``; ``b`` of shape (n,))."""
+        self._usable()
+        t0 = time.perf_counter()
+        y = self.chol.forward(self.s * b)
+        self.stats["solve_s"] += time.perf_counter() - t0
+        self.stats["solves"] += 0.5
+        return y
+
+    def backward(self, y: np.ndarray) -> np.ndarray:
+        """``K⁻¹ b = D Pᵀ L⁻ᵀ y`` for ``y = forward(b)``."""
+        self._usable()
+        t0 = time.perf_counter()
+        x = self.s * self.chol.backward(y)
+        self.stats["solve_s"] += time.perf_counter() - t0
+        self.stats["solves"] += 0.5
+        return x
+
+    def trailing_forward(self, b_last: np.ndarray) -> np.ndarray:
+        """``forward(b)[no:]`` for a ``b`` that is zero off ``last`` (``b_last``: its values on
+        ``last``): ``L_ll⁻¹ D_l b_l``, a dense triangular solve; the rest of ``forward(b)`` is 0."""
+        return sla.solve_triangular(self.Lll, self.s[self.last] * b_last, lower=True, check_finite=False)
+
+    def trailing_backward(self, y_last: np.ndarray) -> np.ndarray:
+        """``(K⁻¹ b)[last]`` from ``forward(b)[no:]``: ``D_l L_ll⁻ᵀ y_l``, a dense triangular solve."""
+        return self.s[self.last] * sla.solve_triangular(self.Lll, y_last, lower=True, trans=1, check_finite=False)
+
+    @property
+    def can_split(self) -> bool:
+        """The factor solves in halves (:meth:`forward`, :meth:`backward`): CHOLMOD, unshifted,
+        not spent."""
+        return self.chol is not None and not self.chol.spent and not self.shift
+
+    def _usable(self) -> None:
+        if not self.can_split:
+            raise ValueError("forward/backward need this factor's own CHOLMOD factor, unshifted")
 
     def solve(self, b, refine: int = 0) -> np.ndarray:
         """``K⁻¹ b`` (``b`` of shape (n,) or (n, k)), with ``refine`` refinement steps. With the

@@ -9,6 +9,7 @@ else its contact set) go only to backends that take them (:data:`WARM_START_BACK
 
 from __future__ import annotations
 
+import contextlib
 import time
 import warnings
 from collections import OrderedDict
@@ -18,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..assembly import Model, build_model
+from ..contact.routing import repeated_solves
 from ..errors import NoEquilibriumError, PlateQPWarning
 from ..paths import set_param
 from ..post import NodalOperator, TriNodalOperator, nodal_operator
@@ -94,7 +96,7 @@ def solve_value(ctx: Context, value, warm=None):
         opts = dict(ctx.options or {})
         if warm is not None:
             opts["active"] = np.asarray(warm, dtype=bool)
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), (repeated_solves() if ctx.reuse else contextlib.nullcontext()):
             warnings.simplefilter("ignore", PlateQPWarning)  # the row's status says it
             res = solve(scene, backend=ctx.backend, formulation=ctx.formulation, accuracy=ctx.accuracy,
                         options=opts or None, model=model)

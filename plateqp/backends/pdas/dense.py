@@ -57,8 +57,35 @@ class DenseDual:
         self.M = M
         self.pb = pb
         self._dense_s = time.perf_counter() - t0
-        self.d = pb.g - B @ self.solve_K(pb.f)
+        self.Bc = B[:, c].tocsr()  # the rows on the trailing unknowns, in the factor's order of them
+        self.yf = self._forward(pb.f)
+        self.d = pb.g - self.Bc @ self._tail(self.yf)  # g − B K⁻¹ f: half a solve
         self._chol = None
+
+    # K⁻¹ in two halves where the factor allows (SchurFactor.forward / backward: the rows need
+    # only the trailing part of the first half); else "y" is the whole solution x = K⁻¹ b
+
+    def _forward(self, b: np.ndarray) -> np.ndarray:
+        return self.fac.forward(b) if self.fac.can_split else self.solve_K(b)
+
+    def _backward(self, y: np.ndarray) -> np.ndarray:
+        return self.fac.backward(y) if self.fac.can_split else y
+
+    def _tail(self, y: np.ndarray) -> np.ndarray:
+        """``(K⁻¹ b)`` on the trailing unknowns, from ``y = _forward(b)``."""
+        return self.fac.trailing_backward(y[self.fac.no:]) if self.fac.can_split else y[self.fac.last]
+
+    def _sub_rows(self, y: np.ndarray, BA, lam_A: np.ndarray) -> np.ndarray:
+        """``_forward(b − B_Aᵀ λ_A)`` from ``y = _forward(b)`` (``B_A`` on the trailing unknowns)."""
+        y = y.copy()
+        b_l = BA.T @ lam_A
+        if self.fac.can_split:  # L⁻¹ of a vector on the trailing unknowns only: a dense solve
+            y[self.fac.no:] -= self.fac.trailing_forward(b_l)
+        else:
+            full = np.zeros(self.fac.n)
+            full[self.fac.last] = b_l
+            y -= self.solve_K(full)
+        return y
 
     @property
     def stats(self) -> dict:
@@ -95,9 +122,9 @@ class DenseDual:
         ``r_u``, ``r_A``, ``v = K⁻¹ r_u``, ``M_AA δλ = r_A + B_A v``, ``δu = v − K⁻¹ B_Aᵀ δλ``."""
         pb = self.pb
         idx = np.flatnonzero(A)
-        BA = pb.B[idx]
+        BA, BcA = pb.B[idx], self.Bc[idx]
         lam = lam.copy()
-        u = self.solve_K(pb.f - BA.T @ lam[idx])
+        u = self._backward(self._sub_rows(self.yf, BcA, lam[idx]))  # K⁻¹ (f − B_Aᵀ λ_A): half a solve
         best = np.inf
         tiny = np.finfo(float).tiny
         for k in range(INNER_EXACT):
@@ -110,14 +137,14 @@ class DenseDual:
             if res == 0.0 or (k >= 1 and res > 0.5 * best):
                 break
             best = min(best, res)
-            v = self.solve_K(r_u)
+            y = self._forward(r_u)  # v = K⁻¹ (r_u − B_Aᵀ δλ): one solve in two halves
             if idx.size:
-                rhs = r_A + BA @ v
+                rhs = r_A + BcA @ self._tail(y)
                 dlam = (sla.cho_solve(self._chol, rhs, check_finite=False) if self._chol is not None
                         else np.linalg.lstsq(self.M[np.ix_(idx, idx)], rhs, rcond=None)[0])
-                v -= self.solve_K(BA.T @ dlam)
+                y = self._sub_rows(y, BcA, dlam)
                 lam[idx] += dlam
-            u += v
+            u += self._backward(y)
         return u, lam
 
 
