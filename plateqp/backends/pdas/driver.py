@@ -116,8 +116,9 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         kfac = None
         if settings["dual_start"] and A is None and not np.all(pb.rho * pb.k >= 1.0):
             kfac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
-        out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac)
-        stats = dict(fac.stats)
+        info: dict = {}
+        out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac, info)
+        stats = dict(fac.stats, **info)
         if kfac is not None:  # the factor of K alone (phase 1's line search) counts too
             for key, val in kfac.stats.items():
                 stats[key] += val

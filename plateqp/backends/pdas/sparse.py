@@ -411,7 +411,13 @@ def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndar
 
 
 def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter, p, steps,
-               kfac: SpringFactor | None = None) -> Outcome:
+               kfac: SpringFactor | None = None, info: dict | None = None) -> Outcome:
+    """The sparse method: a first phase where it applies (soft rows: :func:`newton_pcg`; stiff
+    rows with ``kfac``, a factor for ``K`` alone: :func:`dual_newton`), then exact steps.
+    ``info`` (a dict) receives ``first_phase`` ("newton", "dual" or "none") and
+    ``first_phase_steps``."""
+    info = {} if info is None else info
+    info.update(first_phase="none", first_phase_steps=0)
     ex = Exchange(p)
     u = np.zeros(pb.K.shape[0])
     lam = np.zeros(pb.m)
@@ -421,11 +427,13 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         u, A, newton = newton_pcg(pb, fac, W, sigma, steps)
         lam = np.where(A, W * (pb.B @ u - pb.g), 0.0)
         exact = True
+        info.update(first_phase="newton", first_phase_steps=newton)
     elif A is None and kfac is not None:  # stiff rows, cold start: phase 1 on the dual energy
         first = dual_newton(pb, fac, kfac, W, sigma, feas_tol, steps)
         if first is not None:
             u, lam, A, newton = first
             exact = True
+            info.update(first_phase="dual", first_phase_steps=newton)
     elif A is not None:
         exact = True  # a warm start is meant to be (nearly) right: solve it exactly at once
     A = np.ones(pb.m, dtype=bool) if A is None else A.copy()
