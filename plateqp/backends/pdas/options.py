@@ -69,9 +69,12 @@ ALPHA_MAX = 1e3
 #: from the lowest point met, the arc halved (down to ALPHA_MIN) until Armijo's sufficient
 #: decrease ARMIJO. It applies where two inverse iterations give K a Rayleigh quotient above
 #: DUAL_DEFINITE·σ (a held plate). A rise is one above DUAL_ROUNDING relative (rounding of ψ).
-#: It ends when the step of the free rows leaves at most NEWTON_SETTLED rows infeasible at
-#: LOOSE_TOL: the exact steps start from that set.
-DUAL_STEPS, DUAL_RISES, ARMIJO, ALPHA_MIN, DUAL_DEFINITE, DUAL_ROUNDING = 60, 3, 1e-4, 1e-4, 1e2, 1e-10
+#: It ends when the step of the free rows leaves at most max(NEWTON_SETTLED,
+#: NEWTON_SETTLED_FRACTION · m) rows infeasible at LOOSE_TOL: the exact steps start from that
+#: set (after DUAL_STEPS, from the set whose step left the fewest).
+DUAL_STEPS, DUAL_RISES, ARMIJO, ALPHA_MIN, DUAL_DEFINITE, DUAL_ROUNDING = 60, 8, 1e-4, 1e-4, 1e2, 1e-9
+#: ... or when three steps in a row changed ψ by at most DUAL_FLAT relative.
+DUAL_FLAT = 1e-7
 #: (condensed) A trailing pivot L_ii² below this (K equilibrated to a unit diagonal) means K is
 #: singular to working precision (a floating plate): the sparse method takes over.
 PIVOT_TOL = 1e-13

@@ -18,6 +18,7 @@ from .options import (
     ARMIJO,
     DOWNDATE_LOSS,
     DUAL_DEFINITE,
+    DUAL_FLAT,
     DUAL_RISES,
     DUAL_ROUNDING,
     DUAL_STEPS,
@@ -369,6 +370,9 @@ def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndar
     psi = 0.0  # ψ(0)
     best = (psi, lam, u)  # the lowest ψ met so far, and where
     rises = 0  # full steps that raised ψ
+    flat = 0  # steps in a row that left ψ as it was
+    nearest = (pb.m + 1, u, lam, None)  # the step that left the fewest rows infeasible
+    settled = max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION * pb.m)
     for k in range(1, DUAL_STEPS + 1):
         monotone = rises > DUAL_RISES
         gap = g + rho * lam - B @ u
@@ -379,7 +383,9 @@ def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndar
             return None
         neg = step.lam < 0
         bad = infeasible(pb, F, step.lam, g + rho * step.lam - B @ step.u, LOOSE_TOL)
-        if bad.sum() <= NEWTON_SETTLED:  # a few rows from the answer: the exact steps finish
+        if bad.sum() < nearest[0]:
+            nearest = (int(bad.sum()), step.u, step.lam, F)
+        if bad.sum() <= settled:  # a few rows from the answer: the exact steps finish
             if steps is not None:
                 steps.append({"step": f"dual {k}", "active": int(F.sum()), "infeasible": int(bad.sum()),
                               "solve": "loose", "solves": step.solves})
@@ -401,13 +407,16 @@ def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndar
             steps.append({"step": f"dual {k}", "active": int(F.sum()), "infeasible": int(bad.sum()),
                           "solve": "loose", "solves": step.solves, "alpha": alpha, "energy": pt})
         rises += pt > psi + DUAL_ROUNDING * abs(psi)
+        flat = flat + 1 if abs(pt - psi) <= DUAL_FLAT * abs(pt) else 0
         psi = pt
+        if flat >= 3:  # ψ no longer moves: what is left is rows of (nearly) no force, for the exact steps
+            return u, lam, (lam > 0) | (g + rho * lam - B @ u <= 0), k
         if pt < best[0]:
             best = (pt, lam, u)
         if rises > DUAL_RISES and not monotone:  # from now on monotone, from the lowest point met
             psi, lam, u = best
-    A = (lam > 0) | (g + rho * lam - B @ u < 0)
-    return u, lam, A, DUAL_STEPS
+    _, u, lam, F = nearest  # not settled within DUAL_STEPS: the exact steps start from the nearest set
+    return u, lam, F, DUAL_STEPS
 
 
 def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter, p, steps,
