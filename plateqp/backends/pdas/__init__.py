@@ -117,6 +117,20 @@ When a Newton step changes few rows (``NEWTON_SETTLED``), the factor is rebuilt 
 active set and exact steps finish as above. On the 128 × 128 bed: three Newton steps, 13 PCG
 iterations, then one exact step and two updated rows.
 
+Stiff rows (rigid posts) on a held plate, cold start: plain PDAS from the two-sided start
+cycles and falls back to Murty's one row per step (a 64 × 64 slab with 45 × 45 posts: 407
+steps, each a refactorisation). So a first phase finds the contact by projected Newton on the
+dual energy ``ψ(λ) = ½λᵀMλ + dᵀλ`` over ``λ ≥ 0`` (Bertsekas 1982; :func:`.sparse.dual_newton`),
+``M`` never formed: from ``λ = 0`` each step solves the active set ``F = {λ > 0} ∪ {gap ≤ 0}``
+(the Newton step of ``ψ`` on that face) and clips its negative reactions to zero; ``ψ`` and
+the gaps at a clipped point take one solve with a second factor, of ``K`` alone. Full steps
+are taken until ``DUAL_RISES`` of them have raised ``ψ``; then monotone steps (the arc
+searched back to Armijo's decrease) from the lowest point met. It hands its set to the exact
+steps when a step leaves few rows infeasible or ``ψ`` stops moving (same slab: 21 steps in
+all). It needs ``K`` definite (two inverse iterations tell; a floating plate keeps plain
+PDAS); option ``dual_start=False`` turns it off. ``extras["first_phase"]`` says which first
+phase ran ("newton", "dual" or "none") and ``extras["first_phase_steps"]`` its steps.
+
 Singular steps and no equilibrium (sparse method)
 -------------------------------------------------
 If the active rows do not hold a floating plate, the refinement's first correction is
@@ -139,11 +153,12 @@ floating plates to the sparse one.
 Warm start and output
 ---------------------
 Option ``active`` (bool array over the rows of ``G``) gives the first active set (default:
-the rows the unsupported plate would press into, ``d < 0``, for the condensed method; every
-row, the two-sided problem, for the sparse one); ``extras["active"]`` holds the final set,
+the rows the unsupported plate would press into, ``d < 0``, for the condensed method; for
+the sparse one, the set its first phase finds, or every row, the two-sided problem, where no
+first phase applies); ``extras["active"]`` holds the final set,
 so a sweep can warm start each solve from the previous one. ``x`` (``u`` with the eliminated
 variables restored), ``z = λ ≥ 0`` (one per row of ``G``, the qpsolvers sign convention),
-``iterations`` (active sets solved, Newton steps of the first phase included),
+``iterations`` (active sets solved, the steps of the first phase included),
 ``solve_time``; ``extras`` has the method and the counts and times of the linear algebra
 (``extras["trace"]`` each step, with option ``trace``).
 

@@ -82,6 +82,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     p = _option(settings, "p", lambda v: _is_int(v, 0), "an integer ≥ 0")
     max_dense = _option(settings, "max_dense", lambda v: _is_int(v, 0), "an integer ≥ 0")
     max_rows = _option(settings, "max_rows", lambda v: _is_int(v, 1), "a positive integer")
+    _option(settings, "dual_start", lambda v: isinstance(v, (bool, np.bool_)), "True or False")
     if not isinstance(trace, (bool, np.bool_)):
         raise ProblemError(f"option trace must be True or False, got {trace!r}")
 
@@ -112,8 +113,16 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     if out is None:
         W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k))
         fac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
-        out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps)
-        extras.update(method="sparse", factor=fac.method, **fac.stats)
+        kfac = None
+        if settings["dual_start"] and A is None and not np.all(pb.rho * pb.k >= 1.0):
+            kfac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
+        info: dict = {}
+        out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac, info)
+        stats = dict(fac.stats, **info)
+        if kfac is not None:  # the factor of K alone (phase 1's line search) counts too
+            for key, val in kfac.stats.items():
+                stats[key] += val
+        extras.update(method="sparse", factor=fac.method, **stats)
 
     extras["active"] = out.A.copy()
     if steps is not None:

@@ -31,8 +31,11 @@ ACCURACY: dict[str, dict[str, float]] = {
 #: ``p``          block exchanges allowed without progress before Murty's single exchange.
 #: ``max_rows``   refuse a ``G`` with more rows than ``min(n, max_rows)``.
 #: ``max_iter``   active sets solved before ``Status.MAX_ITER``; default 50 + 2 m.
+#: ``dual_start`` (sparse, stiff rows, cold start) find the active set first by projected Newton
+#:                on the dual energy (:func:`.sparse.dual_newton`); False: plain PDAS from the
+#:                two-sided problem (every row active).
 SETTINGS: dict = {"method": "auto", "max_dense": 2000, "penalty": 1e8, "prox": 1e-12, "factor": "auto",
-                  "p": 3, "max_rows": 100_000, "max_iter": None}
+                  "p": 3, "max_rows": 100_000, "max_iter": None, "dual_start": True}
 
 #: Keys accepted in the ``options`` dict of :func:`solve`.
 OPTIONS = ("active", "trace") + tuple(SETTINGS) + tuple(ACCURACY["default"])
@@ -61,6 +64,17 @@ NEWTON_STEPS, PCG_TOL, PCG_MAX = 8, 5e-2, 30
 NEWTON_SETTLED, NEWTON_SETTLED_FRACTION, NEWTON_BUDGET = 10, 2e-3, 3.0
 #: The line search looks for the minimum up to this step length.
 ALPHA_MAX = 1e3
+#: (sparse, stiff rows) Phase 1, projected Newton on the dual energy: at most DUAL_STEPS steps.
+#: Full (projected) steps until DUAL_RISES of them have raised the energy; then monotone steps
+#: from the lowest point met, the arc halved (down to ALPHA_MIN) until Armijo's sufficient
+#: decrease ARMIJO. It applies where two inverse iterations give K a Rayleigh quotient above
+#: DUAL_DEFINITE·σ (a held plate). A rise is one above DUAL_ROUNDING relative (rounding of ψ).
+#: It ends when the step of the free rows leaves at most max(NEWTON_SETTLED,
+#: NEWTON_SETTLED_FRACTION · m) rows infeasible at LOOSE_TOL: the exact steps start from that
+#: set (after DUAL_STEPS, from the set whose step left the fewest).
+DUAL_STEPS, DUAL_RISES, ARMIJO, ALPHA_MIN, DUAL_DEFINITE, DUAL_ROUNDING = 60, 8, 1e-4, 1e-4, 1e2, 1e-9
+#: ... or when three steps in a row changed ψ by at most DUAL_FLAT relative.
+DUAL_FLAT = 1e-7
 #: (condensed) A trailing pivot L_ii² below this (K equilibrated to a unit diagonal) means K is
 #: singular to working precision (a floating plate): the sparse method takes over.
 PIVOT_TOL = 1e-13

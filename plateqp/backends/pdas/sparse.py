@@ -1,6 +1,7 @@
 r"""The sparse method: a factor of ``K + σ diag(K) + B_Aᵀ W_A B_A`` kept current as the active
-set changes, exact steps by refinement, and (soft rows) a Newton–PCG first phase (see the
-package docstring: "Two ways to solve a step", "Singular steps and no equilibrium")."""
+set changes, exact steps by refinement, and a first phase: Newton–PCG for soft rows, projected
+Newton on the dual energy for stiff rows on a held plate (see the package docstring: "Two ways
+to solve a step", "Singular steps and no equilibrium")."""
 
 from __future__ import annotations
 
@@ -14,7 +15,14 @@ from ...linalg import Cholesky, Factor, bindings
 from ..base import Status
 from .options import (
     ALPHA_MAX,
+    ALPHA_MIN,
+    ARMIJO,
     DOWNDATE_LOSS,
+    DUAL_DEFINITE,
+    DUAL_FLAT,
+    DUAL_RISES,
+    DUAL_ROUNDING,
+    DUAL_STEPS,
     FREE_MOTIONS,
     FREE_SHARPEN,
     FREE_WORK,
@@ -323,7 +331,103 @@ def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, st
     return u, A, k + 1
 
 
-def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter, p, steps) -> Outcome:
+def _dual_energy(pb: ReducedQP, uf: np.ndarray, lam: np.ndarray, u: np.ndarray) -> float:
+    """``ψ(λ) = ½λᵀMλ + dᵀλ`` from ``u = K⁻¹(f − Bᵀλ)`` and ``u_f = K⁻¹f`` (no ``M``):
+    ``−½ (Bᵀλ)ᵀ(u_f + u) + ½ λᵀρλ + gᵀλ``."""
+    return float(-0.5 * (pb.B.T @ lam) @ (uf + u) + 0.5 * lam @ (pb.rho * lam) + pb.g @ lam)
+
+
+def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndarray, sigma: float,
+                feas_tol: float, steps) -> tuple | None:
+    """Phase 1 of the sparse method for stiff rows on a held plate: projected Newton on the
+    dual energy ``ψ(λ) = ½λᵀMλ + dᵀλ`` over ``λ ≥ 0`` (Bertsekas 1982), ``M`` never formed.
+
+    From ``λ = 0`` (the plate without its rows), each step takes the free rows
+    ``F = {λ_i > 0} ∪ {gap_i ≤ 0}`` (the others, ``λ_i = 0`` with an open gap, stay at zero),
+    solves the step of active set ``F`` (the Newton step of ``ψ`` on that face; the factor of
+    ``H_F`` as in the exact steps) and projects its reactions onto ``λ ≥ 0``. Where the
+    projection clips nothing the step is the minimiser of ``ψ`` on the face and is taken;
+    otherwise the projected arc is searched back from its full length until ``ψ`` falls
+    (Armijo), each trial one solve with the factor of ``K`` alone (``kfac``: the
+    displacements ``K⁻¹(f − Bᵀλ)`` and the gaps, the gradient of ``ψ``). ``ψ`` falls at every
+    step, so no active set comes back: this replaces plain PDAS's block exchanges, which
+    cycle on a plate's many stiff rows (its condensed stiffness is not an M-matrix), and
+    Murty's one-row-per-step way out. It ends when a step clips nothing and no zero row has
+    a negative gap (the exact steps then confirm the set), or after :data:`DUAL_STEPS` steps.
+
+    Returns ``(u, λ, A, steps)``, or None where it does not apply: ``K`` singular (a floating
+    plate, recognised by inverse iteration as in the exact steps) or a step that the active
+    rows do not hold.
+    """
+    B, g, rho, f = pb.B, pb.g, pb.rho, pb.f
+    kfac.set(np.zeros(pb.m))
+    uf = kfac.solve(f)
+    v = kfac.solve(pb.Kd * np.cos(np.arange(uf.size)))  # two inverse iterations: the softest mode of K
+    v = kfac.solve(pb.Kd * v)
+    if float(v @ (pb.K @ v)) < DUAL_DEFINITE * sigma * float(v @ (pb.Kd * v)):
+        return None  # K (nearly) singular: a floating plate, left to the exact steps
+    lam = np.zeros(pb.m)
+    u = uf.copy()
+    psi = 0.0  # ψ(0)
+    best = (psi, lam, u)  # the lowest ψ met so far, and where
+    rises = 0  # full steps that raised ψ
+    flat = 0  # steps in a row that left ψ as it was
+    nearest = (pb.m + 1, u, lam, None)  # the step that left the fewest rows infeasible
+    settled = max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION * pb.m)
+    for k in range(1, DUAL_STEPS + 1):
+        monotone = rises > DUAL_RISES
+        gap = g + rho * lam - B @ u
+        F = (lam > 0) | (gap <= 0)
+        fac.set(np.where(F, W, 0.0))
+        step = solve_active(pb, fac, W, F, u, lam, sigma, exact=False)
+        if step.ray is not None:
+            return None
+        neg = step.lam < 0
+        bad = infeasible(pb, F, step.lam, g + rho * step.lam - B @ step.u, LOOSE_TOL)
+        if bad.sum() < nearest[0]:
+            nearest = (int(bad.sum()), step.u, step.lam, F)
+        if bad.sum() <= settled:  # a few rows from the answer: the exact steps finish
+            if steps is not None:
+                steps.append({"step": f"dual {k}", "active": int(F.sum()), "infeasible": int(bad.sum()),
+                              "solve": "loose", "solves": step.solves})
+            return step.u, step.lam, F, k
+        dirn = step.lam - lam
+        alpha = 1.0
+        while True:
+            lt = np.maximum(0.0, lam + alpha * dirn)
+            if alpha == 1.0 and not neg.any():  # the step itself: its displacements are at hand
+                ut = step.u
+            else:
+                ut = kfac.solve(f - B.T @ lt)
+            pt = _dual_energy(pb, uf, lt, ut)
+            if not monotone or pt <= psi + ARMIJO * float(gap @ (lt - lam)) or alpha < ALPHA_MIN:
+                break
+            alpha *= 0.5
+        lam, u = lt, ut
+        if steps is not None:
+            steps.append({"step": f"dual {k}", "active": int(F.sum()), "infeasible": int(bad.sum()),
+                          "solve": "loose", "solves": step.solves, "alpha": alpha, "energy": pt})
+        rises += pt > psi + DUAL_ROUNDING * abs(psi)
+        flat = flat + 1 if abs(pt - psi) <= DUAL_FLAT * abs(pt) else 0
+        psi = pt
+        if flat >= 3:  # ψ no longer moves: what is left is rows of (nearly) no force, for the exact steps
+            return u, lam, (lam > 0) | (g + rho * lam - B @ u <= 0), k
+        if pt < best[0]:
+            best = (pt, lam, u)
+        if rises > DUAL_RISES and not monotone:  # from now on monotone, from the lowest point met
+            psi, lam, u = best
+    _, u, lam, F = nearest  # not settled within DUAL_STEPS: the exact steps start from the nearest set
+    return u, lam, F, DUAL_STEPS
+
+
+def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter, p, steps,
+               kfac: SpringFactor | None = None, info: dict | None = None) -> Outcome:
+    """The sparse method: a first phase where it applies (soft rows: :func:`newton_pcg`; stiff
+    rows with ``kfac``, a factor for ``K`` alone: :func:`dual_newton`), then exact steps.
+    ``info`` (a dict) receives ``first_phase`` ("newton", "dual" or "none") and
+    ``first_phase_steps``."""
+    info = {} if info is None else info
+    info.update(first_phase="none", first_phase_steps=0)
     ex = Exchange(p)
     u = np.zeros(pb.K.shape[0])
     lam = np.zeros(pb.m)
@@ -333,6 +437,13 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         u, A, newton = newton_pcg(pb, fac, W, sigma, steps)
         lam = np.where(A, W * (pb.B @ u - pb.g), 0.0)
         exact = True
+        info.update(first_phase="newton", first_phase_steps=newton)
+    elif A is None and kfac is not None:  # stiff rows, cold start: phase 1 on the dual energy
+        first = dual_newton(pb, fac, kfac, W, sigma, feas_tol, steps)
+        if first is not None:
+            u, lam, A, newton = first
+            exact = True
+            info.update(first_phase="dual", first_phase_steps=newton)
     elif A is not None:
         exact = True  # a warm start is meant to be (nearly) right: solve it exactly at once
     A = np.ones(pb.m, dtype=bool) if A is None else A.copy()
