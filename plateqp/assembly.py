@@ -400,7 +400,7 @@ def _rigid_modes(model: Model) -> np.ndarray:
                 rows.append([0.0, 0.0, 1.0])
         R = np.array(rows).reshape(-1, 3)
         # null space of the constraints on (α, β, γ)
-        _, s, vt = np.linalg.svd(R if len(R) else np.zeros((1, 3)))
+        _, s, vt = np.linalg.svd(R if len(R) else np.zeros((1, 3)), full_matrices=len(R) < 3)  # vt 3 × 3
         s_full = np.zeros(3)
         s_full[: len(s)] = s
         null = vt[s_full <= 1e-10 * max(1.0, s_full.max())]

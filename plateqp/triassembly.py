@@ -235,7 +235,7 @@ def _rigid_modes(model: TriModel) -> np.ndarray:
         R[kind == 0] = np.column_stack([np.ones((kind == 0).sum()), xy[node[kind == 0]]])
         R[kind == 1, 1] = 1.0
         R[kind == 2, 2] = 1.0
-        _, s, vt = np.linalg.svd(R if len(R) else np.zeros((1, 3)))
+        _, s, vt = np.linalg.svd(R if len(R) else np.zeros((1, 3)), full_matrices=len(R) < 3)  # vt 3 × 3
         s_full = np.zeros(3)
         s_full[: len(s)] = s
         nodes = np.flatnonzero(label == comp)

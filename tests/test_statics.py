@@ -201,3 +201,21 @@ def test_an_open_support_is_not_in_contact_because_another_settles_far():
             np.testing.assert_allclose(res.reactions[:4], P / 4, rtol=1e-6)
             assert abs(res.reactions[4]) <= 1e-9 * P and res.gaps[4] > 0.9e-5, (backend, res.gaps)
             assert list(res.active) == [True] * 4 + [False] * (1 + len(far)), (backend, far, res.active)
+
+
+@pytest.mark.parametrize("rows", [0, 1, 2, 3, 5000])
+def test_null_space_of_tall_and_short_constraint_sets(rows):
+    """settle's null space of the loaded supports' rigid-motion rows: A N = 0, N orthonormal, of
+    dimension 3 − rank, whether A has fewer rows than 3 or thousands (a bed's nodes)."""
+    from plateqp.contact.statics import _null_space
+
+    rng = np.random.default_rng(rows)
+    xy = rng.uniform(0.0, 1.0, (rows, 2))
+    A = np.column_stack([np.ones(rows), xy])  # w = a + b x + c y at each row's point
+    if rows == 2:
+        A[1] = 2.0 * A[0]  # dependent: rank 1
+    N = _null_space(A, 3)
+    rank = np.linalg.matrix_rank(A) if rows else 0
+    assert N.shape == (3, 3 - rank)
+    np.testing.assert_allclose(A @ N, 0.0, atol=1e-12 * max(1.0, rows))
+    np.testing.assert_allclose(N.T @ N, np.eye(3 - rank), atol=1e-12)
