@@ -51,7 +51,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # b
 
 import argparse
 import csv
-import re
 import statistics
 import sys
 import time
@@ -71,6 +70,7 @@ from plateqp.studies.sweep import sweep
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 from bench_contact import run_in_subprocess
+from bench_scaling import _status_kb  # (VmRSS, VmHWM) from /proc/self/status
 
 KKT_KEYS = ("stationarity", "spring", "primal", "dual", "complementarity", "natural")
 OTHERS = ("clarabel", "qpsolvers:piqp", "qpsolvers:proxqp", "qpsolvers:scs", "osqp")
@@ -180,12 +180,6 @@ def goal_row(kind: str, n: int, repeat: int) -> dict:
 # ----------------------------------------------------------------------------- memory, in a fresh interpreter
 
 
-def _status_kb():
-    try:
-        s = open("/proc/self/status").read()
-        return tuple(int(re.search(k + r":\s+(\d+)", s).group(1)) for k in ("VmRSS", "VmHWM"))
-    except (OSError, AttributeError):
-        return None
 
 
 def _reset_peak() -> bool:
