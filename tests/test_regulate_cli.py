@@ -109,3 +109,28 @@ def test_supports_are_numbered_from_one(capsys, corners, tmp_path):
     code, stdout, err = run(capsys, "solve", out, "--json", "--accuracy", "high")
     # supports 1 and 3 (opposite corners) carry 300; statics leaves 200 for 2 and 4
     np.testing.assert_allclose(json.loads(stdout)["reactions"], [300, 200, 300, 200], rtol=1e-9)
+
+
+def test_regulate_reports_the_shim_tolerance(tmp_path, capsys):
+    """--json's shim_sensitivity (dR_i/dg0_j among the regulated supports, from the active set)
+    against finite differences: the regulated scene re-solved with one shim thinner."""
+    import plateqp as pq
+    from plateqp.paths import set_param
+
+    out = tmp_path / "reg.toml"
+    rc = main(["regulate", "heave", "--target", "11000", "--supports", "12,13,17,18", "--json",
+               "--out", str(out)])
+    d = json.loads(capsys.readouterr().out)
+    assert rc == 0 and d["shim_sensitivity_note"] is None
+    S = np.array(d["shim_sensitivity"])
+    assert S.shape == (4, 4)
+    sc = pq.Scene.from_toml(out)
+    idx = [11, 12, 16, 17]
+    base = pq.solve(sc, accuracy="high").reactions[idx]
+    gaps = np.array([s.gap for s in sc.supports])
+    h = 1e-5  # cm
+    for j, k in enumerate(idx):
+        g = gaps.copy()
+        g[k] += h
+        fd = (pq.solve(set_param(sc, "supports.*.gap", g), accuracy="high").reactions[idx] - base) / h
+        np.testing.assert_allclose(S[:, j], fd, rtol=1e-6, atol=1e-6 * np.abs(S).max())

@@ -19,6 +19,23 @@ from ..progress import Progress
 from .common import _options, _backend_name, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, _numbers
 
 
+def _shim_sensitivity(check, supports) -> tuple[np.ndarray | None, str | None]:
+    """dR_i/dg0_j among the regulated supports at the regulated scene (:func:`plateqp.sensitivity`,
+    from its active set): how much a shim error moves the reactions. Where a support sits at
+    lift-off the derivative as the gap grows (a shim too thin), said in the note."""
+    from ..errors import PlateQPError as _Err
+    from ..sensitivity import sensitivity
+
+    try:
+        s = sensitivity(check, "gaps")
+    except _Err as e:  # e.g. an active set that leaves a rigid motion free: no unique answer
+        return None, f"not available ({e})"
+    idx = np.asarray(supports, dtype=int)
+    note = None if s.smooth else ("a support is at lift-off: the derivative as the gap grows (a shim too thin); "
+                                  "as it shrinks the slope differs")
+    return s.increasing.reactions[np.ix_(idx, idx)], note
+
+
 def cmd_regulate(args) -> int:
     """Gaps that make the chosen supports carry the target reactions, checked by solving the
     regulated scene (:func:`plateqp.studies.regulate_gaps`)."""
@@ -48,6 +65,7 @@ def cmd_regulate(args) -> int:
         check = solve(reg.scene, backend=args.backend, formulation=args.formulation, accuracy="high")
         bar.update()
     got = check.reactions[reg.supports]
+    shim, shim_note = _shim_sensitivity(check, reg.supports)
     scale = max(float(np.abs(reg.reactions).max(initial=0.0)), float(np.abs(check.reactions).max(initial=0.0)), 1e-300)
     error = float(np.abs(got - reg.reactions).max(initial=0.0) / scale)
     ok = check.status == Status.OPTIMAL and error <= 1e-6
@@ -60,7 +78,9 @@ def cmd_regulate(args) -> int:
     if args.json:
         print(json.dumps({"scene": scene.name, "reachable": reg.reachable, "projection": reg.projection,
                           "status": check.status.value, "check_error": error, "supports": rows,
-                          "gaps": [float(g) for g in reg.gaps], "out": args.out}, indent=1))
+                          "gaps": [float(g) for g in reg.gaps], "out": args.out,
+                          "shim_sensitivity": None if shim is None else shim.tolist(),
+                          "shim_sensitivity_note": shim_note}, indent=1))
     else:
         print(f"{scene.name}: gaps for {len(rows)} regulated supports (numbers from 1)")
         print(f"{'support':>7} {'gap before':>12} {'gap':>12} {'target R':>12} {'R':>12} {'R check':>12}")
@@ -69,6 +89,13 @@ def cmd_regulate(args) -> int:
                   f"{r['reaction']:12.5g} {r['reaction_check']:12.5g}")
         print(f"check: {check.status.value}, reactions within {error:.1e} of the regulated ones"
               + (f"; the regulated scene is in {args.out}" if args.out else ""))
+        if shim is not None and shim.size:
+            i, j = np.unravel_index(np.abs(shim).argmax(), shim.shape)
+            print(f"shim tolerance: a gap error d under support {reg.supports[j] + 1} changes the reaction of "
+                  f"support {reg.supports[i] + 1} by {shim[i, j]:.4g} x d, the largest of dR_i/dg0_j among the "
+                  "regulated supports (--json: shim_sensitivity)")
+        elif shim_note:
+            print(f"shim tolerance: {shim_note}")
     if not reg.reachable:
         print(f"plateqp: regulate: the target is not in equilibrium with the load: the nearest reachable "
               f"reactions are used (relative distance {reg.projection:.2e})", file=sys.stderr)
