@@ -197,7 +197,6 @@ def main(argv=None) -> int:
             else HERE / "results" / "discretisation-elements.csv"
         elements_study(meshes, args.reps, out)
         return 0
-    import plateqp as pq
     from plateqp.studies import auto_tolerance
     from plateqp.families import family
 

@@ -111,8 +111,8 @@ def main():
                 cases.append((name, n, k, b, float(acc)))
     out = HERE / "results" / f"many_contacts-{n}{'-' + a.tag if a.tag else ''}.csv"
     rows = []
-    print(f"| scene | k | contacts | backend | accuracy | CPU s | iterations | factorisations | method | "
-          f"KKT max | ok | status |\n|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
+    print("| scene | k | contacts | backend | accuracy | CPU s | iterations | factorisations | method | "
+          "KKT max | ok | status |\n|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     for name, n_, k, b, acc in cases:
         res = run_in_subprocess(_run, (name, n_, k, b, acc, a.repeat), a.timeout)
         row = {"mesh": n_, "scene": "bed" if name == "bed" else "grid_rigid", "k": "" if k is None else k,

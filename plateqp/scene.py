@@ -395,7 +395,7 @@ class Scene:
                 check_polygon_region(self, grid)
             elif f.region is not None:
                 if not isinstance(f.region, (list, tuple)) or len(f.region) != 4:
-                    self._fail("foundation.region", f"must be [x0, x1, y0, y1]" + (" or { polygon = [[x, y], ...] }"
+                    self._fail("foundation.region", "must be [x0, x1, y0, y1]" + (" or { polygon = [[x, y], ...] }"
                                if self.triangles else "") + f" (got {_short(f.region)})")
                 for j, v in enumerate(f.region):
                     self._num(f"foundation.region.{j}", v)

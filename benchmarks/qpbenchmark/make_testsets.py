@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from plateqp.io import write_qpbenchmark
-from plateqp.io.graded import FORMS, GAP_PATTERNS, MESHES, SUPPORT_KINDS, graded_problems
+from plateqp.io.graded import FORMS, GAP_PATTERNS, MESHES, graded_problems
 
 HERE = Path(__file__).resolve().parent
 #: the time limit (s) of every settings in the qpbenchmark run (its default is 10 s)

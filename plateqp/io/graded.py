@@ -32,7 +32,6 @@ condensed and dual matrices are dense (n − 1)² × (n − 1)²: 126 MB at 64²
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Iterator
 
 import numpy as np
