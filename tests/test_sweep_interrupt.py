@@ -85,6 +85,7 @@ def run_and_interrupt(tmp_path: Path, workers: int, sig: int, extra=()):
            "--range", f"0:1e-3:{N}", "--no-refine", "--workers", str(workers), *extra]
     env = dict(os.environ, PYTHONPATH=str(Path(pq.__file__).parents[1]))
     env.pop("PLATEQP_DEBUG", None)
+    env.pop("CI", None)  # an interactive terminal: CI=true hides the progress counter this waits for
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=slave, stdin=subprocess.DEVNULL, env=env,
                          start_new_session=True)
     os.close(slave)
