@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -168,6 +169,15 @@ def mesh_domain(domain: Domain, size: float, points=(), lines=()) -> TriMesh:
     they lie on); a point at a polygon vertex is that vertex. Duplicates are merged. A line must
     lie inside the plate (:func:`plateqp.geometry.inner_segments`); its ends may touch the boundary.
     """
+    with _GMSH_LOCK:  # gmsh is one global session: one mesh at a time (threaded executors)
+        return _mesh_domain(domain, size, points, lines)
+
+
+#: gmsh keeps one global session and model list: two threads meshing at once would clash.
+_GMSH_LOCK = threading.RLock()
+
+
+def _mesh_domain(domain: Domain, size: float, points=(), lines=()) -> TriMesh:
     gmsh = import_gmsh()
     owner = not gmsh.isInitialized()
     if owner:

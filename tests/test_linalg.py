@@ -11,6 +11,8 @@ closed forms and the exact condensed stiffness it bounds.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -276,3 +278,35 @@ def test_row_stiffness_closed_forms_and_bound():
     assert np.allclose(row_stiffness(K, B, rho=rho), ray / (1 + rho * ray), rtol=1e-14)
     with pytest.raises(ValueError):
         row_stiffness(K, B, "trace")
+
+
+def test_cvxopt_options_are_not_left_changed_by_two_threads():
+    """cvxopt's CHOLMOD options are one global dict. Two threads in ``_cvx_options`` at once
+    left it changed (nmethods=1: every later analysis without a given order failed in that
+    process, as after a threaded Dask cluster). The lock makes the second wait for the first."""
+    import threading
+
+    from plateqp.linalg import cholmod as ch
+
+    if not ch.HAVE_CVXOPT:
+        pytest.skip("cvxopt is not installed")
+    before = dict(ch._cvx_cholmod.options)
+    a_in, a_out = threading.Event(), threading.Event()
+
+    def first():
+        with ch._cvx_options(nmethods=1, postorder=False):
+            a_in.set()
+            time.sleep(0.3)  # the second thread tries to enter meanwhile
+        a_out.set()
+
+    def second():
+        a_in.wait(5)
+        with ch._cvx_options(nmethods=1, postorder=False):
+            a_out.wait(2)  # without the lock: inside while the first restores, then restores its copy
+
+    threads = [threading.Thread(target=first), threading.Thread(target=second)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(10)
+    assert dict(ch._cvx_cholmod.options) == before

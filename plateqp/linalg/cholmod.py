@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import threading
 import warnings
 
 import numpy as np
@@ -35,9 +36,36 @@ try:  # optional, faster where it installs
 except Exception:  # pragma: no cover - depends on the machine
     HAVE_SKSPARSE = False
 
+#: cvxopt's CHOLMOD keeps one global workspace (its ``Common``) and one global options dict, so
+#: two threads in it at once (a Dask cluster of threads, a thread pool) corrupt each other:
+#: measured, a threaded LocalCluster left later symbolic analyses failing in the same process.
+#: Every call into it holds this lock (re-entrant: an options block holds it around its calls).
+_CVX_LOCK = threading.RLock()
+
+
+class _Locked:
+    """A module whose callables run under :data:`_CVX_LOCK`."""
+
+    def __init__(self, module) -> None:
+        self._module = module
+
+    def __getattr__(self, name):
+        attr = getattr(self._module, name)
+        if not callable(attr):
+            return attr
+
+        def call(*args, **kwargs):
+            with _CVX_LOCK:
+                return attr(*args, **kwargs)
+
+        return call
+
+
 try:  # optional: CHOLMOD as shipped inside cvxopt's wheels (plateqp[solvers] installs it)
-    from cvxopt import amd as _cvx_amd  # type: ignore
-    from cvxopt import cholmod as _cvx_cholmod
+    from cvxopt import amd as _cvx_amd_module  # type: ignore
+    from cvxopt import cholmod as _cvx_cholmod_module
+
+    _cvx_amd, _cvx_cholmod = _Locked(_cvx_amd_module), _Locked(_cvx_cholmod_module)
     from cvxopt import matrix as _cvx_matrix
     from cvxopt import spmatrix as _cvx_spmatrix
 
@@ -50,14 +78,16 @@ LIBS = ("sksparse", "cvxopt")
 
 @contextlib.contextmanager
 def _cvx_options(**kw):
-    """cvxopt's CHOLMOD options are one global dict: set them for one call, then restore."""
-    old = dict(_cvx_cholmod.options)
-    _cvx_cholmod.options.update(kw)
-    try:
-        yield
-    finally:
-        _cvx_cholmod.options.clear()
-        _cvx_cholmod.options.update(old)
+    """cvxopt's CHOLMOD options are one global dict: set them for one call, then restore (under
+    :data:`_CVX_LOCK`, so no other thread's call sees them)."""
+    with _CVX_LOCK:
+        old = dict(_cvx_cholmod.options)
+        _cvx_cholmod.options.update(kw)
+        try:
+            yield
+        finally:
+            _cvx_cholmod.options.clear()
+            _cvx_cholmod.options.update(old)
 
 
 @contextlib.contextmanager
