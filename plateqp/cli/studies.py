@@ -19,28 +19,11 @@ from ..progress import Progress
 from .common import _options, _backend_name, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, _numbers
 
 
-def _shim_sensitivity(check, supports) -> tuple[np.ndarray | None, str | None]:
-    """dR_i/dg0_j among the regulated supports at the regulated scene (:func:`plateqp.sensitivity`,
-    from its active set): how much a shim error moves the reactions. Where a support sits at
-    lift-off the derivative as the gap grows (a shim too thin), said in the note."""
-    from ..errors import PlateQPError as _Err
-    from ..sensitivity import sensitivity
-
-    try:
-        s = sensitivity(check, "gaps")
-    except _Err as e:  # e.g. an active set that leaves a rigid motion free: no unique answer
-        return None, f"not available ({e})"
-    idx = np.asarray(supports, dtype=int)
-    note = None if s.smooth else ("a support is at lift-off: the derivative as the gap grows (a shim too thin); "
-                                  "as it shrinks the slope differs")
-    return s.increasing.reactions[np.ix_(idx, idx)], note
-
-
 def cmd_regulate(args) -> int:
     """Gaps that make the chosen supports carry the target reactions, checked by solving the
     regulated scene (:func:`plateqp.studies.regulate_gaps`)."""
     from ..io.files import check_file
-    from ..studies import regulate_gaps
+    from ..studies.design import regulate_gaps, shim_sensitivity
 
     scene = _scene_or_builtin(args.scene)
     target = _numbers(args.target, "--target")
@@ -65,7 +48,7 @@ def cmd_regulate(args) -> int:
         check = solve(reg.scene, backend=args.backend, formulation=args.formulation, accuracy="high")
         bar.update()
     got = check.reactions[reg.supports]
-    shim, shim_note = _shim_sensitivity(check, reg.supports)
+    shim, shim_note = shim_sensitivity(check, reg.supports)
     scale = max(float(np.abs(reg.reactions).max(initial=0.0)), float(np.abs(check.reactions).max(initial=0.0)), 1e-300)
     error = float(np.abs(got - reg.reactions).max(initial=0.0) / scale)
     ok = check.status == Status.OPTIMAL and error <= 1e-6

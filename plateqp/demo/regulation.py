@@ -44,12 +44,6 @@ class Regulation:
     shim: np.ndarray | None = None  # dR_i/dg0_j among the regulated supports, at the regulated scene
 
     @property
-    def shim_tolerance(self) -> float:
-        """The largest change of a regulated reaction per unit error of one regulated shim
-        (max |dR_i/dg0_j|), the slope as the gap grows where a support is at lift-off."""
-        return float(np.abs(self.shim).max()) if self.shim is not None else float("nan")
-
-    @property
     def error(self) -> float:
         """max |R − target| at the regulated supports in the check solve, relative to the load."""
         from ..families import total_load
@@ -74,7 +68,7 @@ def _solve(scene: Scene) -> Result:
 
 def regulation(scene: Scene | None = None) -> RegulationStudy:
     """Both regulations of the study on ``scene`` (default: the built-in ``heave``)."""
-    from ..studies.design import regulate_gaps
+    from ..studies.design import regulate_gaps, shim_sensitivity
 
     scene = scene if scene is not None else scenes.load("heave")
     g0 = np.array([s.gap for s in scene.supports], dtype=float)
@@ -85,21 +79,11 @@ def regulation(scene: Scene | None = None) -> RegulationStudy:
     target = np.full(foot.size, before.reactions[foot].mean())
     r = regulate_gaps(scene, target, supports=foot.tolist())
     check = _solve(r.scene)
-    runs.append(Regulation("equalise", foot, target, g0, r.gaps, check, _shim(check, foot)))
+    runs.append(Regulation("equalise", foot, target, g0, r.gaps, check, shim_sensitivity(check, foot)[0]))
     flat = np.flatnonzero(g0 == 0.0)
     r = regulate_gaps(scene, level.reactions[flat], supports=flat.tolist())
     runs.append(Regulation("re-level", flat, level.reactions[flat], g0, r.gaps, _solve(r.scene)))
     return RegulationStudy(scene, before, level, runs)
-
-
-def _shim(check: Result, reg: np.ndarray) -> np.ndarray:
-    """dR_i/dg0_j for i, j among the regulated supports, from the regulated scene's active set
-    (:func:`plateqp.sensitivity`; where a support sits at lift-off, the derivative as the gap
-    grows, i.e. a shim too thin)."""
-    from ..sensitivity import sensitivity
-
-    s = sensitivity(check, "gaps")
-    return s.increasing.reactions[np.ix_(reg, reg)]
 
 
 def _ids(idx) -> str:

@@ -208,6 +208,27 @@ def regulate_gaps(scene: Scene, target_reactions, supports: Sequence[int] | None
     return GapRegulation(gaps, new, reg, target, R_reg, R_other, proj)
 
 
+def shim_sensitivity(result, supports) -> tuple[np.ndarray | None, str | None]:
+    """dR_i/dg0_j among ``supports`` (0-based) at a solved, regulated scene: how much a shim
+    error moves the regulated reactions (:func:`plateqp.sensitivity`, from its active set).
+
+    Returns (matrix, note). Where a support sits at lift-off the matrix is the derivative as the
+    gap grows (a shim too thin) and the note says so; where the active set leaves a rigid motion
+    free (no unique answer) the matrix is None and the note says why.
+    """
+    from ..errors import PlateQPError
+    from ..sensitivity import sensitivity
+
+    try:
+        s = sensitivity(result, "gaps")
+    except PlateQPError as e:
+        return None, f"not available ({e})"
+    idx = np.asarray(supports, dtype=int)
+    note = None if s.smooth else ("a support is at lift-off: the derivative as the gap grows (a shim too thin); "
+                                  "as it shrinks the slope differs")
+    return s.increasing.reactions[np.ix_(idx, idx)], note
+
+
 def _held_or_floating(model: Model, rhs: np.ndarray, V: np.ndarray) -> np.ndarray:
     """K u = rhs; on a floating plate (rigid motions V) the solution orthogonal to V, from the
     bordered system [K V; Vᵀ 0] (:func:`plateqp.linalg.solve_saddle` with ρ = 0)."""
@@ -324,4 +345,5 @@ def most_uniform_stiffness(scene: Scene, c_range: tuple[float, float], supports:
     return UniformStiffness(best[0], uniformity(R, "std/mean"), R, evals, at_bound, measure, best[1])
 
 
-__all__ = ["UNIFORMITY_MEASURES", "GapRegulation", "UniformStiffness", "uniformity", "most_uniform_stiffness", "project_reactions", "regulate_gaps"]
+__all__ = ["UNIFORMITY_MEASURES", "GapRegulation", "UniformStiffness", "uniformity", "most_uniform_stiffness", "project_reactions", "regulate_gaps",
+           "shim_sensitivity"]
