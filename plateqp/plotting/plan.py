@@ -15,7 +15,7 @@ import numpy as np
 
 from .data import _point_loads, _supports, support_spacing
 from .marks import _draw_supports, _legend_handles, _norm_sections  # noqa: F401  (shared by the maps)
-from .style import _figure, _fmt, _lab, _units
+from .style import _figure, _fmt, _frame, _lab, _units
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -30,14 +30,7 @@ def _plan_axes(ax, result: Result, units, title: str | None = None):
     if on_triangles(result):
         return tri_plan_axes(ax, result, units, title)
     g = result.model.grid
-    L = _units(units)[0]
-    ax.set_aspect("equal")
-    ax.set_xlim(0.0, g.a)
-    ax.set_ylim(0.0, g.b)
-    ax.set_xlabel(_lab("x", L))
-    ax.set_ylabel(_lab("y", L))
-    if title:
-        ax.set_title(title)
+    _frame(ax, (0.0, g.a), (0.0, g.b), units, title)
 
 
 # -- the mesh, the supports, their reactions --------------------------------------------------

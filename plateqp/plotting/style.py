@@ -38,6 +38,18 @@ def _figure(figsize):
     return Figure(figsize=figsize, layout="constrained")
 
 
+def _frame(ax, xlim, ylim, units, title: str | None = None) -> None:
+    """A plan view's axes: equal aspect, the limits, x and y labelled in length units, a title."""
+    L = _units(units)[0]
+    ax.set_aspect("equal")
+    ax.set_xlim(*xlim)
+    ax.set_ylim(*ylim)
+    ax.set_xlabel(_lab("x", L))
+    ax.set_ylabel(_lab("y", L))
+    if title:
+        ax.set_title(title)
+
+
 def _lab(name: str, unit: str | None) -> str:
     return f"{name} ({unit})" if unit else name
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from .data import _supports
 from .marks import _supports_on_surface
-from .style import (ONE_SIDED, TWO_SIDED, _fig_legend, _figure, _fmt, _lab, _levels, _name, _range,
+from .style import (ONE_SIDED, TWO_SIDED, _fig_legend, _figure, _fmt, _frame, _lab, _levels, _name, _range,
                     _stress_unit, _symmetric_or_not, _units, _w_label)
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -76,14 +76,7 @@ def _draw_outline(ax, result, lw: float = 1.2):
 def tri_plan_axes(ax, result, units, title: str | None = None, margin: float = 0.04):
     x0, x1, y0, y1 = _bbox(result)
     m = margin * max(x1 - x0, y1 - y0)
-    L = _units(units)[0]
-    ax.set_aspect("equal")
-    ax.set_xlim(x0 - m, x1 + m)
-    ax.set_ylim(y0 - m, y1 + m)
-    ax.set_xlabel(_lab("x", L))
-    ax.set_ylabel(_lab("y", L))
-    if title:
-        ax.set_title(title)
+    _frame(ax, (x0 - m, x1 + m), (y0 - m, y1 + m), units, title)
 
 
 # -- plan view --------------------------------------------------------------------------------
