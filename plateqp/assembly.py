@@ -101,6 +101,11 @@ class Model:
         u[self.fixed] = self.values if u_free.ndim == 1 else self.values[:, None]
         return u
 
+    def load_vector(self, scene: Scene) -> np.ndarray:
+        """The consistent load vector (all dofs) of ``scene.loads`` on this model's mesh and
+        element, without assembling the stiffness (a model re-used with new loads)."""
+        return _loads(scene, self.grid, self.element, self.cells, self.cell_dofs, self.n_full)
+
     def rigid_modes(self) -> np.ndarray:
         """(n_free, k) basis of the rigid motions the two-sided supports leave free (k = 0..3 per piece).
 

@@ -35,6 +35,9 @@ class TriModel(Model):
     """A :class:`~plateqp.assembly.Model` on a triangle mesh (``grid`` is the :class:`TriMesh`,
     ``cells`` the triangles, ``cell_dofs`` their 9 dofs)."""
 
+    def load_vector(self, scene: Scene) -> np.ndarray:
+        return tri_loads(scene, self)
+
     def rigid_modes(self) -> np.ndarray:
         return _rigid_modes(self)
 

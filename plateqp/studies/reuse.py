@@ -50,14 +50,7 @@ def adapt_model(base: Model, scene: Scene) -> Model | None:
         return None
     model = dataclasses.replace(base, scene=scene)
     if old.loads != scene.loads:
-        if scene.triangles:
-            from ..triassembly import tri_loads  # the load vector alone, on the same mesh
-
-            f_full = tri_loads(scene, base)
-        else:
-            from ..assembly import _loads  # the load vector alone (no stiffness assembly)
-
-            f_full = _loads(scene, base.grid, base.element, base.cells, base.cell_dofs, base.n_full)
+        f_full = base.load_vector(scene)  # the load vector alone, on the same mesh
         model.f_full = f_full
         model.f = f_full[base.free] - base.K_full[base.free][:, base.fixed] @ base.values
     c = base.contacts
