@@ -90,12 +90,15 @@ def make_scene(kind: str, n: int) -> pq.Scene:
 
 def plate_matrix(kind: str, model) -> tuple[sp.csc_matrix, np.ndarray]:
     """The floor's matrix and load: the plate's K (grid), K + Bᵀ C B with every bed spring
-    bonded (bed)."""
+    bonded (bed), on K's stored pattern: SciPy's ``+`` would drop the assembly's structural zeros
+    and with them CHOLMOD's node supervariables (a slower floor: plateqp.linalg.pattern)."""
     if kind == "grid":
         return sp.csc_matrix(model.K), np.asarray(model.f, dtype=float)
     c = model.contacts
-    C = sp.diags(1.0 / c.rho)
-    return sp.csc_matrix(model.K + c.B.T @ C @ c.B), model.f + c.B.T @ (c.g0 / c.rho)
+    K, BCB = sp.coo_matrix(model.K), sp.coo_matrix(c.B.T @ sp.diags(1.0 / c.rho) @ c.B)
+    A = sp.csc_matrix((np.concatenate([K.data, BCB.data]),
+                       (np.concatenate([K.row, BCB.row]), np.concatenate([K.col, BCB.col]))), shape=K.shape)
+    return A, model.f + c.B.T @ (c.g0 / c.rho)
 
 
 def to_cvxopt(K: sp.csc_matrix):

@@ -72,7 +72,8 @@ KNOWN_ERRORS = {("toggle", "condensed"): "floating plate: all supports at once g
 
 
 def check_claim(res, reference, rtol=1e-6):
-    """An OPTIMAL result must be right and say so; an INACCURATE one must have a failing KKT; an
+    """An OPTIMAL result must be right and say so; an INACCURATE one (or a MAX_ITER one: toggle
+    cycles where S is rounding, a floating plate on three supports) must have a failing KKT; an
     ERROR only where declared in KNOWN_ERRORS."""
     if res.status == pq.Status.ERROR and (res.backend, res.formulation) in KNOWN_ERRORS:
         return
@@ -81,7 +82,7 @@ def check_claim(res, reference, rtol=1e-6):
         scale = np.abs(reference).max()
         np.testing.assert_allclose(res.reactions, reference, atol=rtol * scale, rtol=0)
     else:
-        assert res.status == pq.Status.INACCURATE and not res.kkt.ok, res.status
+        assert res.status in (pq.Status.INACCURATE, pq.Status.MAX_ITER) and not res.kkt.ok, res.status
 
 
 def floating_triangle():

@@ -51,7 +51,7 @@ import scipy.sparse as sp
 
 from ..backends.base import LCP, QP, RawSolution
 from ..errors import MechanismError, ProblemError, SingularMatrixError
-from ..linalg import SchurFactor
+from ..linalg import SchurFactor, pattern
 from .scaling import Scaled
 
 FORMULATIONS = ("primal", "condensed", "dual")
@@ -225,7 +225,8 @@ def _condense(data: Scaled):
     To = sp.hstack([sp.csr_matrix((others.size, m)), sp.identity(others.size)])
     P = sp.csr_matrix((np.ones(n), (np.concatenate([master, others]), np.arange(n))), shape=(n, n))
     T = (P @ sp.vstack([Tm, To])).tocsr()
-    Kt = (T.T @ data.K @ T).tocsr()
+    order = np.concatenate([master, others])  # T permutes K so, but for the contact rows
+    Kt = pattern.congruence(T, data.K, like=data.K[order][:, order])  # stored zeros kept (ordering)
     Koc = Kt[m:][:, :m].tocsc()
     # one factorisation of K̃ with the contact deflections last: its trailing block is S. A
     # floating plate's K̃ is singular, its K̃_oo (every contact point held) is not: the trailing

@@ -11,6 +11,8 @@
                        (static condensation) and ``B K⁻¹ Bᵀ`` from its trailing block
 :func:`row_stiffness`  the stiffness of a matrix along each row of an operator (no solves)
 :func:`solve_saddle`   the saddle-point system [K Bᵀ; B −diag(ρ)]
+:mod:`pattern`         scale and sum without dropping stored entries (the orderings read
+                       the stored pattern: a plate's structural zeros keep nodes together)
 =====================  ===========================================================
 
 Errors are :class:`~plateqp.errors.SingularMatrixError`, in matrix words; a caller that
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 from ..errors import SingularMatrixError
 from . import cholmod as _cholmod
+from . import pattern
 from .cholmod import Cholesky
 from .factor import METHODS, Factor
 from .rows import row_stiffness
@@ -49,4 +52,4 @@ def bindings() -> list[str]:
 
 
 __all__ = ["HAVE_CHOLMOD", "HAVE_CVXOPT", "METHODS", "Cholesky", "Factor", "SchurFactor", "SingularMatrixError",
-           "bindings", "row_stiffness", "solve_saddle"]
+           "bindings", "pattern", "row_stiffness", "solve_saddle"]

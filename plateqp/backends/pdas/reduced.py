@@ -34,15 +34,15 @@ class ReducedQP:
         if m > min(n, max_rows):
             raise SolverError(f"the pdas backend takes few constraint rows (m ≤ min(n, {max_rows})), "
                               f"got m = {m}, n = {n}")
-        P = sp.csc_matrix(qp.P, dtype=float)
-        P.eliminate_zeros()
+        P = sp.csc_matrix(qp.P, dtype=float)  # stored zeros kept: the ordering reads them (linalg.pattern)
         G = sp.csc_matrix(qp.G, dtype=float)
         G.eliminate_zeros()
         v, w = np.random.default_rng(0).standard_normal((2, n))
         if abs(v @ (P @ w) - w @ (P @ v)) > 1e-10 * np.sqrt((P @ v) @ (P @ v) * (w @ w)) + 1e-300:
             raise SolverError("the pdas backend needs a symmetric P")  # a randomised check, O(nnz)
         d = P.diagonal()
-        sep = (np.diff(P.indptr) == 1) & (d > 0) & (np.diff(G.indptr) == 1)
+        stored = np.bincount(np.repeat(np.arange(n), np.diff(P.indptr))[P.data != 0], minlength=n)
+        sep = (stored == 1) & (d > 0) & (np.diff(G.indptr) == 1)
         # a row left with no coupled variable keeps its separable ones (as plain variables)
         coupled = np.bincount(G.indices, weights=~sep[np.repeat(np.arange(n), np.diff(G.indptr))], minlength=m)
         lone = coupled[G.indices] == 0

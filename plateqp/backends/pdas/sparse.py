@@ -11,7 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import ProblemError, SingularMatrixError, SolverError
-from ...linalg import Cholesky, Factor, bindings
+from ...linalg import Cholesky, Factor, bindings, pattern
 from ..base import Status
 from .options import (
     ALPHA_MAX,
@@ -70,7 +70,7 @@ class SpringFactor:
         self.B, self.c = B, c
         self.s = 1.0 / np.sqrt(Kd)
         Babs = abs(B)
-        pat = sp.csc_matrix(abs(K) + Babs.T @ Babs)
+        pat = pattern.add(K, Babs.T @ Babs)  # K's stored zeros kept: the ordering reads them
         pat.sort_indices()
         self.indptr, self.indices = pat.indptr, pat.indices
         cols = np.repeat(np.arange(n), np.diff(pat.indptr))
