@@ -362,3 +362,72 @@ def test_the_contact_pipeline_keeps_the_plates_stored_pattern():
     np.testing.assert_allclose(pb.K.toarray(), (sp.diags(data.dof_scale) @ K @ sp.diags(data.dof_scale)).toarray()
                                / (data.F0 * data.W), rtol=1e-13, atol=0)
     assert pq.solve(grid_rigid(8, 3), backend="pdas").kkt.ok
+
+
+# --------------------------------------------------------------------------- CHOLMOD through ctypes
+
+
+@pytest.fixture
+def seam_off(monkeypatch):
+    from plateqp.linalg import seam
+
+    monkeypatch.setattr(seam, "SEAM", False)
+
+
+@pytest.mark.skipif(not linalg.HAVE_CVXOPT, reason="cvxopt is not installed")
+def test_the_seam_loads_here_and_solves_like_spsolve_and_the_binding(monkeypatch):
+    """CHOLMOD's C API inside cvxopt's wheel, read in place through ctypes: the same solves and
+    the same trailing block (a given order kept exactly) as cvxopt's own binding and SciPy."""
+    from plateqp.linalg import seam as ch
+
+    assert ch._seam() is not None  # the default install: the seam must load (else it is slower)
+    K = spd(9, seed=3)
+    b = np.random.default_rng(0).standard_normal((K.shape[0], 3))
+    ref = spla.spsolve(K, b)
+    last = np.array([5, 17, 40, 63, 70])
+    out = {}
+    for seam in (True, False):
+        monkeypatch.setattr(ch, "SEAM", seam)
+        f = Factor(K, method="cvxopt")
+        assert (f.chol.direct is not None) == seam
+        S = SchurFactor(K, last, method="cvxopt")
+        out[seam] = (f.solve(b), S.schur(), S.forward(b[:, 0]))
+        assert rel(out[seam][0], ref) < 1e-12
+        assert rel(out[seam][1], dense_schur(K, last)) < 1e-9
+    for a, c in zip(out[True], out[False]):
+        np.testing.assert_array_equal(a, c)  # the same supernodal factor, to the bit
+
+
+@pytest.mark.skipif(not linalg.HAVE_CVXOPT, reason="cvxopt is not installed")
+def test_the_seam_refuses_singular_and_indefinite_matrices_silently(capfd):
+    """Simplicial CHOLMOD would factor an indefinite matrix as L D Lᵀ without a word; the seam
+    asks for L Lᵀ, so it refuses, and CHOLMOD prints nothing (stdout may carry --json)."""
+    A = laplacian(6, 1.0).tolil()
+    A[10, 10] = -1.0
+    for M in (laplacian(6), A.tocsc()):  # singular (constants); indefinite
+        with pytest.raises(SingularMatrixError):
+            ch_ = Factor(M, method="cvxopt")
+            assert ch_.chol.direct is not None
+    assert capfd.readouterr().out == ""
+
+
+@pytest.mark.skipif(not linalg.HAVE_CVXOPT, reason="cvxopt is not installed")
+def test_a_different_cholmod_layout_falls_back_to_the_binding(monkeypatch):
+    from plateqp.linalg import seam as ch
+
+    monkeypatch.setattr(ch, "_SEAM", False)  # not tried yet
+    monkeypatch.setattr(ch, "_LAYOUT", ch._LAYOUT + ((ch._OFF_PRINT, "i", 99),))  # not CHOLMOD 3's
+    assert ch._seam() is None
+    f = Factor(spd(5), method="cvxopt")
+    assert f.chol.direct is None
+    assert rel(f.solve(np.ones(25)), spla.spsolve(spd(5), np.ones(25))) < 1e-12
+
+
+@pytest.mark.usefixtures("seam_off")
+def test_pdas_through_cvxopts_binding_too():
+    """The fallback route (cvxopt's own binding) still solves a contact scene exactly."""
+    import plateqp as pq
+    from plateqp.families import grid_rigid
+
+    res = pq.solve(grid_rigid(8, 3), backend="pdas", accuracy=1e-10)
+    assert res.kkt.ok and res.extras["cholmod"] == "cvxopt"

@@ -9,6 +9,13 @@ the trailing block ``L[k:, k:]`` of the factor, and (scikit-sparse only) rank-k 
 downdate. Matrices are
 SciPy CSC holding the lower triangle, all CHOLMOD reads.
 
+CHOLMOD inside cvxopt's wheels is called through its C API (ctypes, :mod:`plateqp.linalg.seam`) where its
+library and the layout of ``cholmod_common`` are the ones checked (CHOLMOD 3, as cvxopt 1.3
+ships it): CHOLMOD then reads the NumPy arrays of the lower triangle in place, with no cvxopt
+matrix built (0.15 s of a 1.3 s factorisation at 256²), and each factor has its own workspace.
+Elsewhere, or with :data:`plateqp.linalg.seam.SEAM` set False, cvxopt's own binding is used, as
+below.
+
 Reading the factor: cvxopt's only call for it, ``cholmod.getfactor``, hands the numeric factor
 over to the matrix it returns and leaves a symbolic one that no longer solves. So the trailing
 block is copied straight out of CHOLMOD's factor structure instead (:func:`_cvx_trailing`,
@@ -28,6 +35,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SingularMatrixError
+from .seam import _Direct, _seam
+from .seam import view as _view
 
 try:  # optional, faster where it installs
     import sksparse.cholmod as _sk  # type: ignore
@@ -157,6 +166,8 @@ class Cholesky:
         self.spent = False  # cvxopt: the numeric factor was handed to getfactor (no more solves)
         self.given = None  # scikit-sparse: an order given to analyse (applied to A and b here)
         self._last = (None, None)  # cvxopt: the last matrix converted, and its conversion
+        seam = _seam() if lib == "cvxopt" else None
+        self.direct = _Direct(seam) if seam is not None else None  # CHOLMOD's C API, no conversion
 
     @property
     def can_update(self) -> bool:
@@ -177,6 +188,8 @@ class Cholesky:
 
     def order(self, A: sp.csc_matrix) -> np.ndarray:
         """A fill-reducing (AMD) order of the pattern of ``A`` (lower triangle)."""
+        if self.direct is not None:
+            return self.direct.order(A)
         if self.lib == "sksparse":
             with _sk_quiet():
                 return _sk.analyze(A, mode="supernodal", ordering_method="amd").P()
@@ -191,6 +204,10 @@ class Cholesky:
         self.F, self.spent, self.given = None, False, None
         if order is not None:
             order = np.asarray(order, dtype=np.int64)
+        if self.direct is not None:
+            self.direct.analyse(A, np.arange(n, dtype=np.int64) if natural and order is None else order)
+            self.sym = self.direct.L
+            return
         if self.lib == "sksparse":
             self.given = order
             with _sk_quiet():
@@ -209,6 +226,10 @@ class Cholesky:
         positive definite (``column``: where it stopped, in the factor's order)."""
         if self.sym is None:
             self.analyse(A)
+        if self.direct is not None:
+            self.direct.factor(A)
+            self.F = self.sym
+            return
         if self.lib == "sksparse":
             try:
                 with _sk_quiet():
@@ -231,6 +252,8 @@ class Cholesky:
             raise RuntimeError("this cvxopt factor was read by getfactor and no longer solves")
 
     def _cvx_solve(self, b: np.ndarray, systems) -> np.ndarray:
+        if self.direct is not None:
+            return self.direct.solve(b, systems)
         b = np.asarray(b, dtype=float)
         B = _cvx_matrix(b.reshape(b.shape[0], -1).copy())
         for sys_ in systems:
@@ -280,6 +303,11 @@ class Cholesky:
         factor read by ``getfactor`` and spent."""
         if self.lib == "sksparse":
             return self.F.L()[no:, no:].toarray()
+        if self.direct is not None:
+            out = _trailing_at(self.direct.L.value, no)
+            if out is None or not self._trailing_checks(out, no):
+                raise SingularMatrixError("the factor's trailing block could not be read")
+            return out
         try:
             out = _cvx_trailing(self.F, no)
         except (ValueError, OSError, AttributeError):
@@ -342,22 +370,15 @@ _NSUPER, _SSIZE, _XSIZE, _SUPER, _PI, _PX, _S = 13, 14, 15, 18, 19, 20, 21
 _LONG, _REAL, _DOUBLE = 2, 1, 0
 
 
-def _view(addr: int, count: int, dtype) -> np.ndarray:
-    """``count`` items at ``addr`` (no copy; valid while the factor lives)."""
-    if count == 0:
-        return np.zeros(0, dtype=dtype)
-    if not addr:
-        raise ValueError("null pointer in the factor")
-    buf = (ctypes.c_char * (count * np.dtype(dtype).itemsize)).from_address(addr)
-    return np.frombuffer(buf, dtype=dtype, count=count)
-
-
 def _cvx_trailing(F, no: int) -> np.ndarray | None:
     """``L[no:, no:]`` (of ``L Lᵀ``) copied from cvxopt's numeric factor without touching it;
     None where the factor is not of the expected kind (64-bit indices, real, double)."""
     ptr = _api.PyCapsule_GetPointer(F, _api.PyCapsule_GetName(F))
-    if not ptr:
-        return None
+    return _trailing_at(ptr, no) if ptr else None
+
+
+def _trailing_at(ptr: int, no: int) -> np.ndarray | None:
+    """``L[no:, no:]`` of the ``cholmod_factor`` at ``ptr`` (see :func:`_cvx_trailing`)."""
     h = _view(ptr, 22, np.uint64)
     _ordering, is_ll, is_super, _monotonic, itype, xtype, dtype = _view(ptr + 22 * 8, 7, np.int32)
     n = int(h[_N])
@@ -400,3 +421,4 @@ def _cvx_trailing(F, no: int) -> np.ndarray | None:
         np.fill_diagonal(out, 1.0)
         out *= np.sqrt(d)[None, :]
     return out
+

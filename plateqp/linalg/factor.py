@@ -22,6 +22,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import SingularMatrixError
+from . import pattern
 from .cholmod import Cholesky, lower
 
 # residuals for iterative refinement are accumulated in long double where it is wider than
@@ -151,7 +152,7 @@ class Factor(Refined):
                 self.chol.analyse(A, natural=self.order is not None)
             self.chol.factor(A)
             return
-        Ks = sp.csc_matrix(sp.diags(self.s) @ self.K @ sp.diags(self.s))
+        Ks = pattern.scaled(self.K, self.s)  # its stored pattern kept (the ordering reads it)
         if self.order is not None:
             Ks = Ks[self.order][:, self.order]
         with warnings.catch_warnings():
