@@ -93,7 +93,8 @@ class Primal(Formulation):
         m = data.m
         el = np.flatnonzero(data.rho > 0)
         ne = el.size
-        P = sp.block_diag([data.K, sp.identity(ne)], format="csc")
+        # block_diag goes through COO: 2.5× the time of a plain conversion where there is no block
+        P = sp.block_diag([data.K, sp.identity(ne)], format="csc") if ne else data.K.tocsc()
         q = np.concatenate([-data.f, np.zeros(ne)])
         T = sp.csr_matrix((-np.sqrt(data.rho[el]), (el, np.arange(ne))), shape=(m, ne))
         G = sp.hstack([data.B, T], format="csc")

@@ -60,7 +60,8 @@ class Refined:
         if not _EXTENDED:
             return b - self.K @ x
         if getattr(self, "_KL", None) is None:
-            self._KL = self.K.astype(np.longdouble)
+            K = self.K  # the values widened; the index arrays shared, not copied
+            self._KL = type(K)((K.data.astype(np.longdouble), K.indices, K.indptr), shape=K.shape)
         return (b.astype(np.longdouble) - self._KL @ x.astype(np.longdouble)).astype(np.float64)
 
     def solve(self, b, refine: int = 3) -> np.ndarray:
