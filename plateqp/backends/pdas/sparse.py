@@ -11,7 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import ProblemError, SingularMatrixError, SolverError
-from ...linalg import Cholesky, Factor, bindings, pattern
+from ...linalg import Cholesky, Factor, bindings
 from ..base import Status
 from .options import (
     ALPHA_MAX,
@@ -70,7 +70,9 @@ class SpringFactor:
         self.B, self.c = B, c
         self.s = 1.0 / np.sqrt(Kd)
         Babs = abs(B)
-        pat = pattern.add(K, Babs.T @ Babs)  # K's stored zeros kept: the ordering reads them
+        Kc = sp.csc_matrix(K)  # its stored pattern with ones (a sum of positives drops nothing: the
+        ones = sp.csc_matrix((np.ones(Kc.nnz), Kc.indices, Kc.indptr), shape=Kc.shape)  # ordering reads zeros)
+        pat = sp.csc_matrix(ones + Babs.T @ Babs)
         pat.sort_indices()
         self.indptr, self.indices = pat.indptr, pat.indices
         cols = np.repeat(np.arange(n), np.diff(pat.indptr))
