@@ -13,6 +13,8 @@
 :func:`solve_saddle`   the saddle-point system [K Bᵀ; B −diag(ρ)]
 :mod:`pattern`         scale and sum without dropping stored entries (the orderings read
                        the stored pattern: a plate's structural zeros keep nodes together)
+:mod:`seam`            CHOLMOD's C API inside cvxopt's wheel through ctypes (NumPy arrays
+                       read in place; cvxopt's binding where it does not load)
 =====================  ===========================================================
 
 Errors are :class:`~plateqp.errors.SingularMatrixError`, in matrix words; a caller that
