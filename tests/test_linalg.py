@@ -434,3 +434,30 @@ def test_pdas_through_cvxopts_binding_too():
 
     res = pq.solve(grid_rigid(8, 3), backend="pdas", accuracy=1e-10)
     assert res.kkt.ok and res.extras["cholmod"] == "cvxopt"
+
+
+@pytest.mark.skipif(not linalg.HAVE_CVXOPT, reason="cvxopt is not installed")
+def test_the_seam_takes_either_triangle_or_the_whole_matrix():
+    """CHOLMOD is told which triangle it was handed (stype): the lower triangle, the upper one
+    (what it reads fastest) and the whole symmetric matrix give the same solves."""
+    from plateqp.linalg import seam
+
+    K = spd(7, seed=5)
+    s = 1.0 / np.sqrt(K.diagonal())
+    b = np.random.default_rng(2).standard_normal(K.shape[0])
+    ref = np.linalg.solve((sp.diags(s) @ K @ sp.diags(s)).toarray(), b)
+    full = linalg.pattern.scaled(K, s)
+    unsorted = full.copy()
+    unsorted.indices = unsorted.indices.copy()
+    for j in range(unsorted.shape[1]):  # each column's entries reversed: not sorted
+        a, z = unsorted.indptr[j], unsorted.indptr[j + 1]
+        unsorted.indices[a:z] = unsorted.indices[a:z][::-1]
+        unsorted.data[a:z] = unsorted.data[a:z][::-1]
+    unsorted.has_sorted_indices = False
+    for A, stype in ((lower(K, s), -1), (lower(K, s, upper=True), 1), (full, 1), (unsorted, 1)):
+        assert seam._stype(A) == stype
+        chol = Cholesky("cvxopt")
+        assert chol.direct is not None and chol.upper
+        chol.analyse(A)
+        chol.factor(A)
+        assert rel(chol.solve(b), ref) < 1e-12

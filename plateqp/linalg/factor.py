@@ -148,7 +148,7 @@ class Factor(Refined):
         self._KL = None
         self.s = equilibration(self.K)
         if self.chol is not None:
-            A = lower(self.K, self.s, self.order)
+            A = lower(self.K, self.s, self.order, upper=self.chol.upper)
             if self.chol.sym is None:
                 self.chol.analyse(A, natural=self.order is not None)
             self.chol.factor(A)

@@ -117,7 +117,7 @@ class SchurFactor:
     def _by_trailing_block(self, lib: str) -> None:
         t0 = time.perf_counter()
         chol = Cholesky(lib)
-        A = lower(self.K, self.s)  # one pass over K (CHOLMOD reads it in place): the order is given to CHOLMOD
+        A = lower(self.K, self.s, upper=chol.upper)  # one pass over K; the order is given to CHOLMOD
         order = chol.order(A)
         self.perm = np.concatenate([order[~self._mask[order]], self.last])
         if self.shift:

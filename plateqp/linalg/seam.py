@@ -4,7 +4,8 @@ CHOLMOD ships inside cvxopt's wheels as a shared library (cvxopt.libs/ on Linux,
 macOS). cvxopt's own binding takes a cvxopt matrix: converting a 256² plate's K into one costs
 0.15 s (its constructor sorts 2.7 M triplets), and extracting the lower triangle for it 0.2 s,
 a quarter of the whole factorisation. Through ctypes CHOLMOD reads NumPy's arrays in place
-(a ``cholmod_sparse`` pointing at the arrays of :func:`plateqp.linalg.cholmod.lower`; handed
+(a ``cholmod_sparse`` pointing at the arrays of :func:`plateqp.linalg.cholmod.lower`, best
+with ``upper=True``: CHOLMOD reads an upper triangle without transposing it; handed
 the whole symmetric matrix instead, CHOLMOD took 0.2 s longer at 256² than with the lower
 triangle). Each factor has its own ``cholmod_common`` (no shared workspace: no lock). The fields set in it are found at the
 offsets of CHOLMOD 3's ``cholmod_common``, checked against the defaults ``cholmod_l_start``
@@ -127,6 +128,22 @@ def _seam() -> _Seam | None:
     return _SEAM if SEAM else None
 
 
+def _stype(A: sp.csc_matrix) -> int:
+    """CHOLMOD's ``stype`` for the triangle ``A`` holds: −1 lower, 1 upper (or both: a whole
+    symmetric matrix, read by its upper triangle). With sorted indices, O(n): where each column
+    starts or ends at its diagonal."""
+    n = A.shape[0]
+    d = np.arange(n)
+    counts = np.diff(A.indptr)
+    if A.has_sorted_indices and np.all(counts > 0):
+        if np.array_equal(A.indices[A.indptr[:-1]], d):
+            return -1
+        if np.array_equal(A.indices[A.indptr[1:] - 1], d):
+            return 1
+    col = np.repeat(d, counts)
+    return -1 if np.all(A.indices >= col) else 1
+
+
 def _set_int(buf, off: int, value: int) -> None:
     ctypes.c_int.from_buffer(buf, off).value = value
 
@@ -158,7 +175,7 @@ class _Direct:
         i = np.ascontiguousarray(A.indices, dtype=np.int64)
         x = np.ascontiguousarray(A.data, dtype=np.float64)
         self._hold = (p, i, x)
-        return _Sparse(n, n, int(p[-1]), p.ctypes.data, i.ctypes.data, None, x.ctypes.data, None, -1,
+        return _Sparse(n, n, int(p[-1]), p.ctypes.data, i.ctypes.data, None, x.ctypes.data, None, _stype(A),
                        _ITYPE_LONG, _XTYPE_REAL, _DTYPE_DOUBLE, int(bool(A.has_sorted_indices)), 1)
 
     def order(self, A: sp.csc_matrix) -> np.ndarray:

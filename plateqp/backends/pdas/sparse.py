@@ -101,8 +101,9 @@ class SpringFactor:
         self.pair_pos = pos(B.indices[ia], B.indices[ib])
         self.scale = self.s[pat.indices] * self.s[cols]
         self.nnz = nnz
-        # CHOLMOD reads the lower triangle only: hand it that (half the data)
-        self.low = np.flatnonzero(pat.indices >= cols)
+        # CHOLMOD reads one triangle only: hand it that (half the data)
+        up = self.chol is not None and self.chol.upper
+        self.low = np.flatnonzero(pat.indices <= cols if up else pat.indices >= cols)
         self.low_indptr = np.concatenate([[0], np.cumsum(np.bincount(cols[self.low], minlength=n))])
         self.w = None
         self.fac = None  # a plateqp.linalg.Factor (linalg, superlu)
@@ -116,7 +117,7 @@ class SpringFactor:
         data = self.base + np.bincount(self.pair_pos, weights=w[self.pair_row] * self.pair_val,
                                        minlength=self.nnz)
         n = self.s.size
-        if scaled:  # the lower triangle, equilibrated, for CHOLMOD
+        if scaled:  # one triangle (see above), equilibrated, for CHOLMOD
             low = self.low
             return sp.csc_matrix((data[low] * self.scale[low], self.indices[low], self.low_indptr), shape=(n, n))
         return sp.csc_matrix((data, self.indices, self.indptr), shape=(n, n))
