@@ -32,9 +32,10 @@ _EXTENDED = np.finfo(np.longdouble).eps < np.finfo(np.float64).eps
 METHODS = ("auto", "cholmod", "cvxopt", "superlu", "superlu-default")
 
 
-def equilibration(K: sp.spmatrix) -> np.ndarray:
-    """``s = diag(K)^(-1/2)``; SingularMatrixError if a diagonal entry is not positive."""
-    d = K.diagonal()
+def equilibration(K: sp.spmatrix, diagonal: np.ndarray | None = None) -> np.ndarray:
+    """``s = diag(K)^(-1/2)`` (``diagonal``: ``diag(K)``, where the caller has it);
+    SingularMatrixError if a diagonal entry is not positive."""
+    d = K.diagonal() if diagonal is None else np.asarray(diagonal, dtype=float)
     bad = np.flatnonzero(~(d > 0))
     if bad.size:
         raise SingularMatrixError(f"the matrix has a zero or negative diagonal entry (row {bad[0]}): "

@@ -72,6 +72,7 @@ class SchurFactor:
         is singular to that precision.
     method : "auto" (the first CHOLMOD binding in use, else "blocks"), "sksparse",
         "cvxopt", or "blocks" (``S`` by solves with a :class:`Factor` of ``K_oo``).
+    diagonal : ``diag(K)``, where the caller has it (it equilibrates ``K``).
 
     Raises
     ------
@@ -80,7 +81,8 @@ class SchurFactor:
         factorisation stopped in the factor's order: below ``n − len(last)`` it is ``K_oo``.
     """
 
-    def __init__(self, K, last, shift: float = 0.0, pivot_tol: float = 0.0, method: str = "auto") -> None:
+    def __init__(self, K, last, shift: float = 0.0, pivot_tol: float = 0.0, method: str = "auto",
+                 diagonal: np.ndarray | None = None) -> None:
         if method not in SCHUR_METHODS:
             raise ValueError(f"unknown method {method!r}; choose one of {SCHUR_METHODS}")
         self.K = sp.csc_matrix(K)
@@ -98,7 +100,7 @@ class SchurFactor:
             libs = bindings()
             method = libs[0] if libs else "blocks"
         self.method = method
-        self.s = equilibration(self.K)
+        self.s = equilibration(self.K, diagonal)
         self.stats = {"analyse_s": 0.0, "factor_s": 0.0, "extract_s": 0.0, "factorisations": 1, "solves": 0,
                       "solve_s": 0.0, "last": int(self.nl), "method": method}
         self._mask = mask

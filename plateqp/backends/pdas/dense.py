@@ -48,7 +48,7 @@ class DenseDual:
         if c.size > max_dense:
             raise NotApplicable(f"the rows touch {c.size} dofs (max_dense = {max_dense})")
         try:
-            self.fac = SchurFactor(pb.K, c, pivot_tol=PIVOT_TOL, method=libs[0])
+            self.fac = SchurFactor(pb.K, c, pivot_tol=PIVOT_TOL, method=libs[0], diagonal=pb.Kd)
         except SingularMatrixError as exn:
             raise NotApplicable(f"K is singular ({exn})") from exn
         t0 = time.perf_counter()

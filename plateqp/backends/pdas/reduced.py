@@ -61,7 +61,7 @@ class ReducedQP:
         self.B = (G[:, self.keep] if self.sep.size else G).tocsr()
         self.rho = np.bincount(self.sep_row, weights=self.sep_gamma**2 / self.sep_p, minlength=m)
         self.g = qp.h + np.bincount(self.sep_row, weights=self.sep_gamma * self.sep_q / self.sep_p, minlength=m)
-        Kd = self.K.diagonal()
+        Kd = d[self.keep] if self.sep.size else d  # K's diagonal (one pass over P, not three)
         if np.any(Kd <= 0):
             raise SolverError("the pdas backend needs P with a positive diagonal on the coupled variables "
                               "(a coupled variable with no curvature makes the QP unbounded or degenerate)")
@@ -69,7 +69,7 @@ class ReducedQP:
         if empty.size:
             raise SolverError(f"row {empty[0]} of G acts on no coupled variable: not a contact row")
         self.Kd = Kd
-        self.k = row_stiffness(self.K, self.B, "diagonal")  # local stiffness of each row: Σ_j B_ij² K_jj
+        self.k = row_stiffness(sp.diags(Kd), self.B, "diagonal")  # that kind reads the diagonal alone  # local stiffness of each row: Σ_j B_ij² K_jj
         self.c = self.k / (1.0 + self.rho * self.k)  # in series with the row's spring
         self.P, self.q = P, qp.q
 
