@@ -461,3 +461,23 @@ def test_the_seam_takes_either_triangle_or_the_whole_matrix():
         chol.analyse(A)
         chol.factor(A)
         assert rel(chol.solve(b), ref) < 1e-12
+
+
+@pytest.mark.skipif(not linalg.HAVE_CVXOPT, reason="cvxopt is not installed")
+def test_a_seam_that_loses_the_order_falls_back_with_the_triangle_it_was_handed(monkeypatch):
+    """If CHOLMOD did not keep a given order (a layout not the one checked), the factor goes
+    through cvxopt's binding instead, which reads a lower triangle: the upper one made for the
+    seam is transposed for it, so the Schur complement is still right."""
+    from plateqp.linalg import seam
+
+    def lose(self, A, perm):
+        raise OSError("CHOLMOD did not keep the given order")
+
+    monkeypatch.setattr(seam._Direct, "analyse", lose)
+    K = spd(8, seed=4)
+    last = np.array([3, 20, 41, 60])
+    S = SchurFactor(K, last, method="cvxopt")
+    assert S.chol.direct is None
+    assert rel(S.schur(), dense_schur(K, last)) < 1e-9
+    b = np.ones(K.shape[0])
+    assert rel(S.solve(b), spla.spsolve(K, b)) < 1e-10

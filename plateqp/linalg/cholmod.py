@@ -36,7 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SingularMatrixError
-from .seam import _Direct, _seam
+from .seam import _Direct, _seam, _stype
 from .seam import view as _view
 
 try:  # optional, faster where it installs
@@ -187,10 +187,13 @@ class Cholesky:
     def _cvx(self, A: sp.csc_matrix):
         if self._last[0] is A:
             return self._last[1]
+        key = A
+        if _stype(A) == 1:  # an upper triangle (made for the seam): cvxopt reads the lower one
+            A = sp.csc_matrix(A.T)
         cols = np.repeat(np.arange(A.shape[0], dtype=np.int64), np.diff(A.indptr))
         out = _cvx_spmatrix(_cvx_matrix(A.data.astype(float)), _cvx_matrix(A.indices.astype(np.int64)),
                             _cvx_matrix(cols), A.shape)
-        self._last = (A, out)
+        self._last = (key, out)
         return out
 
     def _sk_matrix(self, A: sp.csc_matrix) -> sp.csc_matrix:
@@ -215,9 +218,13 @@ class Cholesky:
         if order is not None:
             order = np.asarray(order, dtype=np.int64)
         if self.direct is not None:
-            self.direct.analyse(A, np.arange(n, dtype=np.int64) if natural and order is None else order)
-            self.sym = self.direct.L
-            return
+            try:
+                self.direct.analyse(A, np.arange(n, dtype=np.int64) if natural and order is None else order)
+            except OSError:  # CHOLMOD did not keep the order: not the layout checked; the binding instead
+                self.direct = None
+            else:
+                self.sym = self.direct.L
+                return
         if self.lib == "sksparse":
             self.given = order
             with _sk_quiet():

@@ -7,9 +7,10 @@ a quarter of the whole factorisation. Through ctypes CHOLMOD reads NumPy's array
 (a ``cholmod_sparse`` pointing at the arrays of :func:`plateqp.linalg.cholmod.lower`, best
 with ``upper=True``: CHOLMOD reads an upper triangle without transposing it; handed
 the whole symmetric matrix instead, CHOLMOD took 0.2 s longer at 256² than with the lower
-triangle). Each factor has its own ``cholmod_common`` (no shared workspace: no lock). The fields set in it are found at the
-offsets of CHOLMOD 3's ``cholmod_common``, checked against the defaults ``cholmod_l_start``
-writes there before anything is set; any other layout or library and the binding is used.
+triangle). Each factor has its own ``cholmod_common`` (no shared workspace: no lock). The
+fields set in it are found at the offsets of CHOLMOD 3's ``cholmod_common``, checked against
+the defaults ``cholmod_l_start`` writes there before anything is set; any other layout or
+library and the binding is used.
 """
 
 from __future__ import annotations
@@ -37,15 +38,20 @@ def view(addr: int, count: int, dtype) -> np.ndarray:
 
 _ITYPE_LONG, _XTYPE_REAL, _DTYPE_DOUBLE = 2, 1, 0
 _COMMON_BYTES = 1 << 16  # CHOLMOD 3's cholmod_common is about 2.3 kB
-# offsets in cholmod_common (CHOLMOD 3.0): supernodal (48), print, nmethods, method[0] (168 bytes each; its
-# ordering at +132), postorder; and defaults to recognise the layout by
-_OFF_PRINT, _OFF_NMETHODS, _OFF_METHOD0, _METHOD_BYTES, _OFF_ORDERING, _OFF_POSTORDER = 144, 168, 184, 168, 132, 1864
-_OFF_SUPERNODAL, _SUPERNODAL = 48, 2  # CHOLMOD_AUTO (1) by default
+# offsets in cholmod_common (CHOLMOD 3.0): supernodal, print, nmethods, method[0] (168 bytes
+# each; its ordering at +132), postorder
+_OFF_SUPERNODAL, _OFF_PRINT, _OFF_NMETHODS, _OFF_POSTORDER = 48, 144, 168, 1864
+_OFF_METHOD0, _METHOD_BYTES, _OFF_ORDERING = 184, 168, 132
+_SUPERNODAL = 2  # CHOLMOD_AUTO (1) by default
 _GIVEN, _AMD = 1, 2  # CHOLMOD's ordering codes (NATURAL is 0)
-_LAYOUT = ((8, "d", 1.2), (_OFF_SUPERNODAL, "i", 1), (60, "i", 0), (16, "d", 1.2), (24, "q", 5), (32, "q", 8), (40, "d", 40.0), (80, "d", 0.8),
-           (104, "q", 4), (120, "q", 48), (_OFF_PRINT, "i", 3), (_OFF_NMETHODS, "i", 0), (_OFF_METHOD0, "d", -1.0),
-           (_OFF_METHOD0 + _OFF_ORDERING, "i", _GIVEN),
-           (_OFF_METHOD0 + _METHOD_BYTES + _OFF_ORDERING, "i", _AMD), (_OFF_POSTORDER, "i", 1))
+# the defaults cholmod_l_start writes (offset, type, value): dbound, grow0..2, maxrank,
+# supernodal_switch, supernodal, final_ll, zrelax[0], nrelax[0], nrelax[2], print, nmethods,
+# method[0].lnz, method[0].ordering, method[1].ordering, postorder
+_LAYOUT = ((0, "d", 0.0), (8, "d", 1.2), (16, "d", 1.2), (24, "q", 5), (32, "q", 8), (40, "d", 40.0),
+           (_OFF_SUPERNODAL, "i", 1), (60, "i", 0), (80, "d", 0.8), (104, "q", 4), (120, "q", 48),
+           (_OFF_PRINT, "i", 3), (_OFF_NMETHODS, "i", 0), (_OFF_METHOD0, "d", -1.0),
+           (_OFF_METHOD0 + _OFF_ORDERING, "i", _GIVEN), (_OFF_METHOD0 + _METHOD_BYTES + _OFF_ORDERING, "i", _AMD),
+           (_OFF_POSTORDER, "i", 1))
 
 
 class _Sparse(ctypes.Structure):
@@ -207,6 +213,7 @@ class _Direct:
             finally:
                 _set_int(self.cm, _OFF_NMETHODS, 0)
                 _set_int(self.cm, _OFF_POSTORDER, 1)
+        self._hold = None  # CHOLMOD keeps no pointer into A
         if not L:
             raise SingularMatrixError("CHOLMOD's symbolic analysis failed (out of memory?)")
         self.L = ctypes.c_void_p(L)
@@ -216,6 +223,7 @@ class _Direct:
     def factor(self, A: sp.csc_matrix) -> None:
         S = self._sparse(A)
         ok = self.s.c.cholmod_l_factorize(ctypes.byref(S), self.L, self.cm)
+        self._hold = None
         n = A.shape[0]
         minor = int(view(self.L.value, 2, np.uint64)[_MINOR])
         if minor < n:
