@@ -12,7 +12,7 @@ SciPy CSC holding the lower triangle, all CHOLMOD reads (or the upper one where
 
 CHOLMOD inside cvxopt's wheels is called through its C API (ctypes, :mod:`plateqp.linalg.seam`) where its
 library and the layout of ``cholmod_common`` are the ones checked (CHOLMOD 3, as cvxopt 1.3
-ships it): CHOLMOD then reads the NumPy arrays of the lower triangle in place, with no cvxopt
+ships it): CHOLMOD then reads the NumPy arrays of one triangle in place, with no cvxopt
 matrix built (0.15 s of a 1.3 s factorisation at 256²), and each factor has its own workspace.
 Elsewhere, or with :data:`plateqp.linalg.seam.SEAM` set False, cvxopt's own binding is used, as
 below.
@@ -323,7 +323,8 @@ class Cholesky:
         if self.direct is not None:
             out = _trailing_at(self.direct.L.value, no)
             if out is None or not self._trailing_checks(out, no):
-                raise SingularMatrixError("the factor's trailing block could not be read")
+                raise SingularMatrixError("the factor's trailing block failed its check against a solve "
+                                          "(the matrix is near singular, or the factor is not laid out as read)")
             return out
         try:
             out = _cvx_trailing(self.F, no)
