@@ -10,7 +10,7 @@ cvxopt matrix before the clock starts. The matrix is
   plate's ``K``;
 * bed: a free ACM plate on a tensionless bed (k = 2·10⁴) whose surface falls away towards
   (1, 1) (gap 0.004 x + 0.002 y), under a uniform load and an off-centre point load (about
-  half of the plate lifts off): ``K + Bᵀ C B``, every bed spring bonded.
+  half of the plate lifts off): ``K + Bᵀ C B``, every bed spring bonded, on K's stored pattern.
 
 Parts (``--parts``, comma-separated):
 
