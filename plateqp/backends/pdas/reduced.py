@@ -69,7 +69,8 @@ class ReducedQP:
         if empty.size:
             raise SolverError(f"row {empty[0]} of G acts on no coupled variable: not a contact row")
         self.Kd = Kd
-        self.k = row_stiffness(sp.diags(Kd), self.B, "diagonal")  # that kind reads the diagonal alone  # local stiffness of each row: Σ_j B_ij² K_jj
+        # local stiffness of each row, Σ_j B_ij² K_jj: that kind reads the diagonal alone
+        self.k = row_stiffness(sp.diags(Kd), self.B, "diagonal")
         self.c = self.k / (1.0 + self.rho * self.k)  # in series with the row's spring
         self.P, self.q = P, qp.q
 

@@ -70,8 +70,11 @@ class SpringFactor:
         self.B, self.c = B, c
         self.s = 1.0 / np.sqrt(Kd)
         Babs = abs(B)
-        Kc = sp.csc_matrix(K)  # its stored pattern with ones (a sum of positives drops nothing: the
-        ones = sp.csc_matrix((np.ones(Kc.nnz), Kc.indices, Kc.indptr), shape=Kc.shape)  # ordering reads zeros)
+        Ks = sp.csc_matrix(K)
+        Ks.sort_indices()
+        # K's stored pattern as ones plus |B|ᵀ|B|: a sum of positives drops no entry, and the
+        # ordering reads K's stored zeros (plateqp.linalg.pattern)
+        ones = sp.csc_matrix((np.ones(Ks.nnz), Ks.indices, Ks.indptr), shape=Ks.shape)
         pat = sp.csc_matrix(ones + Babs.T @ Babs)
         pat.sort_indices()
         self.indptr, self.indices = pat.indptr, pat.indices
@@ -82,8 +85,6 @@ class SpringFactor:
         def pos(r, cc):
             return np.searchsorted(keys, np.asarray(cc, np.int64) * n + r)
 
-        Ks = sp.csc_matrix(K)
-        Ks.sort_indices()
         if Ks.nnz == nnz:  # B's pattern lies in K's (rows within one element): same structure
             self.base = Ks.data.astype(float, copy=True)
         else:
