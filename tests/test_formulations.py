@@ -64,3 +64,84 @@ def test_condensation_is_reused_across_gap_changes():
     fresh = pq.solve(sc2, backend="lemke", formulation="condensed")
     assert not np.allclose(first.reactions, fresh.reactions)
     np.testing.assert_allclose(reused.reactions, fresh.reactions, rtol=1e-10, atol=1e-12)
+
+
+# -- the dual's flexibility from the trailing block, corrected ------------------------------------
+
+@pytest.fixture(scope="module")
+def fine_dual():
+    """grid_rigid(32, 15): 225 posts on a 32² slab, where G from the trailing block alone
+    (accurate to about cond(K)·ε) is not enough at 1e-10 (measured: KKT 8e-10 with BPP)."""
+    sc = family("grid_rigid", 32, 15)
+    ref = pq.solve(sc, backend="pdas", formulation="primal", accuracy=1e-10)  # independent formulation
+    assert ref.status == pq.Status.OPTIMAL
+    return sc, ref
+
+
+def test_dual_is_corrected_where_its_flexibility_is_not_enough(fine_dual):
+    from plateqp.backends import get_backend
+    from plateqp.contact.kkt import kkt_report
+
+    sc, ref = fine_dual
+    d = Scaled.from_model(build_model(sc))
+    form = formulate(d, "dual")
+    raw = get_backend("bpp").solve(form.lcp, accuracy=1e-10)
+    assert not kkt_report(d, form.recover(raw), 1e-10).ok  # the uncorrected answer fails the check
+    res = pq.solve(sc, backend="bpp", formulation="dual", accuracy=1e-10)
+    assert res.status == pq.Status.OPTIMAL and res.kkt.worst <= 1e-10
+    assert 1 <= res.extras["corrections"] <= 3
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+
+
+def test_export_hands_the_exact_flexibility(fine_dual):
+    """The exported dual is all another solver sees: its exact solution passes at 1e-10 with no
+    correction (from the trailing block's G it fails: the test above)."""
+    from plateqp.backends import get_backend
+    from plateqp.backends.base import LCP
+    from plateqp.io import contact_qp
+
+    sc, ref = fine_dual
+    exp = contact_qp(sc, "dual")
+    raw = get_backend("bpp").solve(LCP(exp.qp.P, exp.qp.q), accuracy=1e-10)
+    res = exp.result(raw.x, accuracy=1e-10, solver="bpp")
+    assert res.status == pq.Status.OPTIMAL
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+
+
+class _Sloppy:
+    """BPP with every reaction then scaled by 1 + 1e-7, claiming optimal: the backend's own error."""
+
+    name = "test-sloppy"
+    accepts = frozenset({"lcp"})
+    warm_start = False
+
+    def available(self):
+        return True
+
+    def version(self):
+        return "0"
+
+    def solve(self, problem, accuracy="default", options=None):
+        from plateqp.backends import get_backend
+
+        raw = get_backend("bpp").solve(problem, accuracy=accuracy)
+        raw.x = raw.x * (1 + 1e-7)
+        raw.w = problem.M @ raw.x + problem.q
+        return raw
+
+
+def test_dual_correction_leaves_a_backends_own_error_alone(fine_dual):
+    """The correction removes G's error, not the backend's: the sloppy answer stays INACCURATE,
+    and no re-solve is spent on it (the gaps' error explains too little of the residual)."""
+    from plateqp.backends import registry
+
+    sc, _ = fine_dual
+    reg = registry()
+    reg[_Sloppy.name] = _Sloppy()
+    try:
+        with pytest.warns(pq.PlateQPWarning, match="inaccurate"):
+            res = pq.solve(sc, backend=_Sloppy.name, formulation="dual", accuracy=1e-10)
+    finally:
+        del reg[_Sloppy.name]
+    assert res.status == pq.Status.INACCURATE and res.kkt.worst > 1e-8
+    assert res.extras["corrections"] == 0

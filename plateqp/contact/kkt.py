@@ -69,9 +69,7 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     force = max(np.linalg.norm(data.f), np.linalg.norm(BtR), 1e-300)
     st = np.linalg.norm(r) / force
     w = data.B @ u
-    # the plate's own deflection too: with every support touching at zero gap, w and g0 vanish
-    delta = max(np.abs(w).max(initial=0.0), np.abs(data.g0).max(initial=0.0),
-                np.abs(u[data.is_w]).max(initial=0.0), 1e-300)
+    delta = deflection_scale(data, u, w)
     # A force residual st (of the load) deflects the plate by up to about st · w_load, the load's
     # own deflection scale; where the supports carry the load straight down the plate deflects
     # far less than that, and the same residual is a larger error relative to what it does.
@@ -100,6 +98,37 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
         tol=tol,
         scale=delta * data.W,
     )
+
+
+def deflection_scale(data: Scaled, u: np.ndarray, w: np.ndarray | None = None) -> float:
+    """The deflection scale δ of the gap residuals: the largest of the contact deflections B u,
+    the gaps and the plate's own deflection (with every support touching at zero gap, the first
+    two vanish)."""
+    w = data.B @ u if w is None else w
+    return max(np.abs(w).max(initial=0.0), np.abs(data.g0).max(initial=0.0),
+               np.abs(u[data.is_w]).max(initial=0.0), 1e-300)
+
+
+def defect_residual(data: Scaled, c: ContactSolution, e: np.ndarray, M: np.ndarray, tol: float) -> float:
+    """What correcting an error ``e`` in the gaps of an LCP gap = M R + q (a formulation's own
+    data, :meth:`plateqp.contact.formulations.Dual.defect`) would change in the solution ``c``,
+    in the units of :func:`kkt_report`'s natural residual: the gaps by e (max(k|e|/ρ_R, |e|/δ):
+    a gap left open by e where a support acts shows as about k·e), and, to first order on the
+    contact set A of ``c``, the reactions by ΔR = M_AA⁻¹ e_A (/ρ_R; large where two close
+    supports share a load, whose split is what an error of M spoils first)."""
+    if e.size == 0:
+        return 0.0
+    R = c.R
+    rscale = reaction_scale(R, data.f, tol)
+    a = np.abs(e)
+    size = max((local_stiffness(data) * a).max() / rscale, a.max() / deflection_scale(data, c.u))
+    A = np.flatnonzero(R > tol * rscale)
+    if A.size:
+        try:
+            size = max(size, np.abs(np.linalg.solve(M[np.ix_(A, A)], e[A])).max() / rscale)
+        except np.linalg.LinAlgError:  # a singular contact set: the gaps' measure alone
+            pass
+    return float(size)
 
 
 def reaction_scale(R: np.ndarray, f: np.ndarray, tol: float) -> float:

@@ -103,7 +103,10 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
 
     The very problem :func:`plateqp.solve` hands a QP backend for this formulation: the data
     are scaled by :meth:`Scaled.from_model <plateqp.contact.scaling.Scaled.from_model>` and
-    formulated by :func:`plateqp.contact.formulations.formulate`.
+    formulated by :func:`plateqp.contact.formulations.formulate`. One difference, for the dual:
+    its flexibility G is built here by refined column solves (accurate to ε; m solves), where
+    :func:`plateqp.solve` takes it from a factor's trailing block (to cond(K)·ε) and corrects
+    the backend's answer by re-solves (:meth:`plateqp.contact.formulations.Dual.corrected`).
 
     Parameters
     ----------
@@ -120,7 +123,9 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
     if model.contacts is None or model.contacts.m == 0:
         raise ProblemError(f"scene {model.scene.name!r} has no one-sided supports: there is no contact problem to export")
     data = Scaled.from_model(model)
-    form = formulate(data, formulation)
+    # the dual's G by refined column solves: the file's data are all another solver sees, and
+    # plateqp.solve's G (the trailing block's, to cond(K)·ε) is corrected by re-solves instead
+    form = formulate(data, formulation, exact_data=True)
     qp = form.problem(frozenset({"qp"}))
     c = model.contacts
     # contact point i: a discrete support (its index in the scene) or a bed node
