@@ -330,6 +330,11 @@ def test_scaled_keeps_the_stored_pattern_and_scales_like_diag_products():
         assert ref.nnz == 49 and out.nnz == A.nnz == laplacian(7).nnz
         np.testing.assert_array_equal(out.indices, A.indices)
         assert abs(out - ref).max() <= 1e-15 * abs(ref).max()
+    # a symmetric matrix stays exactly symmetric (each pair rounded alike), factor and all
+    R = sp.random(60, 60, 0.1, random_state=2, format="csr")
+    R = (R + R.T).tocsr()
+    out = linalg.pattern.scaled(R, 10.0 ** np.random.default_rng(3).uniform(-3, 3, 60), 1 / 3.7)
+    assert (out != out.T).nnz == 0
 
 
 def test_add_keeps_entries_that_sum_to_zero():
