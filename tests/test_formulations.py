@@ -145,3 +145,21 @@ def test_dual_correction_leaves_a_backends_own_error_alone(fine_dual):
         del reg[_Sloppy.name]
     assert res.status == pq.Status.INACCURATE and res.kkt.worst > 1e-8
     assert res.extras["corrections"] == 0
+
+
+def test_dual_recovers_u_by_one_solve_where_the_posts_carry_the_load():
+    """A simply supported 32² slab on 31 × 31 posts, heave in one corner: the posts carry nearly
+    all the load, so u0 = K⁻¹f and K⁻¹BᵀR are both far larger than u. Recovered as their
+    difference, the rounding of each left stationarity at 4e-10 (scaled by the load's own
+    deflection over the plate's, as kkt_report does); from one solve with f − BᵀR it is at
+    rounding. The reactions are PDAS's on the primal (an independent formulation)."""
+    xs = np.round(np.linspace(1 / 32, 31 / 32, 31) * 32) / 32
+    sc = pq.Scene(name="posts", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(32, 32, "acm"),
+                  edges={k: "simple" for k in ("left", "right", "bottom", "top")},
+                  loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.7, 0.6)],
+                  supports=[pq.Support(float(x), float(y), gap=float(2e-4 * (x + y - 1))) for x in xs for y in xs])
+    res = pq.solve(sc, backend="bpp", formulation="dual", accuracy=1e-10)
+    ref = pq.solve(sc, backend="pdas", formulation="primal", accuracy=1e-10)
+    assert res.status == ref.status == pq.Status.OPTIMAL
+    assert res.kkt.stationarity <= 1e-13
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-10 * np.abs(ref.reactions).max())
