@@ -187,11 +187,11 @@ def choice(scene, backend="auto", formulation="auto"):
     (lambda: F.grid_rigid(64, 9), "auto", ("pdas", "primal")),  # m = 81
     (lambda: F.grid_rigid(32, 15), "auto", ("pdas", "primal")),  # m = 225
     (lambda: F.bed(16), "auto", ("pdas", "primal")),  # m = 289, every node
-    # a named QP backend: condensed while m ≤ 1 % of the free dofs (and ≤ 1000)
-    (lambda: F.grid_rigid(32, 5), "osqp", ("osqp", "condensed")),  # m = 25 ≤ 30.07
-    (lambda: F.grid_rigid(32, 7), "osqp", ("osqp", "primal")),  # m = 49 > 30.07
-    (lambda: F.grid_rigid(64, 9), "clarabel", ("clarabel", "condensed")),  # m = 81 ≤ 121.6
-    (lambda: F.grid_rigid(64, 15), "clarabel", ("clarabel", "primal")),  # m = 225 > 121.6
+    # a named QP backend: condensed while m ≤ 10 % of the free dofs (and ≤ 1000)
+    (lambda: F.grid_rigid(32, 15), "osqp", ("osqp", "condensed")),  # m = 225 ≤ 300.7
+    (lambda: F.grid_rigid(32, "all"), "osqp", ("osqp", "primal")),  # m = 961 > 300.7
+    (lambda: F.grid_rigid(64, 30), "clarabel", ("clarabel", "condensed")),  # m = 900 ≤ 1000 < 1216
+    (lambda: F.grid_rigid(64, "all"), "clarabel", ("clarabel", "primal")),  # m = 3969 > 1000
     # a backend that takes one kind only gets it, whatever m
     (lambda: F.grid_rigid(32, "all"), "lemke", ("lemke", "condensed")),  # m = 961
     (lambda: F.grid_rigid(16, 3), "pdas", ("pdas", "primal")),  # m = 9

@@ -36,12 +36,19 @@ from .scaling import Scaled
 #   backend for the formulation, the first installed of AUTO_QP_BACKENDS, the external QP
 #   solvers in the order measured.
 # * a named QP backend (osqp, clarabel, qpsolvers:*, …): the condensed problem paid while
-#   m ≤ AUTO_CONDENSED_FRACTION × free dofs: the break-even of OSQP, Clarabel and ProxQP was
-#   m ≈ 25–50 at 3 k dofs, ≈ 100 at 12 k, ≈ 225–960 at 49 k; never beyond AUTO_CONDENSED_MAX
-#   (the dense work grows like m³, its memory like 8 m² bytes).
+#   m ≤ AUTO_CONDENSED_FRACTION × free dofs, never beyond AUTO_CONDENSED_MAX (the dense work
+#   grows like m³, its memory like 8 m² bytes). Re-measured once condensation came from one
+#   factorisation's trailing block (bench_scaling.py --parts contacts --meshes 32,64,128
+#   --ks 5,9,15,31, accuracy 1e-6; results/scaling-auto-s21.csv): condensed was faster for
+#   OSQP, Clarabel and ProxQP at every m up to 7.5 % of the dofs (225 posts at 32²: 1.8–2×),
+#   and at 2 % (961 at 128²: OSQP 7.4 s against 181 s, Clarabel 2.5 against 9.3, ProxQP 2.0
+#   against 15.9); at 7.9 % (961 at 64²) for OSQP and ProxQP but not Clarabel (2.1 s against
+#   1.4); at 32 % (961 at 32²) the primal for OSQP and Clarabel (7–8×). So 10 %: the worst
+#   case measured is Clarabel at 7.9 %, 1.5× its primal. (The 1 % before was measured while
+#   condensation took m refined column solves.)
 # * a backend that takes only one of them (lemke, bpp, pgs: LCPs; pdas: the primal) gets it.
 AUTO_LCP_MAX = 100
-AUTO_CONDENSED_FRACTION = 0.01
+AUTO_CONDENSED_FRACTION = 0.10
 AUTO_CONDENSED_MAX = 1000
 AUTO_QP_BACKENDS = ("clarabel", "qpsolvers:clarabel", "osqp", "cvxpy")
 
