@@ -54,7 +54,7 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
         points, and in a sweep (which re-uses the condensation) with at most 100; the rule and
         its measurements: :mod:`plateqp.contact.routing`, benchmarks/README.md)
     formulation : "primal", "condensed", "dual" or "auto" (with a named backend: the form it
-        takes; with a QP backend that takes all, condensed while m ≤ 1 % of the dofs and ≤ 1000)
+        takes; with a QP backend that takes all, condensed while m ≤ 10 % of the dofs and ≤ 1000)
     accuracy : "low", "default" or "high" (KKT tolerance 1e-3, 1e-6, 1e-9), or a tolerance
         between 1e-14 and 0.1 (each backend maps it to its own settings: the nearest preset's,
         with its tolerances scaled; see :func:`plateqp.backends.base.preset`), or "auto": a
