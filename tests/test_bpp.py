@@ -228,7 +228,7 @@ def test_warm_start_from_the_solution_takes_one_split():
 def test_bpp_ill_conditioned_against_lemke():
     """cond ≈ 1e8, the beam of :func:`ill_conditioned`; exact to rounding like Lemke's method.
 
-    (With the default p = 3 this one needs hundreds of Murty single pivots; a longer
+    (With the default p = 6 (or 3) this one needs hundreds of Murty single pivots; a longer
     patience with block pivots, p = 30, gets there in under a hundred splits.)
     """
     M, q = ill_conditioned(150)

@@ -28,14 +28,20 @@ ACCURACY: dict[str, dict[str, float]] = {
 #:                refactorisation at every change), "linalg" (:class:`plateqp.linalg.Factor`'s
 #:                own choice, a new factorisation at every change), "superlu" (Factor's SuperLU,
 #:                likewise); "auto": the first of these that is installed.
-#: ``p``          block exchanges allowed without progress before Murty's single exchange.
+#: ``p``          block exchanges allowed without progress before Murty's single exchange
+#:                (cycles always go to Murty's). 6, not Júdice–Pires' 3: on 30 × 30 post grids
+#:                the block steps stall near the end (infeasible rows 7 → 24 → 12 → 41), and
+#:                with 3 tries Murty's one-row steps then took 25–35 more sets; with 6, the
+#:                block steps find a better set: 61 → 35, 46 → 34, 62 → 30 and 58 → 31 sets at
+#:                32², 64², 128², 256² (a quarter of the dense method's time at 64²). Nothing
+#:                else measured changed (other post grids, beds, 45² and 63² posts at 128²).
 #: ``max_rows``   refuse a ``G`` with more rows than ``min(n, max_rows)``.
 #: ``max_iter``   active sets solved before ``Status.MAX_ITER``; default 50 + 2 m.
 #: ``dual_start`` (sparse, stiff rows, cold start) find the active set first by projected Newton
 #:                on the dual energy (:func:`.sparse.dual_newton`); False: plain PDAS from the
 #:                two-sided problem (every row active).
 SETTINGS: dict = {"method": "auto", "max_dense": 2000, "penalty": 1e8, "prox": 1e-12, "factor": "auto",
-                  "p": 3, "max_rows": 100_000, "max_iter": None, "dual_start": True}
+                  "p": 6, "max_rows": 100_000, "max_iter": None, "dual_start": True}
 
 #: Keys accepted in the ``options`` dict of :func:`solve`.
 OPTIONS = ("active", "trace") + tuple(SETTINGS) + tuple(ACCURACY["default"])
