@@ -278,7 +278,7 @@ def _condense(data: Scaled):
         # 1.7 s on grid_rigid(128, 30))
         d = np.concatenate([1.0 / B.data, np.ones(others.size)])
         T = (P @ sp.diags(d)).tocsr()
-        Kt = pattern.scaled(data.K[order][:, order], d)
+        Kt = pattern.scaled(_permuted(data.K, order), d)
         return _condensed_factor(data, T, Kt, m)
     Bm = B[:, master].tocsc()
     Bo = B[:, others].tocsc()
@@ -304,8 +304,15 @@ def _condense(data: Scaled):
     Tm = sp.hstack([Binv, -X])
     To = sp.hstack([sp.csr_matrix((others.size, m)), sp.identity(others.size)])
     T = (P @ sp.vstack([Tm, To])).tocsr()
-    Kt = pattern.congruence(T, data.K, like=data.K[order][:, order])  # stored zeros kept (ordering)
+    Kt = pattern.congruence(T, data.K, like=_permuted(data.K, order))  # stored zeros kept (ordering)
     return _condensed_factor(data, T, Kt, m)
+
+
+def _permuted(K, order: np.ndarray) -> sp.csc_matrix:
+    """``K[order][:, order]`` (CSC), without SciPy's slow path for the rows of a CSC matrix:
+    through the transpose, a CSR view of the same arrays (exact for any K)."""
+    K = sp.csc_matrix(K)
+    return K.T.tocsr()[order][:, order].T.tocsc()
 
 
 def _condensed_factor(data: Scaled, T, Kt, m: int):
