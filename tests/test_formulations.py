@@ -163,3 +163,53 @@ def test_dual_recovers_u_by_one_solve_where_the_posts_carry_the_load():
     assert res.status == ref.status == pq.Status.OPTIMAL
     assert res.kkt.stationarity <= 1e-13
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-10 * np.abs(ref.reactions).max())
+
+
+class _Flaky:
+    """BPP on the first call; then a solver that fails (``mode``): an error, no answer, NaNs."""
+
+    name = "test-flaky"
+    accepts = frozenset({"lcp"})
+    warm_start = False
+
+    def __init__(self, mode):
+        self.mode, self.calls = mode, 0
+
+    def available(self):
+        return True
+
+    def version(self):
+        return "0"
+
+    def solve(self, problem, accuracy="default", options=None):
+        from plateqp.backends import get_backend
+        from plateqp.backends.base import RawSolution, Status
+
+        self.calls += 1
+        if self.calls == 1:
+            return get_backend("bpp").solve(problem, accuracy=accuracy)
+        if self.mode == "raise":
+            raise pq.SolverError("the flaky solver gave up")
+        if self.mode == "none":
+            return RawSolution(status=Status.ERROR, solver_status="gave up")
+        return RawSolution(status=Status.OPTIMAL, x=np.full(problem.n, np.nan), solver_status="solved (NaN)")
+
+
+@pytest.mark.parametrize("mode", ["raise", "none", "nan"])
+def test_a_failed_correction_keeps_the_answer_in_hand(fine_dual, mode):
+    """The first answer fails the check by G's error (see above); the re-solve fails: the first
+    answer is returned, INACCURATE with its own residuals, and the failure is said."""
+    from plateqp.backends import registry
+
+    sc, ref = fine_dual
+    reg = registry()
+    reg[_Flaky.name] = flaky = _Flaky(mode)
+    try:
+        with pytest.warns(pq.PlateQPWarning, match="inaccurate"):
+            res = pq.solve(sc, backend=_Flaky.name, formulation="dual", accuracy=1e-10)
+    finally:
+        del reg[_Flaky.name]
+    assert flaky.calls == 2
+    assert res.status == pq.Status.INACCURATE and np.isfinite(res.kkt.worst)
+    assert res.extras["corrections"] == 0 and res.extras["correction_failed"]
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * np.abs(ref.reactions).max())

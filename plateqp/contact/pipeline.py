@@ -81,24 +81,36 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     # block: Dual.defect) hands the backend a corrected problem; the backend's own error is
     # never corrected. Not worth a re-solve: a change below a tenth of the tolerance, or below a
     # quarter of the worst residual (the rest is the backend's, which another round keeps).
+    # The answer kept is always the best one checked: a round that fails, or ends worse, is
+    # dropped (and said in extras["correction_failed"]), never raised over an answer in hand.
+    failed = None
     while corrections < form.max_corrections and raw.status.solved and not res.kkt.ok:
         e = form.defect(raw)
         size = defect_residual(form.data, form.recover(raw), e, form.lcp.M, acc.tol)
-        if size <= 0.1 * acc.tol or 4.0 * size < res.kkt.worst:
+        if not np.isfinite(size) or size <= 0.1 * acc.tol or 4.0 * size < res.kkt.worst:
             break
         nxt = form.corrected(e)
         opts = dict(options or {})
         if getattr(b, "warm_start", False) and "active" in raw.extras and "active" not in opts:
             opts["active"] = raw.extras["active"]
         t3 = time.perf_counter()
-        again = b.solve(nxt.problem(b.accepts), accuracy=acc, options=opts)
-        solve_s += time.perf_counter() - t3
+        try:
+            again = b.solve(nxt.problem(b.accepts), accuracy=acc, options=opts)
+        except (SolverError, ProblemError) as exn:
+            failed = f"{type(exn).__name__}: {exn}"
+            break
+        finally:
+            solve_s += time.perf_counter() - t3
         if again.x is None or again.status in (Status.INFEASIBLE, Status.UNBOUNDED):
-            break  # keep the answer before, with its residuals
-        form, raw, corrections = nxt, again, corrections + 1
+            failed = f"{again.status.value} ({again.solver_status})"
+            break
+        checked = finish(model, nxt, again, acc, backend)
+        if not checked.kkt.worst <= res.kkt.worst:
+            failed = f"worse (worst KKT residual {checked.kkt.worst:.2e} against {res.kkt.worst:.2e})"
+            break
+        form, raw, res, corrections = nxt, again, checked, corrections + 1
         if raw.iterations is not None:
             iterations = (iterations or 0) + raw.iterations
-        res = finish(model, form, raw, acc, backend)
     if res.status != Status.OPTIMAL:
         warnings.warn(f"{backend} on the {formulation} problem: {res.status.value} "
                       f"(worst KKT residual {res.kkt.worst:.2e}, asked {res.kkt.tol:.0e})", PlateQPWarning,
@@ -107,6 +119,8 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     res.extras = {"solver_status": raw.solver_status, **raw.extras}
     if form.max_corrections:
         res.extras["corrections"] = corrections
+        if failed is not None:
+            res.extras["correction_failed"] = failed
     res.times.update(formulate=t1 - t0, solve=solve_s, recover=time.perf_counter() - t2 - solve_s + (t2 - t1))
     return res
 
