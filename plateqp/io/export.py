@@ -106,7 +106,7 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
     formulated by :func:`plateqp.contact.formulations.formulate`. One difference, for the dual:
     its flexibility G is built here by refined column solves (accurate to ε; m solves), where
     :func:`plateqp.solve` takes it from a factor's trailing block (to cond(K)·ε) and corrects
-    the backend's answer by re-solves (:meth:`plateqp.contact.formulations.Dual.corrected`).
+    the backend's answer by re-solves (:meth:`plateqp.contact.formulations.Dual.defect`).
 
     Parameters
     ----------

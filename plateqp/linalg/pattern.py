@@ -22,7 +22,7 @@ import scipy.sparse as sp
 
 def scaled(K: sp.spmatrix, s: np.ndarray, factor: float = 1.0) -> sp.csr_matrix | sp.csc_matrix:
     """``factor · diag(s) K diag(s)`` with exactly ``K``'s stored pattern (CSR or CSC as ``K``;
-    any other format becomes CSR). One copy of the values, no product."""
+    any other format becomes CSR). One copy of the values and the indices, no product."""
     K = K if sp.isspmatrix_csr(K) or sp.isspmatrix_csc(K) else sp.csr_matrix(K)
     s = np.asarray(s, dtype=float)
     # in place on one array: (s_i s_j)·factor·K_ij, the same rounding for (i, j) and (j, i), so a
