@@ -1552,8 +1552,10 @@ assert np.allclose(w_nodes[post_nodes], G[:, j], rtol=1e-12)
 assert np.all(np.argmax(G, axis=0) == np.arange(5))        # each post moves most under its own force"""),
 md("""**Cost.** By hand we factorised K_oo densely and solved for m columns: fine for a few posts
 on a small mesh. plateqp gets S as the trailing block of one sparse factorisation of K with
-the contact dofs ordered last (no column solves), and never forms G unless the dual is asked
-for: G from S⁻¹ would carry S's condition number into every entry."""),
+the contact dofs ordered last (no column solves), and forms G only when the dual is asked
+for. G taken as S⁻¹ from that block carries the condition number of K into its entries, so
+plateqp checks the dual's answer against the exact gaps and, where G's error shows, hands the
+backend the problem again with the gaps corrected (a defect correction: one round is typical)."""),
 ])
 
 print("written")
