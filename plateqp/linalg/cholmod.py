@@ -439,4 +439,3 @@ def _trailing_at(ptr: int, no: int) -> np.ndarray | None:
         np.fill_diagonal(out, 1.0)
         out *= np.sqrt(d)[None, :]
     return out
-

@@ -166,6 +166,7 @@ class _Direct:
         _set_int(self.cm, _OFF_SUPERNODAL, _SUPERNODAL)
         self.L = ctypes.c_void_p()
         self._hold = None  # the arrays the last cholmod_sparse points at
+        self._wide = None  # (A, indptr, indices as int64): order, analyse and factor of one A widen once
 
     def __del__(self) -> None:
         try:
@@ -175,10 +176,17 @@ class _Direct:
         except Exception:  # pragma: no cover - interpreter shutdown
             pass
 
+    def _indices(self, A: sp.csc_matrix) -> tuple[np.ndarray, np.ndarray]:
+        """``A``'s indptr and indices as CHOLMOD's 64-bit integers, widened once per matrix (the
+        same triangle goes through order, analyse and factor)."""
+        if self._wide is None or self._wide[0] is not A:
+            self._wide = (A, np.ascontiguousarray(A.indptr, dtype=np.int64),
+                          np.ascontiguousarray(A.indices, dtype=np.int64))
+        return self._wide[1], self._wide[2]
+
     def _sparse(self, A: sp.csc_matrix) -> _Sparse:
         n = A.shape[0]
-        p = np.ascontiguousarray(A.indptr, dtype=np.int64)
-        i = np.ascontiguousarray(A.indices, dtype=np.int64)
+        p, i = self._indices(A)
         x = np.ascontiguousarray(A.data, dtype=np.float64)
         self._hold = (p, i, x)
         return _Sparse(n, n, int(p[-1]), p.ctypes.data, i.ctypes.data, None, x.ctypes.data, None, _stype(A),
@@ -186,8 +194,7 @@ class _Direct:
 
     def order(self, A: sp.csc_matrix) -> np.ndarray:
         n = A.shape[0]
-        p = np.ascontiguousarray(A.indptr, dtype=np.int64)
-        i = np.ascontiguousarray(A.indices, dtype=np.int64)
+        p, i = self._indices(A)
         P = np.empty(n, dtype=np.int64)
         i64p = ctypes.POINTER(ctypes.c_int64)
         st = self.s.amd.amd_l_order(n, p.ctypes.data_as(i64p), i.ctypes.data_as(i64p), P.ctypes.data_as(i64p),
@@ -223,7 +230,7 @@ class _Direct:
     def factor(self, A: sp.csc_matrix) -> None:
         S = self._sparse(A)
         ok = self.s.c.cholmod_l_factorize(ctypes.byref(S), self.L, self.cm)
-        self._hold = None
+        self._hold = self._wide = None  # released: a refactorisation brings its own matrix
         n = A.shape[0]
         minor = int(view(self.L.value, 2, np.uint64)[_MINOR])
         if minor < n:
