@@ -18,9 +18,11 @@ import warnings
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 import plateqp as pq
 from plateqp import families as F
+from plateqp.backends.pdas import factor as pdas_factor
 from plateqp.backends.pdas import sparse as pdas_sparse
 from plateqp.errors import ProblemError
 
@@ -143,3 +145,85 @@ def test_bed_24_statics_and_contact_physics():
     np.testing.assert_allclose(res.reactions @ xy[:, 1], F.P * F.PY, rtol=1e-9)
     assert 0.05 < res.active.mean() < 0.95
     assert res.reactions.min() >= -1e-10 * res.reactions.max()
+
+
+# ----------------------------------------------------------------- the factor's low-rank corrections
+
+
+@pytest.fixture(scope="module")
+def bed_8_matrices():
+    from plateqp.assembly import build_model
+
+    m = build_model(F.bed(8))
+    K = m.K.tocsc()
+    return K, m.contacts.B.tocsr(), K.diagonal().copy()
+
+
+def _h_inverse(K, B, Kd, w, sigma, b):
+    """An independent reference: SciPy's sparse LU of ``K + σ diag(K) + Bᵀ diag(w) B``."""
+    import scipy.sparse.linalg as spla
+
+    H = sp.csc_matrix(K + sp.diags(sigma * Kd) + B.T @ sp.diags(w) @ B)
+    return spla.spsolve(H, b)
+
+
+@pytest.mark.parametrize("method", ["cvxopt", "linalg"])
+def test_a_few_changed_rows_solve_by_woodbury_on_the_factor_in_hand(bed_8_matrices, method, monkeypatch):
+    from plateqp.linalg import bindings
+
+    # on an 8² plate a factorisation costs a few solves: the cost rule alone would refactorise
+    monkeypatch.setattr(pdas_factor, "LOWRANK_COST", 1e9)
+    if method == "cvxopt" and "cvxopt" not in bindings():
+        pytest.skip("cvxopt's CHOLMOD is not installed")
+    K, B, Kd = bed_8_matrices
+    m, sigma = B.shape[0], 1e-12
+    rng = np.random.default_rng(3)
+    w0 = rng.uniform(0.5, 2.0, m) * Kd.max()
+    fac = pdas_factor.SpringFactor(K, B, Kd, np.full(m, Kd.max()), sigma, method)
+    fac.set(w0)
+    b = rng.standard_normal(K.shape[0])
+    fac.solve(b)  # a measured solve time for the cost rule
+    w1 = w0.copy()
+    w1[[3, 17, 40]] = 0.0  # three springs leave
+    w1[[5, 6]] *= 3.0  # two get stiffer
+    fac.set(w1)
+    assert fac.stats["factorisations"] == 1 and fac.stats["lowrank"] == 1 and not fac.clean
+    ref = _h_inverse(K, B, Kd, w1, sigma, b)
+    x = fac.solve(b)
+    np.testing.assert_allclose(x, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
+    H1 = K + sp.diags(sigma * Kd) + B.T @ sp.diags(w1) @ B  # backward error at rounding
+    assert np.abs(H1 @ x - b).max() <= 1e-12 * np.abs(b).max()
+    # back to the factor's own w: the correction is dropped, the factor solves as it is
+    fac.set(w0)
+    assert fac.clean and fac.stats["factorisations"] == 1
+    ref0 = _h_inverse(K, B, Kd, w0, sigma, b)
+    np.testing.assert_allclose(fac.solve(b), ref0, rtol=0, atol=1e-9 * np.abs(ref0).max())
+    # too many rows for a correction: a factorisation
+    w2 = w0.copy()
+    w2[: pdas_factor.LOWRANK_MAX + 1] = 0.0
+    fac.set(w2)
+    assert fac.stats["factorisations"] == 2 and fac.clean
+
+
+def test_a_rigid_row_entering_or_leaving_refactorises(bed_8_matrices, monkeypatch):
+    """A penalty row κ = 1e8 times stiffer than its dofs: Woodbury would lose ~8 digits (leaving:
+    cancellation in the capacitance, as a downdate; entering: B x carries an error ε|x| that
+    the row's weight multiplies into the residual). The factor is rebuilt instead, and its
+    solve's backward error stays at rounding."""
+    monkeypatch.setattr(pdas_factor, "LOWRANK_COST", 1e9)
+    K, B, Kd = bed_8_matrices
+    m, sigma = B.shape[0], 1e-12
+    c = np.full(m, Kd.max())
+    w0 = np.full(m, 1e8 * Kd.max())
+    w0[::2] = 0.0
+    fac = pdas_factor.SpringFactor(K, B, Kd, c, sigma, "linalg")
+    fac.set(w0)
+    b = np.ones(K.shape[0])
+    for row, n_fac in ((1, 2), (2, 3)):  # row 1 leaves, then row 2 enters
+        w = fac.w.copy()
+        w[row] = 1e8 * Kd.max() - w[row]
+        fac.set(w)
+        assert fac.stats["factorisations"] == n_fac and fac.stats["lowrank"] == 0 and fac.clean
+        H = K + sp.diags(sigma * Kd) + B.T @ sp.diags(w) @ B
+        x = fac.solve(b)
+        assert np.abs(H @ x - b).max() <= 1e-9 * np.abs(b).max()

@@ -102,7 +102,14 @@ that is cheaper (the costs are measured as the solve goes: about 0.4 ms a row ag
 a factorisation on a 128 × 128 plate). A downdate of a stiff penalty loses about ``ε κ``
 relative; that only slows the refinement, and the factor is rebuilt when the accumulated
 loss says so. Without CHOLMOD every change refactorises with :class:`plateqp.linalg.Factor`
-(SuperLU: its analysis cannot be re-used).
+(SuperLU: its analysis cannot be re-used). Without an in-place update (cvxopt's CHOLMOD, the
+default install, or Factor), a change of a few soft rows is taken by the Sherman–Morrison–
+Woodbury formula on the factor in hand (one solve with k right-hand sides, a k × k
+capacitance) while that costs under half a factorisation; not for a rigid row, entering or
+leaving, whose weight would multiply Woodbury's rounding into the residual (``ε κ``), nor
+where the factor is nearly singular along a rigid motion the rows move
+(``extras["lowrank"]``, ``extras["lowrank_rows"]``). On the 128 × 128 bed below, the last
+exchange (two rows) is such a correction: two factorisations instead of three.
 
 A bed's first steps change thousands of rows each (plain PDAS from the two-sided start:
 16 641 → 11 501 → 9 352 → 8 727 → 8 658 rows in contact on a 128 × 128 bed, a
@@ -115,7 +122,7 @@ search (the energy is piecewise quadratic along a line). Removing soft springs c
 ``H`` only in its few smooth, spring-dominated modes, so PCG needs a handful of iterations.
 When a Newton step changes few rows (``NEWTON_SETTLED``), the factor is rebuilt once for that
 active set and exact steps finish as above. On the 128 × 128 bed: three Newton steps, 13 PCG
-iterations, then one exact step and two updated rows.
+iterations, then one exact step and two rows exchanged (a Woodbury correction).
 
 Stiff rows (rigid posts) on a held plate, cold start: plain PDAS from the two-sided start
 cycles and falls back to Murty's one row per step (a 64 × 64 slab with 45 × 45 posts: 407

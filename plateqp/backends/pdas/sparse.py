@@ -1,23 +1,17 @@
 r"""The sparse method: a factor of ``K + σ diag(K) + B_Aᵀ W_A B_A`` kept current as the active
-set changes, exact steps by refinement, and a first phase: Newton–PCG for soft rows, projected
+set changes (:mod:`.factor`), exact steps by refinement, and a first phase: Newton–PCG for soft rows, projected
 Newton on the dual energy for stiff rows on a held plate (see the package docstring: "Two ways
 to solve a step", "Singular steps and no equilibrium")."""
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
-import scipy.sparse as sp
 
-from ...errors import ProblemError, SingularMatrixError, SolverError
-from ...linalg import Cholesky, Factor, bindings
 from ..base import Status
 from .options import (
     ALPHA_MAX,
     ALPHA_MIN,
     ARMIJO,
-    DOWNDATE_LOSS,
     DUAL_DEFINITE,
     DUAL_FLAT,
     DUAL_RISES,
@@ -38,158 +32,10 @@ from .options import (
     RAY_MESSAGE,
     SINGULAR_QUOTIENT,
 )
+from .factor import SpringFactor
 from .reduced import Exchange, Outcome, ReducedQP, infeasible
 
 __all__ = ["SpringFactor", "run_sparse"]
-
-
-class SpringFactor:
-    """Factor of ``H(w) = K + σ diag(K) + Bᵀ diag(w) B``, kept current as ``w`` changes.
-
-    CHOLMOD: one symbolic analysis of the pattern of ``K + BᵀB`` (equilibrated by
-    ``diag(K)^(-1/2)``); changes by numeric refactorisation with that analysis or, with
-    scikit-sparse, by rank-k update/downdate, whichever the measured costs say is cheaper.
-    Otherwise :class:`plateqp.linalg.Factor` on every change.
-    """
-
-    def __init__(self, K: sp.csc_matrix, B: sp.csr_matrix, Kd: np.ndarray, c: np.ndarray,
-                 sigma: float, method: str) -> None:
-        libs = bindings()
-        if method == "auto":
-            method = ("cholmod" if "sksparse" in libs else "cvxopt" if "cvxopt" in libs else "linalg")
-        if method not in ("cholmod", "cvxopt", "linalg", "superlu"):
-            raise ProblemError("option factor must be 'auto', 'cholmod', 'cvxopt', 'linalg' or 'superlu', "
-                               f"got {method!r}")
-        lib = {"cholmod": "sksparse", "cvxopt": "cvxopt"}.get(method)
-        if lib is not None and lib not in libs:
-            raise SolverError(f"option factor={method!r}: that CHOLMOD binding is not in use here "
-                              f"(plateqp.linalg found: {libs or 'none'})")
-        self.method = method
-        self.chol = Cholesky(lib) if lib else None
-        n, m = K.shape[0], B.shape[0]
-        self.B, self.c = B, c
-        self.s = 1.0 / np.sqrt(Kd)
-        Babs = abs(B)
-        Ks = sp.csc_matrix(K)
-        Ks.sort_indices()
-        # K's stored pattern as ones plus |B|ᵀ|B|: a sum of positives drops no entry, and the
-        # ordering reads K's stored zeros (plateqp.linalg.pattern)
-        ones = sp.csc_matrix((np.ones(Ks.nnz), Ks.indices, Ks.indptr), shape=Ks.shape)
-        pat = sp.csc_matrix(ones + Babs.T @ Babs)
-        pat.sort_indices()
-        self.indptr, self.indices = pat.indptr, pat.indices
-        cols = np.repeat(np.arange(n), np.diff(pat.indptr))
-        keys = cols.astype(np.int64) * n + pat.indices
-        nnz = keys.size
-
-        def pos(r, cc):
-            return np.searchsorted(keys, np.asarray(cc, np.int64) * n + r)
-
-        if Ks.nnz == nnz:  # B's pattern lies in K's (rows within one element): same structure
-            self.base = Ks.data.astype(float, copy=True)
-        else:
-            Kc = Ks.tocoo()
-            self.base = np.bincount(pos(Kc.row, Kc.col), weights=Kc.data, minlength=nnz)
-        self.base[pos(np.arange(n), np.arange(n))] += sigma * Kd
-        # all products B_ia B_ib of each row, and where they go in the pattern
-        L = np.diff(B.indptr)
-        L2 = L * L
-        pr = np.repeat(np.arange(m), L2)
-        within = np.arange(L2.sum()) - np.repeat(np.cumsum(L2) - L2, L2)
-        ia = B.indptr[pr] + within // L[pr]
-        ib = B.indptr[pr] + within % L[pr]
-        self.pair_row, self.pair_val = pr, B.data[ia] * B.data[ib]
-        self.pair_pos = pos(B.indices[ia], B.indices[ib])
-        self.scale = self.s[pat.indices] * self.s[cols]
-        self.nnz = nnz
-        # CHOLMOD reads one triangle only: hand it that (half the data)
-        up = self.chol is not None and self.chol.upper
-        self.low = np.flatnonzero(pat.indices <= cols if up else pat.indices >= cols)
-        self.low_indptr = np.concatenate([[0], np.cumsum(np.bincount(cols[self.low], minlength=n))])
-        self.w = None
-        self.fac = None  # a plateqp.linalg.Factor (linalg, superlu)
-        self.loss = 0.0
-        self.t_factor = None  # seconds per numeric factorisation (last measured)
-        self.t_row = None  # seconds per updated row (last measured)
-        self.stats = {"analyse_s": 0.0, "factorisations": 0, "factor_s": 0.0, "updates": 0, "updated_rows": 0,
-                      "update_s": 0.0, "solves": 0, "solve_s": 0.0}
-
-    def _matrix(self, w: np.ndarray, scaled: bool) -> sp.csc_matrix:
-        data = self.base + np.bincount(self.pair_pos, weights=w[self.pair_row] * self.pair_val,
-                                       minlength=self.nnz)
-        n = self.s.size
-        if scaled:  # one triangle (see above), equilibrated, for CHOLMOD
-            low = self.low
-            return sp.csc_matrix((data[low] * self.scale[low], self.indices[low], self.low_indptr), shape=(n, n))
-        return sp.csc_matrix((data, self.indices, self.indptr), shape=(n, n))
-
-    def refactor(self, w: np.ndarray) -> None:
-        t0 = time.perf_counter()
-        if self.chol is not None:
-            H = self._matrix(w, scaled=True)
-            if self.chol.sym is None:
-                self.chol.analyse(H)
-                t1 = time.perf_counter()
-                self.stats["analyse_s"] += t1 - t0
-                t0 = t1
-            try:
-                self.chol.factor(H)
-            except SingularMatrixError as exn:
-                raise SolverError(f"pdas: the active-set matrix is not positive definite ({exn}); is P "
-                                  "positive semidefinite?") from exn
-        else:  # plateqp.linalg.Factor: its own choice of library, or SuperLU; analysis not re-used
-            try:
-                self.fac = Factor(self._matrix(w, scaled=False), method="auto" if self.method == "linalg" else "superlu")
-            except Exception as exn:
-                raise SolverError(f"pdas: the active-set matrix could not be factorised ({exn})") from exn
-        dt = time.perf_counter() - t0
-        self.t_factor = dt
-        self.stats["factorisations"] += 1
-        self.stats["factor_s"] += dt
-        self.w = w.copy()
-        self.loss = 0.0
-
-    def set(self, w: np.ndarray) -> None:
-        """Make the factor that of ``H(w)``."""
-        if self.w is None:
-            self.refactor(w)
-            return
-        dw = w - self.w
-        changed = np.flatnonzero(dw)
-        if changed.size == 0:
-            return
-        down = changed[dw[changed] < 0]
-        loss = self.loss + np.finfo(float).eps * np.sum(-dw[down] / self.c[down])
-        t_row = self.t_row if self.t_row is not None else self.t_factor / 400.0
-        if (self.chol is None or not self.chol.can_update or changed.size * t_row > 0.7 * self.t_factor
-                or loss > DOWNDATE_LOSS):
-            self.refactor(w)
-            return
-        t0 = time.perf_counter()
-        up = changed[dw[changed] > 0]
-        for rows, subtract in ((up, False), (down, True)):  # updates first: stays definite
-            if rows.size:
-                C = (self.B[rows].T.tocsc() @ sp.diags(np.sqrt(np.abs(dw[rows])))).tocsc()
-                C = sp.diags(self.s) @ C
-                self.chol.update(sp.csc_matrix(C), subtract)
-        dt = time.perf_counter() - t0
-        self.t_row = dt / changed.size
-        self.stats["updates"] += 1
-        self.stats["updated_rows"] += int(changed.size)
-        self.stats["update_s"] += dt
-        self.w = w.copy()
-        self.loss = loss
-
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        t0 = time.perf_counter()
-        if self.chol is not None:
-            x = self.s * self.chol.solve(self.s * b)
-        else:
-            x = self.fac.solve(b, refine=0)
-        self.stats["solves"] += 1
-        self.stats["solve_s"] += time.perf_counter() - t0
-        return x
-
 
 
 class Step:
@@ -457,7 +303,7 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         entered = False
         while True:
             step = solve_active(pb, fac, W, A, u, lam, sigma, exact, null)
-            if step.ray is not None and fac.loss > 0:  # judge a free rigid motion on a clean factor
+            if step.ray is not None and not fac.clean:  # judge a free rigid motion on a clean factor
                 fac.refactor(np.where(A, W, 0.0))
                 step = solve_active(pb, fac, W, A, u, lam, sigma, exact, null)
             if step.ray is None:

@@ -1,0 +1,246 @@
+"""The factor of the sparse method: ``K + σ diag(K) + B_Aᵀ W_A B_A`` kept current as the active set
+changes (numeric refactorisation with one analysis, CHOLMOD's rank-k updates, or a Woodbury
+correction on the factor in hand; see the package docstring, "The method")."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from ...errors import ProblemError, SingularMatrixError, SolverError
+from ...linalg import Cholesky, Factor, bindings
+from .options import DOWNDATE_LOSS, LOWRANK_COND, LOWRANK_COST, LOWRANK_MAX
+
+__all__ = ["SpringFactor"]
+
+
+class SpringFactor:
+    """Factor of ``H(w) = K + σ diag(K) + Bᵀ diag(w) B``, kept current as ``w`` changes.
+
+    CHOLMOD: one symbolic analysis of the pattern of ``K + BᵀB`` (equilibrated by
+    ``diag(K)^(-1/2)``); changes by numeric refactorisation with that analysis or, with
+    scikit-sparse, by rank-k update/downdate, whichever the measured costs say is cheaper.
+    Otherwise :class:`plateqp.linalg.Factor` on every change.
+
+    Without an in-place update (cvxopt's CHOLMOD, the default install; or Factor), a few
+    changed rows are taken by the Sherman–Morrison–Woodbury formula on the factor in hand
+    instead: for ``H(w) = H(w₀) + Uᵀ diag(Δw) U`` (``U`` the changed rows of ``B``),
+    ``H(w)⁻¹b = x − Z C⁻¹ U x`` with ``x = H(w₀)⁻¹b``, ``Z = H(w₀)⁻¹Uᵀ`` (one solve with k
+    right-hand sides; a column is kept for as long as the factor) and the k × k capacitance
+    ``C = diag(1/Δw) + U Z``. It is used while those columns cost less than half a
+    factorisation (measured) and the rows removed lose no more digits than a downdate would be
+    allowed to (``DOWNDATE_LOSS``); the exact steps' refinement takes what rounding is left.
+    """
+
+    def __init__(self, K: sp.csc_matrix, B: sp.csr_matrix, Kd: np.ndarray, c: np.ndarray,
+                 sigma: float, method: str) -> None:
+        libs = bindings()
+        if method == "auto":
+            method = ("cholmod" if "sksparse" in libs else "cvxopt" if "cvxopt" in libs else "linalg")
+        if method not in ("cholmod", "cvxopt", "linalg", "superlu"):
+            raise ProblemError("option factor must be 'auto', 'cholmod', 'cvxopt', 'linalg' or 'superlu', "
+                               f"got {method!r}")
+        lib = {"cholmod": "sksparse", "cvxopt": "cvxopt"}.get(method)
+        if lib is not None and lib not in libs:
+            raise SolverError(f"option factor={method!r}: that CHOLMOD binding is not in use here "
+                              f"(plateqp.linalg found: {libs or 'none'})")
+        self.method = method
+        self.chol = Cholesky(lib) if lib else None
+        n, m = K.shape[0], B.shape[0]
+        self.B, self.c = B, c
+        self.s = 1.0 / np.sqrt(Kd)
+        Babs = abs(B)
+        Ks = sp.csc_matrix(K)
+        Ks.sort_indices()
+        # K's stored pattern as ones plus |B|ᵀ|B|: a sum of positives drops no entry, and the
+        # ordering reads K's stored zeros (plateqp.linalg.pattern)
+        ones = sp.csc_matrix((np.ones(Ks.nnz), Ks.indices, Ks.indptr), shape=Ks.shape)
+        pat = sp.csc_matrix(ones + Babs.T @ Babs)
+        pat.sort_indices()
+        self.indptr, self.indices = pat.indptr, pat.indices
+        cols = np.repeat(np.arange(n), np.diff(pat.indptr))
+        keys = cols.astype(np.int64) * n + pat.indices
+        nnz = keys.size
+
+        def pos(r, cc):
+            return np.searchsorted(keys, np.asarray(cc, np.int64) * n + r)
+
+        if Ks.nnz == nnz:  # B's pattern lies in K's (rows within one element): same structure
+            self.base = Ks.data.astype(float, copy=True)
+        else:
+            Kc = Ks.tocoo()
+            self.base = np.bincount(pos(Kc.row, Kc.col), weights=Kc.data, minlength=nnz)
+        self.base[pos(np.arange(n), np.arange(n))] += sigma * Kd
+        # all products B_ia B_ib of each row, and where they go in the pattern
+        L = np.diff(B.indptr)
+        L2 = L * L
+        pr = np.repeat(np.arange(m), L2)
+        within = np.arange(L2.sum()) - np.repeat(np.cumsum(L2) - L2, L2)
+        ia = B.indptr[pr] + within // L[pr]
+        ib = B.indptr[pr] + within % L[pr]
+        self.pair_row, self.pair_val = pr, B.data[ia] * B.data[ib]
+        self.pair_pos = pos(B.indices[ia], B.indices[ib])
+        self.scale = self.s[pat.indices] * self.s[cols]
+        self.nnz = nnz
+        # CHOLMOD reads one triangle only: hand it that (half the data)
+        up = self.chol is not None and self.chol.upper
+        self.low = np.flatnonzero(pat.indices <= cols if up else pat.indices >= cols)
+        self.low_indptr = np.concatenate([[0], np.cumsum(np.bincount(cols[self.low], minlength=n))])
+        self.w = None
+        self.fac = None  # a plateqp.linalg.Factor (linalg, superlu)
+        self.loss = 0.0
+        self.t_factor = None  # seconds per numeric factorisation (last measured)
+        self.t_row = None  # seconds per updated row (last measured)
+        self.t_solve = None  # seconds per solve with one right-hand side (last measured)
+        self.target = None  # the w solved for: self.w (the factor's) plus the low-rank rows
+        self.lr = None  # the low-rank correction in use: (rows, Z columns, U, LU of C)
+        self._zcols: dict = {}  # row -> column of H(self.w)⁻¹ Bᵀ (kept while the factor is)
+        self.stats = {"analyse_s": 0.0, "factorisations": 0, "factor_s": 0.0, "updates": 0, "updated_rows": 0,
+                      "update_s": 0.0, "lowrank": 0, "lowrank_rows": 0, "lowrank_s": 0.0, "solves": 0,
+                      "solve_s": 0.0}
+
+    def _matrix(self, w: np.ndarray, scaled: bool) -> sp.csc_matrix:
+        data = self.base + np.bincount(self.pair_pos, weights=w[self.pair_row] * self.pair_val,
+                                       minlength=self.nnz)
+        n = self.s.size
+        if scaled:  # one triangle (see above), equilibrated, for CHOLMOD
+            low = self.low
+            return sp.csc_matrix((data[low] * self.scale[low], self.indices[low], self.low_indptr), shape=(n, n))
+        return sp.csc_matrix((data, self.indices, self.indptr), shape=(n, n))
+
+    def refactor(self, w: np.ndarray) -> None:
+        t0 = time.perf_counter()
+        if self.chol is not None:
+            H = self._matrix(w, scaled=True)
+            if self.chol.sym is None:
+                self.chol.analyse(H)
+                t1 = time.perf_counter()
+                self.stats["analyse_s"] += t1 - t0
+                t0 = t1
+            try:
+                self.chol.factor(H)
+            except SingularMatrixError as exn:
+                raise SolverError(f"pdas: the active-set matrix is not positive definite ({exn}); is P "
+                                  "positive semidefinite?") from exn
+        else:  # plateqp.linalg.Factor: its own choice of library, or SuperLU; analysis not re-used
+            try:
+                self.fac = Factor(self._matrix(w, scaled=False), method="auto" if self.method == "linalg" else "superlu")
+            except Exception as exn:
+                raise SolverError(f"pdas: the active-set matrix could not be factorised ({exn})") from exn
+        dt = time.perf_counter() - t0
+        self.t_factor = dt
+        self.stats["factorisations"] += 1
+        self.stats["factor_s"] += dt
+        self.w = w.copy()
+        self.target = self.w
+        self.loss = 0.0
+        self.lr = None
+        self._zcols = {}
+
+    def set(self, w: np.ndarray) -> None:
+        """Make the factor that of ``H(w)``."""
+        if self.w is None:
+            self.refactor(w)
+            return
+        if self.target is not None and np.array_equal(w, self.target):
+            return
+        dw = w - self.w
+        changed = np.flatnonzero(dw)
+        if changed.size == 0:  # back to the factor's own w: the correction is dropped
+            self.lr, self.target = None, self.w
+            return
+        down = changed[dw[changed] < 0]
+        loss = self.loss + np.finfo(float).eps * np.sum(-dw[down] / self.c[down])
+        if self.chol is None or not self.chol.can_update:
+            if not self._low_rank(w, dw, changed, loss):
+                self.refactor(w)
+            return
+        t_row = self.t_row if self.t_row is not None else self.t_factor / 400.0
+        if changed.size * t_row > 0.7 * self.t_factor or loss > DOWNDATE_LOSS:
+            self.refactor(w)
+            return
+        t0 = time.perf_counter()
+        up = changed[dw[changed] > 0]
+        for rows, subtract in ((up, False), (down, True)):  # updates first: stays definite
+            if rows.size:
+                C = (self.B[rows].T.tocsc() @ sp.diags(np.sqrt(np.abs(dw[rows])))).tocsc()
+                C = sp.diags(self.s) @ C
+                self.chol.update(sp.csc_matrix(C), subtract)
+        dt = time.perf_counter() - t0
+        self.t_row = dt / changed.size
+        self.stats["updates"] += 1
+        self.stats["updated_rows"] += int(changed.size)
+        self.stats["update_s"] += dt
+        self.w = w.copy()
+        self.target = self.w
+        self.loss = loss
+
+    def _low_rank(self, w: np.ndarray, dw: np.ndarray, changed: np.ndarray, loss: float) -> bool:
+        """Take ``w`` as the factor's ``w`` plus a Woodbury correction on the ``changed`` rows,
+        if that is cheaper than a factorisation and keeps its digits (see the class); False:
+        refactorise instead."""
+        k = changed.size
+        new = np.array([r for r in changed.tolist() if r not in self._zcols], dtype=np.int64)
+        t_solve = self.t_solve if self.t_solve is not None else self.t_factor / 10.0
+        # k right-hand sides in one solve cost about half a solve each (CHOLMOD's block solve)
+        if (k > LOWRANK_MAX or loss > DOWNDATE_LOSS
+                or (new.size and t_solve * max(1.0, 0.5 * new.size) > LOWRANK_COST * self.t_factor)):
+            return False
+        t0 = time.perf_counter()
+        if new.size:
+            Ut = self.B[new].T.toarray()
+            Znew = self._solve(Ut)
+            for j, r in enumerate(new.tolist()):
+                self._zcols[r] = Znew[:, j].copy()
+            self.stats["solves"] += 1
+        Z = np.column_stack([self._zcols[r] for r in changed.tolist()])
+        U = self.B[changed]
+        C = U @ Z
+        # Woodbury is not backward stable for a stiff row: U x comes out with an absolute error
+        # of about ε |Δw_i| (U H⁻¹ Uᵀ)_ii relative to x, which the row's weight then multiplies
+        # into the residual (a rigid row added: ε κ, ~1e-7 of the load); and where H is nearly
+        # singular along a rigid motion the row moves, (U H⁻¹ Uᵀ)_ii is huge. Both lose digits:
+        loss = loss + np.finfo(float).eps * float(np.abs(dw[changed] * np.diag(C)).sum())
+        C[np.diag_indices(k)] += 1.0 / dw[changed]
+        ok = bool(np.all(np.isfinite(C))) and loss <= DOWNDATE_LOSS
+        if ok:
+            # a capacitance near singular (H(w) itself near singular, or cancellation): refactorise
+            sv = np.linalg.svd(C, compute_uv=False)
+            ok = sv[-1] > LOWRANK_COND * sv[0]
+        if not ok:
+            return False
+        self.lr = (changed, Z, U, sla.lu_factor(C, check_finite=False))
+        self.target = w.copy()
+        dt = time.perf_counter() - t0
+        self.stats["lowrank"] += 1
+        self.stats["lowrank_rows"] += int(k)
+        self.stats["lowrank_s"] += dt
+        return True
+
+    @property
+    def clean(self) -> bool:
+        """The factor is of ``H(w)`` itself: no downdate's loss, no low-rank correction."""
+        return self.loss == 0.0 and self.lr is None
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        """``H(self.w)⁻¹ b`` with the factor (``b`` of shape (n,) or (n, k))."""
+        if self.chol is not None:
+            s = self.s if b.ndim == 1 else self.s[:, None]
+            return s * self.chol.solve(s * b)
+        return self.fac.solve(b, refine=0)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        t0 = time.perf_counter()
+        x = self._solve(b)
+        if self.lr is not None:
+            _, Z, U, lu = self.lr
+            x = x - Z @ sla.lu_solve(lu, U @ x, check_finite=False)
+        self.stats["solves"] += 1
+        dt = time.perf_counter() - t0
+        self.stats["solve_s"] += dt
+        if self.lr is None:
+            self.t_solve = dt
+        return x
