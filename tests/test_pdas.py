@@ -351,3 +351,27 @@ def test_registered():
     b = pq.get_backend("pdas")
     assert b.accepts == frozenset({"qp"}) and b.available()
     assert "pdas" in pq.available_backends()
+
+
+def test_the_primal_spring_block_and_its_leading_view_keep_k_as_stored():
+    """P = block_diag(K, I) joined column by column keeps K's stored zeros (the ordering reads
+    them), and pdas reads K back as a view of P's leading columns; any other kept set is
+    sliced as before (against SciPy's block_diag and fancy indexing)."""
+    from plateqp.backends.pdas.reduced import _leading_block
+    from plateqp.contact.formulations import _with_identity
+
+    rng = np.random.default_rng(5)
+    A = sp.random(40, 40, density=0.15, format="csc", random_state=rng)
+    K = sp.csc_matrix(A + A.T + 40 * sp.identity(40))
+    K.data[::7] = 0.0  # stored zeros
+    P = _with_identity(K, 6)
+    assert P.nnz == K.nnz + 6  # no entry dropped
+    assert abs(P - sp.block_diag([K, sp.identity(6)], format="csc")).max() == 0
+    lead = _leading_block(P, np.arange(40))
+    assert np.shares_memory(lead.data, P.data) and lead.nnz == K.nnz
+    assert abs(lead - K).max() == 0
+    keep = np.r_[0:10, 12:40, 41]  # not the leading columns: sliced
+    ref = P.toarray()[np.ix_(keep, keep)]
+    np.testing.assert_array_equal(_leading_block(P, keep).toarray(), ref)
+    C = sp.csc_matrix(P + sp.csc_matrix(([1.0, 1.0], ([41, 3], [3, 41])), shape=P.shape))  # couples col 3 to 41
+    np.testing.assert_array_equal(_leading_block(C, np.arange(40)).toarray(), C.toarray()[:40, :40])

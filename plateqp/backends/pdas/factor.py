@@ -52,43 +52,59 @@ class SpringFactor:
         n, m = K.shape[0], B.shape[0]
         self.B, self.c = B, c
         self.s = 1.0 / np.sqrt(Kd)
-        Babs = abs(B)
         Ks = sp.csc_matrix(K)
         Ks.sort_indices()
-        # K's stored pattern as ones plus |B|ᵀ|B|: a sum of positives drops no entry, and the
-        # ordering reads K's stored zeros (plateqp.linalg.pattern)
-        ones = sp.csc_matrix((np.ones(Ks.nnz), Ks.indices, Ks.indptr), shape=Ks.shape)
-        pat = sp.csc_matrix(ones + Babs.T @ Babs)
-        pat.sort_indices()
-        self.indptr, self.indices = pat.indptr, pat.indices
-        cols = np.repeat(np.arange(n), np.diff(pat.indptr))
-        keys = cols.astype(np.int64) * n + pat.indices
-        nnz = keys.size
-
-        def pos(r, cc):
-            return np.searchsorted(keys, np.asarray(cc, np.int64) * n + r)
-
-        if Ks.nnz == nnz:  # B's pattern lies in K's (rows within one element): same structure
-            self.base = Ks.data.astype(float, copy=True)
-        else:
-            Kc = Ks.tocoo()
-            self.base = np.bincount(pos(Kc.row, Kc.col), weights=Kc.data, minlength=nnz)
-        self.base[pos(np.arange(n), np.arange(n))] += sigma * Kd
-        # all products B_ia B_ib of each row, and where they go in the pattern
+        # all products B_ia B_ib of each row (their positions found below)
         L = np.diff(B.indptr)
         L2 = L * L
         pr = np.repeat(np.arange(m), L2)
         within = np.arange(L2.sum()) - np.repeat(np.cumsum(L2) - L2, L2)
         ia = B.indptr[pr] + within // L[pr]
         ib = B.indptr[pr] + within % L[pr]
-        self.pair_row, self.pair_val = pr, B.data[ia] * B.data[ib]
-        self.pair_pos = pos(B.indices[ia], B.indices[ib])
-        self.scale = self.s[pat.indices] * self.s[cols]
-        self.nnz = nnz
-        # CHOLMOD reads one triangle only: hand it that (half the data)
-        up = self.chol is not None and self.chol.upper
-        self.low = np.flatnonzero(pat.indices <= cols if up else pat.indices >= cols)
-        self.low_indptr = np.concatenate([[0], np.cumsum(np.bincount(cols[self.low], minlength=n))])
+        pair_r, pair_c = B.indices[ia], B.indices[ib]
+        pair_val = B.data[ia] * B.data[ib]
+        idx = np.int32 if n < 2**31 - 1 else np.int64
+        cols = np.repeat(np.arange(n, dtype=idx), np.diff(Ks.indptr))
+        keys = cols.astype(np.int64) * n + Ks.indices
+        pk = pair_c.astype(np.int64) * n + pair_r
+        at = np.minimum(np.searchsorted(keys, pk), keys.size - 1)
+        if keys.size and np.all(keys[at] == pk):  # B's pattern lies in K's (rows within one element)
+            indptr, indices = Ks.indptr, Ks.indices
+            base = Ks.data.astype(float, copy=True)
+        else:  # K's stored pattern plus |B|ᵀ|B|: a sum of positives drops no entry, and the
+            # ordering reads K's stored zeros (plateqp.linalg.pattern)
+            Babs = abs(B)
+            ones = sp.csc_matrix((np.ones(Ks.nnz), Ks.indices, Ks.indptr), shape=Ks.shape)
+            pat = sp.csc_matrix(ones + Babs.T @ Babs)
+            pat.sort_indices()
+            indptr, indices = pat.indptr, pat.indices
+            Kc = Ks.tocoo()
+            cols = np.repeat(np.arange(n, dtype=idx), np.diff(indptr))
+            keys = cols.astype(np.int64) * n + indices
+            base = np.bincount(np.searchsorted(keys, Kc.col.astype(np.int64) * n + Kc.row), weights=Kc.data,
+                               minlength=keys.size)
+        nnz = keys.size
+        base[np.searchsorted(keys, np.arange(n, dtype=np.int64) * (n + 1))] += sigma * Kd
+        pair_pos = np.searchsorted(keys, pk)
+        del keys
+        self.pattern_nnz = nnz  # entries of K + BᵀB's pattern (K's own, stored zeros too, where B lies in it)
+        self.nnz, self.pair_row = nnz, pr
+        if self.chol is None:  # plateqp.linalg.Factor: the whole matrix, as it is
+            self.indptr, self.indices, self.base = indptr, indices, base
+            self.pair_pos, self.pair_val = pair_pos, pair_val
+        else:  # CHOLMOD reads one triangle only: that, equilibrated, is all that is kept
+            low = np.flatnonzero(indices <= cols if self.chol.upper else indices >= cols)
+            scale = self.s[indices[low]] * self.s[cols[low]]
+            self.base = base[low] * scale
+            self.indices = indices[low]
+            self.indptr = np.concatenate([[0], np.cumsum(np.bincount(cols[low], minlength=n))])
+            where = np.full(nnz, -1, dtype=np.int64)
+            where[low] = np.arange(low.size)
+            pl = where[pair_pos]
+            inside = pl >= 0  # each off-diagonal pair twice in the pattern, once in the triangle
+            self.pair_row, self.pair_pos = pr[inside], pl[inside]
+            self.pair_val = pair_val[inside] * scale[pl[inside]]
+            self.nnz = low.size
         self.w = None
         self.fac = None  # a plateqp.linalg.Factor (linalg, superlu)
         self.loss = 0.0
@@ -102,19 +118,17 @@ class SpringFactor:
                       "update_s": 0.0, "lowrank": 0, "lowrank_rows": 0, "lowrank_s": 0.0, "solves": 0,
                       "solve_s": 0.0}
 
-    def _matrix(self, w: np.ndarray, scaled: bool) -> sp.csc_matrix:
+    def _matrix(self, w: np.ndarray) -> sp.csc_matrix:
+        """``H(w)``: with CHOLMOD, one triangle of it, equilibrated; else the whole matrix."""
         data = self.base + np.bincount(self.pair_pos, weights=w[self.pair_row] * self.pair_val,
                                        minlength=self.nnz)
         n = self.s.size
-        if scaled:  # one triangle (see above), equilibrated, for CHOLMOD
-            low = self.low
-            return sp.csc_matrix((data[low] * self.scale[low], self.indices[low], self.low_indptr), shape=(n, n))
         return sp.csc_matrix((data, self.indices, self.indptr), shape=(n, n))
 
     def refactor(self, w: np.ndarray) -> None:
         t0 = time.perf_counter()
         if self.chol is not None:
-            H = self._matrix(w, scaled=True)
+            H = self._matrix(w)
             if self.chol.sym is None:
                 self.chol.analyse(H)
                 t1 = time.perf_counter()
@@ -127,7 +141,7 @@ class SpringFactor:
                                   "positive semidefinite?") from exn
         else:  # plateqp.linalg.Factor: its own choice of library, or SuperLU; analysis not re-used
             try:
-                self.fac = Factor(self._matrix(w, scaled=False), method="auto" if self.method == "linalg" else "superlu")
+                self.fac = Factor(self._matrix(w), method="auto" if self.method == "linalg" else "superlu")
             except Exception as exn:
                 raise SolverError(f"pdas: the active-set matrix could not be factorised ({exn})") from exn
         dt = time.perf_counter() - t0

@@ -14,6 +14,20 @@ from ..base import QP
 __all__ = ["Exchange", "Outcome", "ReducedQP", "force_scale", "infeasible", "natural_residuals"]
 
 
+def _leading_block(P: sp.csc_matrix, keep: np.ndarray) -> sp.csc_matrix:
+    """``P[keep][:, keep]``. Where ``keep`` is ``0 … k−1`` and those columns hold no row past
+    them (the primal formulation's ``block_diag(K, I)``), a view of P's leading columns: no
+    copy of K (65 MB and 0.1 s at 256²)."""
+    k = keep.size
+    if k and keep[-1] == k - 1:  # keep is sorted and distinct: 0 … k−1
+        end = P.indptr[k]
+        if end == 0 or P.indices[:end].max() < k:
+            K = sp.csc_matrix((P.data[:end], P.indices[:end], P.indptr[:k + 1]), shape=(k, k), copy=False)
+            K.has_sorted_indices = P.has_sorted_indices
+            return K
+    return P[keep][:, keep].tocsc()
+
+
 class ReducedQP:
     """The QP read back as a contact problem ``(K, f, B, ρ, g)``: separable variables eliminated
     (see the package docstring, "The problem")."""
@@ -59,7 +73,7 @@ class ReducedQP:
         self.sep_row[Gs.col], self.sep_gamma[Gs.col] = Gs.row, Gs.data
         self.sep_p = d[self.sep]
         self.sep_q = qp.q[self.sep]
-        self.K = P[self.keep][:, self.keep].tocsc() if self.sep.size else P
+        self.K = _leading_block(P, self.keep) if self.sep.size else P
         self.f = -qp.q[self.keep]
         self.B = (G[:, self.keep] if self.sep.size else G).tocsr()
         self.rho = np.bincount(self.sep_row, weights=self.sep_gamma**2 / self.sep_p, minlength=m)
