@@ -219,3 +219,29 @@ def test_null_space_of_tall_and_short_constraint_sets(rows):
     assert N.shape == (3, 3 - rank)
     np.testing.assert_allclose(A @ N, 0.0, atol=1e-12 * max(1.0, rows))
     np.testing.assert_allclose(N.T @ N, np.eye(3 - rank), atol=1e-12)
+
+
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_the_cone_kept_for_statics_is_the_whole_cone(k):
+    """The columns kept for the cone test (those on the rim of the projected hull) generate the
+    same cone: SciPy's NNLS on all columns gives the same distance for loads inside, outside
+    and just off its edge; columns on both sides of every plane are all kept."""
+    from scipy.optimize import nnls
+
+    from plateqp.contact.statics import _generators
+
+    rng = np.random.default_rng(k)
+    xy = rng.uniform(-1, 1, (2, 2000))
+    A = np.vstack([np.ones(2000), xy])[:k] + 0.05 * rng.standard_normal((k, 2000))  # one-sided
+    A = rng.standard_normal((k, k)) @ A  # in some other basis, as Qᵀ Bᵀ is
+    G = _generators(A)
+    assert G.shape[1] < A.shape[1] // 10
+    # every column lies in the cone of those kept: the two cones are one
+    for a in A.T:
+        assert nnls(G, a, maxiter=10**5)[1] <= 1e-12 * np.linalg.norm(a)
+    for _ in range(30):
+        b = A @ rng.uniform(0, 1, 2000) * rng.uniform(0.5, 2) + rng.standard_normal(k) * rng.choice([0, 1e-9, 1, 100])
+        full, kept = nnls(A, b, maxiter=10**5)[1], nnls(G, b, maxiter=10**5)[1]
+        assert abs(full - kept) <= 1e-12 * np.linalg.norm(b) + 1e-9 * full
+    B = np.hstack([A, -A[:, :1]])  # a column on the other side: no projection, every column
+    assert _generators(B).shape == B.shape
