@@ -375,3 +375,41 @@ def test_the_primal_spring_block_and_its_leading_view_keep_k_as_stored():
     np.testing.assert_array_equal(_leading_block(P, keep).toarray(), ref)
     C = sp.csc_matrix(P + sp.csc_matrix(([1.0, 1.0], ([41, 3], [3, 41])), shape=P.shape))  # couples col 3 to 41
     np.testing.assert_array_equal(_leading_block(C, np.arange(40)).toarray(), C.toarray()[:40, :40])
+
+
+def test_refinement_stops_at_rounding_and_not_before():
+    """The stop test of the exact steps (Oettli–Prager's backward error): a step solved by
+    SciPy's sparse LU (and refined) passes it; the same step moved by 1e-11 relative does not. And |K||u| by
+    column blocks is SciPy's abs(K) @ |u|."""
+    import scipy.sparse.linalg as spla
+
+    from plateqp.backends.pdas.reduced import ReducedQP, _abs_matvec, at_rounding
+    from plateqp.contact.formulations import formulate
+    from plateqp.contact.scaling import Scaled
+    from plateqp.families import grid_rigid
+
+    from plateqp.assembly import build_model
+
+    data = Scaled.from_model(build_model(grid_rigid(12, 3)))
+    pb = ReducedQP(formulate(data, "primal").problem(frozenset({"qp"})), max_rows=10**6)
+    x = np.abs(np.random.default_rng(2).standard_normal(pb.K.shape[0]))
+    ref = abs(pb.K) @ x
+    for chunk in (7, 1000, 1 << 20):
+        np.testing.assert_allclose(_abs_matvec(pb.K, x, chunk), ref, rtol=1e-14)
+    idx = np.arange(pb.m)  # every post held at its gap: the saddle-point system, solved by LU
+    BA = pb.B[idx]
+    n = pb.K.shape[0]
+    S = sp.bmat([[pb.K, BA.T], [BA, None]], format="csc")
+    rhs = np.concatenate([pb.f, pb.g[idx]])
+    lu = spla.splu(S)
+    sol = lu.solve(rhs)
+    for _ in range(3):  # LU's own refinement, to its backward error's floor
+        sol += lu.solve(rhs - S @ sol)
+    u, lam = sol[:n], sol[n:]
+
+    def residuals(u, lam):
+        return pb.f - pb.K @ u - BA.T @ lam, BA @ u - pb.g[idx] - pb.rho[idx] * lam
+
+    assert at_rounding(pb, u, idx, BA, lam, *residuals(u, lam))
+    u2 = u * (1 + 1e-11)
+    assert not at_rounding(pb, u2, idx, BA, lam, *residuals(u2, lam))

@@ -26,7 +26,7 @@ from ...errors import SingularMatrixError
 from ...linalg import SchurFactor, bindings
 from ..base import Status
 from .options import INNER_EXACT, PIVOT_TOL
-from .reduced import Exchange, Outcome, ReducedQP, infeasible
+from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
 
 __all__ = ["DenseDual", "NotApplicable", "run_dense"]
 
@@ -118,8 +118,9 @@ class DenseDual:
 
     def exact(self, A: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(u, λ)`` of active set ``A`` on the exact sparse equations: ``basic``'s ``λ``, then
-        iterative refinement with ``K⁻¹`` and the Cholesky factor of ``M_AA``: for residuals
-        ``r_u``, ``r_A``, ``v = K⁻¹ r_u``, ``M_AA δλ = r_A + B_A v``, ``δu = v − K⁻¹ B_Aᵀ δλ``."""
+        iterative refinement with ``K⁻¹`` and the Cholesky factor of ``M_AA`` while the
+        residuals are above rounding (:func:`.reduced.at_rounding`) and still halve: for
+        residuals ``r_u``, ``r_A``, ``v = K⁻¹ r_u``, ``M_AA δλ = r_A + B_A v``, ``δu = v − K⁻¹ B_Aᵀ δλ``."""
         pb = self.pb
         idx = np.flatnonzero(A)
         BA, BcA = pb.B[idx], self.Bc[idx]
@@ -134,7 +135,7 @@ class DenseDual:
             delta = max(np.abs(pb.B @ u).max(initial=0.0), np.abs(pb.g).max(initial=0.0), tiny)
             res = max(np.abs(r_u).max() / max(np.abs(pb.f).max(), np.abs(BtL).max(initial=0.0), tiny),
                       np.abs(r_A).max(initial=0.0) / delta)
-            if res == 0.0 or (k >= 1 and res > 0.5 * best):
+            if res == 0.0 or (k >= 1 and res > 0.5 * best) or at_rounding(pb, u, idx, BA, lam[idx], r_u, r_A):
                 break
             best = min(best, res)
             y = self._forward(r_u)  # v = K⁻¹ (r_u − B_Aᵀ δλ): one solve in two halves

@@ -11,7 +11,11 @@ from ...errors import SolverError
 from ...linalg import row_stiffness
 from ..base import QP
 
-__all__ = ["Exchange", "Outcome", "ReducedQP", "force_scale", "infeasible", "natural_residuals"]
+__all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "infeasible", "natural_residuals"]
+
+#: A step is exact when its residuals are within this many ε of the terms that make them
+#: (:func:`at_rounding`).
+ROUNDING_STOP = 2.0
 
 
 def _leading_block(P: sp.csc_matrix, keep: np.ndarray) -> sp.csc_matrix:
@@ -125,6 +129,38 @@ class Exchange:
             i = np.flatnonzero(bad)[-1]  # Murty: the infeasible row of largest index
             A[i] = not A[i]
         return A, mode
+
+
+def _abs_matvec(K: sp.csc_matrix, x: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
+    """``|K| x`` for ``x ≥ 0`` (``K`` CSC), a block of columns at a time: no copy of K's data."""
+    n = K.shape[0]
+    out = np.zeros(n)
+    counts = np.diff(K.indptr)
+    j0 = 0
+    while j0 < K.shape[1]:
+        j1 = int(np.searchsorted(K.indptr, K.indptr[j0] + chunk, side="right"))
+        j1 = min(max(j1 - 1, j0 + 1), K.shape[1])
+        a, b = K.indptr[j0], K.indptr[j1]
+        out += np.bincount(K.indices[a:b], weights=np.abs(K.data[a:b]) * np.repeat(x[j0:j1], counts[j0:j1]),
+                           minlength=n)
+        j0 = j1
+    return out
+
+
+def at_rounding(pb: ReducedQP, u: np.ndarray, idx: np.ndarray, BA, lamA: np.ndarray, r_u: np.ndarray,
+                r_A: np.ndarray) -> bool:
+    """The step ``(u, λ_A)`` of the active rows ``idx`` is exact to rounding: each residual is
+    within ``ROUNDING_STOP·ε`` of the terms that make it (Oettli–Prager's backward error in
+    the max norm, the test LAPACK's iterative refinement stops at): ``|r_u| ≤ c ε (|K||u| +
+    |B_A|ᵀ|λ_A| + |f|)`` and ``|r_A| ≤ c ε (|B_A||u| + |g_A| + ρ_A|λ_A|)``. Another
+    refinement step would not change the answer."""
+    eps = ROUNDING_STOP * np.finfo(float).eps
+    au, al = np.abs(u), np.abs(lamA)
+    su = (_abs_matvec(pb.K, au) + abs(BA.T) @ al + np.abs(pb.f)).max(initial=0.0)
+    if np.abs(r_u).max(initial=0.0) > eps * su:
+        return False
+    sA = abs(BA) @ au + np.abs(pb.g[idx]) + pb.rho[idx] * al
+    return bool(np.all(np.abs(r_A) <= eps * sA.max(initial=0.0)))
 
 
 def force_scale(pb: ReducedQP, lam: np.ndarray) -> float:

@@ -33,7 +33,7 @@ from .options import (
     SINGULAR_QUOTIENT,
 )
 from .factor import SpringFactor
-from .reduced import Exchange, Outcome, ReducedQP, infeasible
+from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
 
 __all__ = ["SpringFactor", "run_sparse"]
 
@@ -79,6 +79,8 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
                   np.abs(r_A).max(initial=0.0) / delta)
         if res <= tol or k == n_max or (k >= 2 and res > 0.5 * best):
             break
+        if exact and k >= 1 and at_rounding(pb, u, idx, BA, lamA, r_u, r_A):
+            break  # another correction would not change the answer
         best = min(best, res)
         du = _project(null, pb.Kd, fac.solve(r_u - BA.T @ (WA * r_A)))
         solves += 1
