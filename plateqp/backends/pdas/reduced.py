@@ -132,17 +132,18 @@ class Exchange:
 
 
 def _abs_matvec(K: sp.csc_matrix, x: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
-    """``|K| x`` for ``x ≥ 0`` (``K`` CSC), a block of columns at a time: no copy of K's data."""
+    """``|K| x`` for symmetric ``K`` (CSC), a block of rows at a time: K's CSC arrays read as
+    CSR are K itself, so each block is ``chunk`` entries of |K| and gives its own rows (no
+    copy of K's data, no pass over all rows per block)."""
     n = K.shape[0]
-    out = np.zeros(n)
-    counts = np.diff(K.indptr)
+    out = np.empty(n)
     j0 = 0
-    while j0 < K.shape[1]:
-        j1 = int(np.searchsorted(K.indptr, K.indptr[j0] + chunk, side="right"))
-        j1 = min(max(j1 - 1, j0 + 1), K.shape[1])
+    while j0 < n:
+        j1 = int(np.searchsorted(K.indptr, K.indptr[j0] + chunk, side="right")) - 1
+        j1 = min(max(j1, j0 + 1), n)
         a, b = K.indptr[j0], K.indptr[j1]
-        out += np.bincount(K.indices[a:b], weights=np.abs(K.data[a:b]) * np.repeat(x[j0:j1], counts[j0:j1]),
-                           minlength=n)
+        rows = sp.csr_matrix((np.abs(K.data[a:b]), K.indices[a:b], K.indptr[j0:j1 + 1] - a), shape=(j1 - j0, n))
+        out[j0:j1] = rows @ x
         j0 = j1
     return out
 
