@@ -67,8 +67,12 @@ costs no column solves at all (where each row is one dof, ``M`` is the inverse o
 plus a third of one to read ``L_cc``, where the columns ``K⁻¹ B_iᵀ`` (each about 1/50 of a
 factorisation, even solved in blocks) would cost 18 for the 900 rows. Each active set is
 then a dense Cholesky of ``M_AA`` (|A|³/3 flops). The final set is solved on the exact sparse
-equations by iterative refinement with ``K⁻¹`` and ``M_AA`` (two sparse solves per step), so
-rounding in ``d`` (``g − B K⁻¹ f`` cancels) does not reach the answer. The same factor
+equations by iterative refinement with ``K⁻¹`` and ``M_AA`` (two sparse solves per step, while
+the residuals are above rounding: usually none), so rounding in ``d`` (``g − B K⁻¹ f``
+cancels) does not reach the answer. ``M`` itself is accurate to about ``cond(K)·ε``; at a row
+whose gap and reaction both end near zero that can call it infeasible both in and out of the
+set, and Murty's rule then toggles it for ever (in exact arithmetic it terminates). So a set
+met a second time is classified on the exact equations instead, as the final one is. The same factor
 solves throughout: with cvxopt, ``L_cc`` is copied out of CHOLMOD's factor without spending it
 (:mod:`plateqp.linalg.cholmod`; before, a second, plain factorisation of ``K`` did the solves).
 
