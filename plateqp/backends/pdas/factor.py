@@ -31,8 +31,10 @@ class SpringFactor:
     ``H(w)⁻¹b = x − Z C⁻¹ U x`` with ``x = H(w₀)⁻¹b``, ``Z = H(w₀)⁻¹Uᵀ`` (one solve with k
     right-hand sides; a column is kept for as long as the factor) and the k × k capacitance
     ``C = diag(1/Δw) + U Z``. It is used while those columns cost less than half a
-    factorisation (measured) and the rows removed lose no more digits than a downdate would be
-    allowed to (``DOWNDATE_LOSS``); the exact steps' refinement takes what rounding is left.
+    factorisation (measured), for at most ``LOWRANK_MAX`` rows (Z is n × k), and while the
+    digits it loses, about ``ε Σ |Δw_i| (U Z)_ii`` (Woodbury is not backward stable for a stiff
+    row: a rigid row entering or leaving loses ε κ), stay within what a downdate is allowed
+    (``DOWNDATE_LOSS``); the exact steps' refinement takes what rounding is left.
     """
 
     def __init__(self, K: sp.csc_matrix, B: sp.csr_matrix, Kd: np.ndarray, c: np.ndarray,
@@ -208,7 +210,7 @@ class SpringFactor:
             Ut = self.B[new].T.toarray()
             Znew = self._solve(Ut)
             for j, r in enumerate(new.tolist()):
-                self._zcols[r] = Znew[:, j].copy()
+                self._zcols[r] = Znew[:, j]  # a view: the block stays one array
             self.stats["solves"] += 1
         Z = np.column_stack([self._zcols[r] for r in changed.tolist()])
         U = self.B[changed]

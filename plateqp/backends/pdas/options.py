@@ -63,10 +63,11 @@ LOOSE_TOL = 1e-7
 #: ~ε·κ = 2e-8, which would hide the σ-sized modes of a plate the active rows do not hold.
 DOWNDATE_LOSS = 1e-10
 #: (sparse, without an in-place update) A change of at most LOWRANK_MAX rows is taken by a
-#: Woodbury correction on the factor in hand while its new columns (one block solve) cost at most
+#: Woodbury correction on the factor in hand (its n × k columns: 26 MB at 256² for 16 rows)
+#: while its new columns (one block solve) cost at most
 #: LOWRANK_COST factorisations and its capacitance's singular values stay above LOWRANK_COND
 #: relative (else the factor is rebuilt).
-LOWRANK_MAX, LOWRANK_COST, LOWRANK_COND = 64, 0.5, 1e-10
+LOWRANK_MAX, LOWRANK_COST, LOWRANK_COND = 16, 0.5, 1e-10
 #: (sparse, soft rows) Phase 1: at most this many Newton steps, PCG to this relative tolerance
 #: (at most PCG_MAX iterations each); it ends when a step changes at most
 #: max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION · m) rows, or when its solves have cost
