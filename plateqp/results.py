@@ -33,6 +33,16 @@ class KKTReport:
     natural: float = 0.0
     tol: float = 0.0
     scale: float = 1.0  # deflection scale for gaps
+    #: the stationarity residual's rounding floor, ε‖|K||u| + |f| + |Bᵀ||R|‖ relative as
+    #: stationarity: an answer exact to double precision may show a residual up to about this
+    floor: float = 0.0
+
+    @property
+    def at_floor(self) -> bool:
+        """Not ok only because stationarity is at its rounding floor: the accuracy asked is
+        below what double precision can show on this plate (the answer may be exact)."""
+        return (not self.ok and self.stationarity <= self.floor
+                and max(self.spring, self.primal, self.dual, self.complementarity, self.natural) <= self.tol)
 
     @property
     def worst(self) -> float:
@@ -46,7 +56,7 @@ class KKTReport:
         return {"stationarity": self.stationarity, "spring": self.spring, "primal": self.primal,
                 "dual": self.dual, "complementarity": self.complementarity, "natural": self.natural,
                 "tol": self.tol,
-                "scale": self.scale, "ok": self.ok}
+                "scale": self.scale, "floor": self.floor, "ok": self.ok}
 
 
 @dataclass

@@ -132,3 +132,30 @@ def test_small_reactions_are_judged_against_themselves():
     R[1] = 1e-6 * c.R[0]
     u = c.u - spla.splu(d.K.tocsc()).solve(d.B[[1]].T.toarray().ravel() * R[1])
     assert kkt_report(d, ContactSolution(u, R, d.rho * R), 1e-9).natural > 1e-7
+
+
+def test_an_accuracy_below_the_rounding_floor_is_said_to_be_so():
+    """Asked 1e-14 on a 32² plate (below what a double-precision answer can show there), pdas's exact answer is
+    INACCURATE with its stationarity at or below the floor ε‖|K||u| + |f| + |Bᵀ||R|‖ (the
+    Oettli–Prager bound), and the warning says so and what to ask instead; an answer moved
+    off the exact one by 1e-8 is above its floor and no such thing is said."""
+    import warnings
+
+    import plateqp as pq
+
+    sc = family("grid_rigid", 32, 3)
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        res = pq.solve(sc, backend="pdas", accuracy=1e-14)
+    assert res.status == pq.Status.INACCURATE
+    rep = res.kkt
+    assert 1e-14 < rep.floor < 1e-12 and rep.stationarity <= rep.floor and rep.at_floor
+    said = " ".join(str(w.message) for w in seen)
+    assert "rounding floor" in said and "ask 1e-" in said
+    d = Scaled.from_model(res.model)
+    exact = pq.solve(sc, backend="pdas", accuracy=1e-10)
+    form = formulate(d, "primal")
+    raw = get_backend("pdas").solve(form.problem(frozenset({"qp"})), accuracy="high")
+    c = form.recover(raw)
+    moved = kkt_report(d, ContactSolution(c.u * (1 + 1e-8), c.R, c.s), 1e-14)
+    assert exact.status == pq.Status.OPTIMAL and not moved.at_floor and moved.stationarity > 10 * moved.floor

@@ -38,7 +38,11 @@ Two refinements for the extremes (benchmarks/README.md, "Extremes"):
   the same contact set (:func:`close_pairs_error`).
 
 A result is ``ok`` when the worst residual is at most the tolerance of its accuracy (a preset's,
-``KKT_TOL``, or the number given). Unlike qpsolvers' own check, this tests the sign of every
+``KKT_TOL``, or the number given). The report also holds the stationarity residual's rounding
+floor, ``floor`` = ε‖|K||u| + |f| + |Bᵀ||R|‖ / max(‖f‖, ‖Bᵀ R‖) (Oettli–Prager): an answer exact
+to double precision can show a residual up to about that, and it grows with the mesh (the 2-norm
+over every dof: 4e-10 on a 256² bed, whose exact answer then fails 1e-10). A report that fails
+only there is ``at_floor``, and the solve's warning says so and which accuracy to ask. Unlike qpsolvers' own check, this tests the sign of every
 reaction and complementarity support by support.
 """
 
@@ -88,6 +92,7 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     natural = max(natural, np.abs(np.minimum(R / np.maximum(k, 1e-300), gap)).max(initial=0.0) / delta)
     natural = max(natural, close_pairs_error(data, R, gap, rscale, delta, tol))
     return KKTReport(
+        floor=float(floor),
         stationarity=float(st),
         spring=float(np.abs(s - data.rho * R).max(initial=0.0) / delta),
         primal=float(max(0.0, -gap.min(initial=0.0)) / delta),

@@ -112,8 +112,13 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         if raw.iterations is not None:
             iterations = (iterations or 0) + raw.iterations
     if res.status != Status.OPTIMAL:
+        why = ""
+        if res.kkt.at_floor:
+            why = (f"; the stationarity residual is at its rounding floor ({res.kkt.floor:.1e}) on this plate: "
+                   "no answer in double precision can show the accuracy asked, ask "
+                   f"{10.0 ** np.ceil(np.log10(res.kkt.floor)):.0e} or more")
         warnings.warn(f"{backend} on the {formulation} problem: {res.status.value} "
-                      f"(worst KKT residual {res.kkt.worst:.2e}, asked {res.kkt.tol:.0e})", PlateQPWarning,
+                      f"(worst KKT residual {res.kkt.worst:.2e}, asked {res.kkt.tol:.0e}){why}", PlateQPWarning,
                       stacklevel=3)
     res.iterations = iterations
     res.extras = {"solver_status": raw.solver_status, **raw.extras}
