@@ -116,7 +116,7 @@ def lower(K: sp.spmatrix, s: np.ndarray | None = None, perm: np.ndarray | None =
     its numeric factorisation took 0.90 s instead of 0.97 s at 256², the same factor)."""
     K = sp.csc_matrix(K)
     n = K.shape[0]
-    col = np.repeat(np.arange(n), np.diff(K.indptr))
+    col = np.repeat(np.arange(n, dtype=K.indices.dtype), np.diff(K.indptr))  # K's own index width
     row = K.indices
     if perm is None:
         keep = row <= col if upper else row >= col
