@@ -84,7 +84,7 @@ def _generators(A: np.ndarray) -> np.ndarray:
     tell: a cone in at most three dimensions with every column on one side of a plane (the
     supports all push up) is the cone over the convex hull of the columns projected onto
     that plane, so only the columns on or near the hull's boundary are kept (a bed of 66 049
-    springs: the ~1 000 on the plate's rim). Otherwise, or where the hull is degenerate, all."""
+    springs: the 4 at the plate's corners). Otherwise, or where the hull is degenerate, all."""
     k, m = A.shape
     if m <= 64 or not 1 <= k <= 3:
         return A
@@ -101,7 +101,7 @@ def _generators(A: np.ndarray) -> np.ndarray:
         return A[:, :1]
     E = np.linalg.svd(d[None, :])[2][1:]  # an orthonormal basis of the plane ⊥ d
     Y = E @ (A / t)  # (k − 1) × m: the columns where their rays cross the plane x·d = 1
-    tol = 1e-8 * max(float(np.ptp(Y, axis=1).max()), 1e-300)
+    tol = 1e-8 * max(float(np.ptp(Y, axis=1).max()), 1e-300)  # (k = 2: the ends, within rounding)
     if k == 2:
         keep = (Y[0] <= Y[0].min() + tol) | (Y[0] >= Y[0].max() - tol)
         return A[:, keep]
@@ -111,11 +111,10 @@ def _generators(A: np.ndarray) -> np.ndarray:
         hull = ConvexHull(Y.T)
     except (QhullError, ValueError):
         return A
-    # the facets' unit normals and offsets: a column within tol of a facet line, or outside
-    # one (rounding), is kept; the hull's vertices always are
-    near = (hull.equations[:, :2] @ Y + hull.equations[:, 2:3]).max(axis=0) >= -tol
-    near[hull.vertices] = True
-    return A[:, near]
+    # the hull's vertices are the cone's extreme rays (a point on an edge between two is a
+    # combination of them); one qhull merged as coplanar is within its precision (~1e-15 of the
+    # spread) of the hull, far inside ROUNDING
+    return A[:, np.sort(hull.vertices)]
 
 
 def supports_reach(data: Scaled, band: float = 1e-9) -> Reach:
