@@ -380,22 +380,23 @@ def test_the_primal_spring_block_and_its_leading_view_keep_k_as_stored():
 def test_refinement_stops_at_rounding_and_not_before():
     """The stop test of the exact steps (Oettli–Prager's backward error): a step solved by
     SciPy's sparse LU (and refined) passes it; the same step moved by 1e-11 relative does not. And |K||u| by
-    column blocks is SciPy's abs(K) @ |u|."""
+    blocks of rows is SciPy's abs(K) @ |u|, from K's CSC arrays or its CSR ones."""
     import scipy.sparse.linalg as spla
 
-    from plateqp.backends.pdas.reduced import ReducedQP, _abs_matvec, at_rounding
+    from plateqp.assembly import build_model
+    from plateqp.backends.pdas.reduced import ReducedQP, at_rounding
     from plateqp.contact.formulations import formulate
     from plateqp.contact.scaling import Scaled
     from plateqp.families import grid_rigid
-
-    from plateqp.assembly import build_model
+    from plateqp.linalg.pattern import abs_matvec
 
     data = Scaled.from_model(build_model(grid_rigid(12, 3)))
     pb = ReducedQP(formulate(data, "primal").problem(frozenset({"qp"})), max_rows=10**6)
     x = np.abs(np.random.default_rng(2).standard_normal(pb.K.shape[0]))
     ref = abs(pb.K) @ x
     for chunk in (7, 1000, 1 << 20):
-        np.testing.assert_allclose(_abs_matvec(pb.K, x, chunk), ref, rtol=1e-14)
+        np.testing.assert_allclose(abs_matvec(pb.K, x, chunk), ref, rtol=1e-14)
+        np.testing.assert_allclose(abs_matvec(pb.K.tocsr(), x, chunk), ref, rtol=1e-14)
     idx = np.arange(pb.m)  # every post held at its gap: the saddle-point system, solved by LU
     BA = pb.B[idx]
     n = pb.K.shape[0]

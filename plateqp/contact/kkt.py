@@ -53,6 +53,7 @@ import numpy as np
 from ..accuracy import PRESET_TOL, Accuracy
 from ..errors import MechanismError
 from ..linalg import row_stiffness, solve_saddle
+from ..linalg.pattern import abs_matvec
 from ..results import KKTReport
 from .formulations import ContactSolution
 from .scaling import Scaled
@@ -80,7 +81,7 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     # Measured: HiGHS on the primal, stationarity 4e-11, deflections 1.4e-7 off (actual deflection
     # 3e-4 of the load's scale). The part of st above its rounding floor is scaled so.
     floor = np.finfo(float).eps * np.linalg.norm(
-        abs(data.K) @ np.abs(u) + np.abs(data.f) + abs(data.B).T @ np.abs(R)) / force
+        abs_matvec(data.K, np.abs(u)) + np.abs(data.f) + abs(data.B).T @ np.abs(R)) / force
     st = max(st, (st - 10.0 * floor) * data.w_load / delta)
     gap = data.g0 + s - w
     rscale = reaction_scale(R, data.f, tol)

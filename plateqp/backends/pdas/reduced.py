@@ -9,6 +9,7 @@ import scipy.sparse as sp
 
 from ...errors import SolverError
 from ...linalg import row_stiffness
+from ...linalg.pattern import abs_matvec
 from ..base import QP
 
 __all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "infeasible", "natural_residuals"]
@@ -131,23 +132,6 @@ class Exchange:
         return A, mode
 
 
-def _abs_matvec(K: sp.csc_matrix, x: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
-    """``|K| x`` for symmetric ``K`` (CSC), a block of rows at a time: K's CSC arrays read as
-    CSR are K itself, so each block is ``chunk`` entries of |K| and gives its own rows (no
-    copy of K's data, no pass over all rows per block)."""
-    n = K.shape[0]
-    out = np.empty(n)
-    j0 = 0
-    while j0 < n:
-        j1 = int(np.searchsorted(K.indptr, K.indptr[j0] + chunk, side="right")) - 1
-        j1 = min(max(j1, j0 + 1), n)
-        a, b = K.indptr[j0], K.indptr[j1]
-        rows = sp.csr_matrix((np.abs(K.data[a:b]), K.indices[a:b], K.indptr[j0:j1 + 1] - a), shape=(j1 - j0, n))
-        out[j0:j1] = rows @ x
-        j0 = j1
-    return out
-
-
 def at_rounding(pb: ReducedQP, u: np.ndarray, idx: np.ndarray, BA, lamA: np.ndarray, r_u: np.ndarray,
                 r_A: np.ndarray) -> bool:
     """The step ``(u, λ_A)`` of the active rows ``idx`` is exact to rounding: each residual is
@@ -157,7 +141,7 @@ def at_rounding(pb: ReducedQP, u: np.ndarray, idx: np.ndarray, BA, lamA: np.ndar
     refinement step would not change the answer."""
     eps = ROUNDING_STOP * np.finfo(float).eps
     au, al = np.abs(u), np.abs(lamA)
-    su = (_abs_matvec(pb.K, au) + abs(BA.T) @ al + np.abs(pb.f)).max(initial=0.0)
+    su = (abs_matvec(pb.K, au) + abs(BA.T) @ al + np.abs(pb.f)).max(initial=0.0)
     if np.abs(r_u).max(initial=0.0) > eps * su:
         return False
     sA = abs(BA) @ au + np.abs(pb.g[idx]) + pb.rho[idx] * al
