@@ -199,11 +199,12 @@ class SpringFactor:
         if that is cheaper than a factorisation and keeps its digits (see the class); False:
         refactorise instead."""
         k = changed.size
+        if k > LOWRANK_MAX or loss > DOWNDATE_LOSS:  # first: a first phase changes thousands of rows
+            return False
         new = np.array([r for r in changed.tolist() if r not in self._zcols], dtype=np.int64)
         t_solve = self.t_solve if self.t_solve is not None else self.t_factor / 10.0
         # k right-hand sides in one solve cost about half a solve each (CHOLMOD's block solve)
-        if (k > LOWRANK_MAX or loss > DOWNDATE_LOSS
-                or (new.size and t_solve * max(1.0, 0.5 * new.size) > LOWRANK_COST * self.t_factor)):
+        if new.size and t_solve * max(1.0, 0.5 * new.size) > LOWRANK_COST * self.t_factor:
             return False
         t0 = time.perf_counter()
         if new.size:
