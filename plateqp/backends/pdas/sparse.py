@@ -1,7 +1,7 @@
 r"""The sparse method: a factor of ``K + σ diag(K) + B_Aᵀ W_A B_A`` kept current as the active
-set changes (:mod:`.factor`), exact steps by refinement, and a first phase: Newton–PCG for soft rows, projected
-Newton on the dual energy for stiff rows on a held plate (see the package docstring: "Two ways
-to solve a step", "Singular steps and no equilibrium")."""
+set changes (:mod:`.factor`), exact steps by refinement, and a first phase: Newton–PCG for soft
+rows, projected Newton on the dual energy for stiff rows on a held plate (see the package
+docstring: "Two ways to solve a step", "Singular steps and no equilibrium")."""
 
 from __future__ import annotations
 
