@@ -245,6 +245,32 @@ def test_shifted_schur_of_a_semidefinite_matrix(method):
         SchurFactor(K, last, pivot_tol=1e-13, method=method)
 
 
+@pytest.mark.parametrize("method", SCHUR_METHODS)
+def test_smallest_eigenvalue_of_the_trailing_block(method):
+    """SchurFactor.smallest_eigenvalue (two inverse iterations) against LAPACK's eigenvalues of
+    the equilibrated Schur complement: an upper bound, within a factor 2 here; about ε·‖S‖
+    for a singular K (a Laplacian: the constants), which pivot_tol then refuses."""
+    K = spd()
+    n = K.shape[0]
+    last = np.random.default_rng(4).permutation(n)[:12]
+    fac = SchurFactor(K, last, method=method)
+    s = 1.0 / np.sqrt(K.diagonal())
+    Ks = sp.diags(s) @ K @ sp.diags(s)
+    low = np.linalg.eigvalsh(dense_schur(sp.csc_matrix(Ks), last))[0]
+    est = fac.smallest_eigenvalue()
+    assert low * (1 - 1e-12) <= est <= 2 * low
+    # nearly singular: a Laplacian (null space: the constants) plus 1e-13 of its diagonal
+    L = laplacian(6)
+    L = sp.csc_matrix(L + 1e-13 * sp.diags(L.diagonal()))
+    last = np.array([0, 5, 14, 30, 35])
+    s = 1.0 / np.sqrt(L.diagonal())
+    low = np.linalg.eigvalsh(dense_schur(sp.csc_matrix(sp.diags(s) @ L @ sp.diags(s)), last))[0]
+    est = SchurFactor(L, last, method=method).smallest_eigenvalue()
+    assert low < 1e-12 and est <= 2 * low + 1e-15
+    with pytest.raises(SingularMatrixError, match="singular"):
+        SchurFactor(L, last, pivot_tol=1e-11, method=method)
+
+
 # --------------------------------------------------------------------------- saddle, row stiffness
 
 

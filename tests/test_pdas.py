@@ -416,12 +416,16 @@ def test_refinement_stops_at_rounding_and_not_before():
     assert not at_rounding(pb, u2, idx, BA, lam, *residuals(u2, lam))
 
 
-def test_dense_method_does_not_cycle_on_a_degenerate_row():
-    """A 14² plate on stiff tensionless springs where one row ends with gap and reaction both
-    near zero: the dense classification (M from the trailing block, accurate to ~cond(K)·ε)
-    called it infeasible both with and without it, and Murty's single exchange toggled it for
-    470 steps (MAX_ITER). A set met again is classified on the exact equations; the answer is
-    Lemke's on the condensed LCP (found by a random search of beds against Lemke)."""
+@pytest.mark.skipif(not (linalg.HAVE_CHOLMOD or getattr(linalg, "HAVE_CVXOPT", False)),
+                    reason="the condensed method needs CHOLMOD")
+def test_a_plate_free_to_turn_about_its_one_held_edge_goes_to_the_sparse_method():
+    """A 14² plate simply supported on one edge only (free to turn about it: K singular) on
+    stiff tensionless springs. Its trailing block's smallest pivot is 1.3e-13, above the old
+    pivot test (1e-13): the dense method took it, and with M from a singular K a row whose
+    gap and reaction both end near zero was called infeasible both with and without it
+    (Murty's exchange toggled it for 470 steps, MAX_ITER; found by a random search of beds
+    against Lemke). The trailing block's smallest eigenvalue (about 1e-16) now sends it to the
+    sparse method; the answer is Lemke's on the condensed LCP."""
     sc = pq.Scene(name="degenerate bed", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(14, 14, "acm"),
                   edges={"left": pq.Edge("simple")},
                   loads=[pq.UniformLoad(10.562219778473672), pq.PointLoad(238.64432399423725, 0.38191689757498704,
@@ -431,10 +435,38 @@ def test_dense_method_does_not_cycle_on_a_degenerate_row():
                                                                    "gy": -0.002965447593238504}))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pq.PlateQPWarning)
-        res = pq.solve(sc, backend="pdas", accuracy=1e-10, options={"method": "condensed"})
+        with pytest.raises(SolverError, match="K is singular"):
+            pq.solve(sc, backend="pdas", accuracy=1e-10, options={"method": "condensed"})
+        res = pq.solve(sc, backend="pdas", accuracy=1e-10)
         ref = pq.solve(sc, backend="lemke", formulation="condensed", accuracy="high")
-    assert res.status == Status.OPTIMAL and res.kkt.ok and res.iterations < 60
+    assert res.extras["method"] == "sparse"
+    assert res.status == Status.OPTIMAL and res.kkt.ok
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+
+
+def floating_bed(n, k):
+    return pq.Scene(name="floating bed", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
+                    edges={}, loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
+                    foundation=pq.Foundation(k, gap={"profile": "linear", "g0": 0.0, "gx": 1e-4, "gy": 0.5e-4}))
+
+
+@pytest.mark.skipif(not (linalg.HAVE_CHOLMOD or getattr(linalg, "HAVE_CVXOPT", False)),
+                    reason="the condensed method needs CHOLMOD")
+@pytest.mark.parametrize("k", [2e4, 1e9])
+def test_a_floating_bed_goes_to_the_sparse_method(k):
+    """A floating 24² plate on a tensionless bed: K is singular (rigid motions), but the
+    trailing block's smallest pivot (1e-13) passed the old pivot test, so the dense method
+    took it, with M from a singular K. On soft springs the answer still passed; on springs of
+    1e9 the block steps ran to MAX_ITER (1300 sets, 10 s). The smallest-eigenvalue estimate
+    (3e-16) now sends it to the sparse method; the reactions are Lemke's."""
+    sc = floating_bed(24, k)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        res = pq.solve(sc, backend="pdas", accuracy=1e-10)
+        ref = pq.solve(sc, backend="lemke", formulation="condensed", accuracy="high")
+    assert res.extras["method"] == "sparse"
+    assert res.status == Status.OPTIMAL and res.kkt.ok, (res.status, res.kkt.as_dict())
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * np.abs(ref.reactions).max())
 
 
 @pytest.mark.parametrize("seed", range(6))

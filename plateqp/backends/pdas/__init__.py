@@ -72,7 +72,11 @@ the residuals are above rounding: usually none), so rounding in ``d`` (``g − B
 cancels) does not reach the answer. ``M`` itself is accurate to about ``cond(K)·ε``; at a row
 whose gap and reaction both end near zero that can call it infeasible both in and out of the
 set, and Murty's rule then toggles it for ever (in exact arithmetic it terminates). So a set
-met a second time is classified on the exact equations instead, as the final one is. The same factor
+met a second time is classified on the exact equations instead, as the final one is. ``K``
+must be definite: a floating plate's (or one free to turn about a single held edge) is found
+by the trailing block's smallest pivot and an estimate of its smallest eigenvalue (two inverse
+iterations, :meth:`plateqp.linalg.SchurFactor.smallest_eigenvalue`) below ``PIVOT_TOL`` and
+goes to the sparse method. The same factor
 solves throughout: with cvxopt, ``L_cc`` is copied out of CHOLMOD's factor without spending it
 (:mod:`plateqp.linalg.cholmod`; before, a second, plain factorisation of ``K`` did the solves).
 
