@@ -31,6 +31,7 @@ from plateqp import linalg
 from plateqp.backends import pdas as PD
 from plateqp.backends.base import LCP, QP, Status
 from plateqp.errors import NoEquilibriumError, ProblemError, SolverError
+from plateqp.families import grid_rigid
 
 PLATE = pq.Plate(a=1.0, b=1.0, h=0.02, E=1.0e7, nu=0.3)
 ALL_SIMPLE = {k: "simple" for k in ("left", "right", "bottom", "top")}
@@ -467,6 +468,67 @@ def test_a_floating_bed_goes_to_the_sparse_method(k):
     assert res.extras["method"] == "sparse"
     assert res.status == Status.OPTIMAL and res.kkt.ok, (res.status, res.kkt.as_dict())
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * np.abs(ref.reactions).max())
+
+
+def random_lcp(seed, m):
+    """An LCP ``gap = d + Mλ`` (M symmetric positive definite) with a known strictly
+    complementary solution ``λ*``: ``d = gap* − Mλ*``."""
+    rng = np.random.default_rng(seed)
+    Z = rng.standard_normal((m, m)) / np.sqrt(m) + np.eye(m)
+    M = Z.T @ Z + np.diag(rng.uniform(0, 1, m) * (rng.random(m) < 0.5))
+    support = rng.random(m) < 0.2
+    lam = np.where(support, rng.uniform(0.5, 2.0, m), 0.0)
+    gap = np.where(support, 0.0, rng.uniform(0.1, 1.0, m))
+    return M, gap - M @ lam, lam, support
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_lawson_hanson_first_set_is_the_solution_of_a_random_lcp(seed):
+    """first_set finds the support of the known solution, and SciPy's NNLS (M = RᵀR: the LCP
+    is the KKT system of min ‖Rλ + R⁻ᵀd‖, λ ≥ 0) finds the same reactions."""
+    from scipy.optimize import nnls
+
+    from plateqp.backends.pdas.dense import first_set
+
+    m = 30 + 20 * seed
+    M, d, lam, support = random_lcp(seed, m)
+    c = np.random.default_rng(seed).uniform(0.5, 2.0, m)  # row weights choose the order, not the answer
+    A, steps = first_set(M, d, c, 1e-12, 0.0, np.inf)
+    assert A is not None and steps >= support.sum()
+    np.testing.assert_array_equal(A, support)
+    R = np.linalg.cholesky(M).T
+    ref = nnls(R, -np.linalg.solve(R.T, d))[0]
+    np.testing.assert_allclose(ref, lam, atol=1e-9)
+
+
+def test_lawson_hanson_first_set_gives_up_over_budget_and_survives_dependent_rows():
+    from plateqp.backends.pdas.dense import first_set
+
+    M, d, _, support = random_lcp(7, 60)
+    A, steps = first_set(M, d, np.ones(60), 1e-12, 0.0, 1e5)  # two rows' work at most
+    assert A is None and steps <= 2
+    # two supports at one point: a repeated row and column (M singular), both pressed
+    Md = np.block([[M, M[:, :1]], [M[:1, :], M[:1, :1]]])
+    dd = np.append(d, d[0])
+    A, steps = first_set(Md, dd, np.ones(61), 1e-12, 0.0, np.inf)
+    if A is not None:  # either twin may carry; the rest is the solution's support
+        assert A[1:60].tolist() == support[1:].tolist() and A[0] + A[60] == support[0]
+
+
+@pytest.mark.skipif(not (linalg.HAVE_CHOLMOD or getattr(linalg, "HAVE_CVXOPT", False)),
+                    reason="the condensed method needs CHOLMOD")
+def test_post_grid_starts_from_the_lawson_hanson_set():
+    """25 × 25 rigid posts on a 36² plate: the block steps from ``d < 0`` (620 rows) take
+    several sets; Lawson–Hanson's set is the final one (one exact step confirms it), and the
+    reactions are Lemke's. Seen failing with first_set returning its set one row short."""
+    sc = grid_rigid(36, 25)
+    res = pq.solve(sc, backend="pdas", formulation="primal", accuracy="high", options={"trace": True})
+    ref = pq.solve(sc, backend="lemke", formulation="condensed", accuracy="high")
+    assert res.extras["first_set"] == "lawson-hanson" and res.extras["first_set_steps"] >= res.extras["active"].sum()
+    assert [t["solve"] for t in res.extras["trace"]] == ["exact"]
+    assert res.iterations == res.extras["first_set_steps"] + 1
+    assert_kkt_ok(res)
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
 
 
 @pytest.mark.parametrize("seed", range(6))

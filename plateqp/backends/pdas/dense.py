@@ -25,10 +25,10 @@ import scipy.linalg as sla
 from ...errors import SingularMatrixError
 from ...linalg import SchurFactor, bindings
 from ..base import Status
-from .options import INNER_EXACT, PIVOT_TOL
+from .options import INNER_EXACT, LH_BUDGET, LH_OVERHEAD, LH_PROBE, PIVOT_TOL
 from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
 
-__all__ = ["DenseDual", "NotApplicable", "run_dense"]
+__all__ = ["DenseDual", "NotApplicable", "first_set", "run_dense"]
 
 
 class NotApplicable(Exception):
@@ -61,6 +61,7 @@ class DenseDual:
         self.yf = self._forward(pb.f)
         self.d = pb.g - self.Bc @ self._tail(self.yf)  # g − B K⁻¹ f: half a solve
         self._chol = None
+        self.first: dict = {}  # how run_dense found its first set (extras)
 
     # K⁻¹ in two halves where the factor allows (SchurFactor.forward / backward: the rows need
     # only the trailing part of the first half); else "y" is the whole solution x = K⁻¹ b
@@ -93,7 +94,8 @@ class DenseDual:
         st = self.fac.stats
         return {"analyse_s": st["analyse_s"], "factor_s": st["factor_s"], "extract_s": st["extract_s"],
                 "dense_s": self._dense_s, "solves": st["solves"], "solve_s": st["solve_s"],
-                "factorisations": st["factorisations"], "contact_dofs": st["last"], "cholmod": st["method"]}
+                "factorisations": st["factorisations"], "contact_dofs": st["last"], "cholmod": st["method"],
+                **self.first}
 
     def solve_K(self, b: np.ndarray) -> np.ndarray:
         """``K⁻¹ b``."""
@@ -149,8 +151,115 @@ class DenseDual:
         return u, lam
 
 
+def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floor: float,
+              budget: float) -> tuple[np.ndarray | None, int]:
+    r"""A first active set for the dual LCP ``gap = d + Mλ ≥ 0, λ ≥ 0, λ·gap = 0`` (``M``
+    symmetric positive definite): Lawson–Hanson's active-set method on ``min ½λᵀMλ + dᵀλ,
+    λ ≥ 0`` (their NNLS algorithm with ``M`` for ``AᵀA``; Lawson & Hanson, *Solving Least
+    Squares Problems*, 1974, ch. 23).
+
+    From ``λ = 0`` it frees, one at a time, the row of most negative force ``c_j gap_j``, solves
+    the free rows' equations ``M_FF λ_F = −d_F`` with a Cholesky factor grown by one row per row
+    freed (k² flops, not k³/3), and where that would make a reaction negative steps back to the
+    first row that reaches zero and fixes it again. It stops when no fixed row has
+    ``c_j gap_j < −feas_tol · max(‖λ‖∞, floor)`` (the block steps' own test,
+    :func:`.reduced.infeasible`). Each set's ``λ`` stays feasible, so where few of many rows end
+    in contact it takes about as many cheap steps as there are contacts, where the block steps
+    from ``d < 0`` take many dense Cholesky factorisations of large sets.
+
+    Returns ``(A, steps)``: the free rows (the active set; the caller checks it) and the sets
+    solved; ``A`` is None when the work (3k² + 2mk + LH_OVERHEAD flops for a set of k rows) would
+    pass ``budget``, or when, after LH_PROBE rows, the rows freed plus the rows still pressed
+    (about the final size) would need more than it. A row whose pivot vanishes (its row of ``M`` dependent on the free ones:
+    two supports at one point) is never freed; the caller's block steps see to it.
+    """
+    m = d.size
+    gap = d.astype(float, copy=True)
+    lam = np.zeros(m)
+    free = np.zeros(m, dtype=bool)
+    barred = np.zeros(m, dtype=bool)
+    F = np.zeros(0, dtype=np.int64)  # the free rows, in the order of the factor
+    cap = 16
+    L = np.zeros((cap, cap))  # Cholesky factor of M_FF in L[:k, :k]
+    R = np.zeros((cap, m))  # the rows M_F·, so gap = d + λ_Fᵀ M_F· is one matrix-vector product
+    work, steps = 0.0, 0
+    tiny = np.finfo(float).tiny
+    sizes = np.arange(m + 1, dtype=float)
+    kmax = int(np.searchsorted(np.cumsum(3.0 * sizes**2 + 2.0 * m * sizes + LH_OVERHEAD), budget))
+    while True:
+        force = np.where(free | barred, np.inf, c * gap)
+        bad = force < -feas_tol * max(np.abs(lam).max(initial=0.0), floor, tiny)
+        if not bad.any():
+            return free, steps
+        j = int(np.argmin(force))
+        k = F.size
+        work += 3.0 * k * k + 2.0 * m * k + LH_OVERHEAD
+        # past the probe, k + (rows still pressed) foretells the final size: each row freed
+        # then relieves about one other (measured on post grids and beds)
+        if work > budget or (k >= LH_PROBE and k + int(bad.sum()) > kmax):
+            return None, steps
+        if k == cap:  # grow the buffers
+            cap *= 2
+            L2, R2 = np.zeros((cap, cap)), np.zeros((cap, m))
+            L2[:k, :k], R2[:k] = L[:k, :k], R[:k]
+            L, R = L2, R2
+        row = M[j]
+        ell = sla.solve_triangular(L[:k, :k], row[F], lower=True, check_finite=False) if k else np.zeros(0)
+        pivot = row[j] - ell @ ell
+        if not pivot > 1e-12 * row[j]:
+            barred[j] = True
+            continue
+        L[k, :k], L[k, k], R[k] = ell, np.sqrt(pivot), row
+        F = np.append(F, j)
+        free[j] = True
+        while True:  # the free rows' reactions; step back while one of them would be negative
+            steps += 1
+            k = F.size
+            y = sla.solve_triangular(L[:k, :k], -d[F], lower=True, check_finite=False)
+            z = sla.solve_triangular(L[:k, :k], y, lower=True, trans="T", check_finite=False)
+            if np.all(z > 0):
+                lam[F] = z
+                break
+            old = lam[F]
+            neg = np.flatnonzero(z <= 0)
+            t = old[neg] / (old[neg] - z[neg])
+            new = old + t.min() * (z - old)
+            new[neg[np.argmin(t)]] = 0.0
+            keep = new > 0
+            if not keep[-1] and old[-1] == 0.0:  # the row just freed cannot carry (rounding)
+                barred[F[-1]] = True
+            lam[F] = np.where(keep, new, 0.0)
+            free[F[~keep]] = False
+            R[:int(keep.sum())] = R[:k][keep]
+            F = F[keep]
+            k = F.size
+            work += k ** 3 / 3.0
+            if k:
+                try:
+                    L[:k, :k] = np.linalg.cholesky(M[np.ix_(F, F)])
+                except np.linalg.LinAlgError:  # M_FF singular to rounding: leave it to the block steps
+                    return None, steps
+        gap = d + lam[F] @ R[:F.size] if F.size else d.astype(float, copy=True)
+
+
 def run_dense(pb: ReducedQP, cond: DenseDual, A, feas_tol, max_iter, p, steps) -> Outcome:
-    A = (cond.d < 0) if A is None else A.copy()
+    first = 0
+    if A is not None:
+        A = A.copy()
+        cond.first = {"first_set": "given"}
+    elif np.median(pb.rho * pb.k) < 1.0:  # stiff rows: Lawson–Hanson first (options.LH_BUDGET)
+        A = cond.d < 0
+        t0 = time.perf_counter()
+        start, first = first_set(cond.M, cond.d, pb.c, feas_tol, 1e-12 * np.abs(pb.f).sum(),
+                                 LH_BUDGET * int(A.sum()) ** 3 / 3.0)
+        cond._dense_s += time.perf_counter() - t0
+        cond.first = {"first_set": "d < 0 (lawson-hanson gave up)" if start is None else "lawson-hanson",
+                      "first_set_steps": first}
+        if start is not None:
+            A = start
+    else:
+        A = cond.d < 0
+        cond.first = {"first_set": "d < 0"}
     ex = Exchange(p)
     for it in range(1, max_iter + 1):
         lam, gap = cond.basic(A)
@@ -169,10 +278,10 @@ def run_dense(pb: ReducedQP, cond: DenseDual, A, feas_tol, max_iter, p, steps) -
         if steps is not None:
             steps.append({"step": it, "active": int(A.sum()), "infeasible": int(bad.sum()), "solve": kind})
         if not bad.any():
-            return Outcome(Status.OPTIMAL, "no infeasible row", A, u, lam, it)
+            return Outcome(Status.OPTIMAL, "no infeasible row", A, u, lam, first + it)
         A, mode = ex.next(A, bad)
         if steps is not None:
             steps[-1]["exchange"] = mode
     lam, _ = cond.basic(A)  # the last iterate: the set the last exchange gave, solved
     u, lam = cond.exact(A, lam)
-    return Outcome(Status.MAX_ITER, f"iteration limit {max_iter} reached", A, u, lam, max_iter)
+    return Outcome(Status.MAX_ITER, f"iteration limit {max_iter} reached", A, u, lam, first + max_iter)

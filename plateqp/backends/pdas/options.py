@@ -87,6 +87,18 @@ ALPHA_MAX = 1e3
 DUAL_STEPS, DUAL_RISES, ARMIJO, ALPHA_MIN, DUAL_DEFINITE, DUAL_ROUNDING = 60, 8, 1e-4, 1e-4, 1e2, 1e-9
 #: ... or when three steps in a row changed ψ by at most DUAL_FLAT relative.
 DUAL_FLAT = 1e-7
+#: (condensed, cold start, stiff rows: median ρ_i k_i < 1) The first active set by
+#: Lawson–Hanson's method on the dual QP (rows freed one at a time, most negative gap first;
+#: :func:`.dense.first_set`). Its k-th row costs 3k² + 2mk + LH_OVERHEAD flops (BLAS 2, and
+#: Python's overhead); it gives up when that work would pass LH_BUDGET times the block steps'
+#: first Cholesky, that of the set ``d < 0`` (|A₀|³/3 flops), or when, after LH_PROBE rows,
+#: the rows freed plus the rows still pressed (the final size, foretold) would. The block steps
+#: then start from ``d < 0`` as before. Measured (single solves, CPU): 30 × 30 post grids, 900
+#: rows, 124–131 in contact at the end: from ``d < 0`` (892 rows) the block steps took 30–34
+#: sets and 0.07–0.10 s, these 145 rows 0.02–0.03 s, and their set was the final one; 44 × 44
+#: posts at 128² (1936 rows, 177 at the end): 48 block sets. Where most rows end in contact
+#: (stiff beds on a held plate: 193 of 529, 1091 of 1521), it gives up at the probe.
+LH_BUDGET, LH_OVERHEAD, LH_PROBE = 0.5, 5e4, 24
 #: (condensed) A trailing pivot L_ii², or the estimate of the trailing block's smallest
 #: eigenvalue (two inverse iterations), below this (K equilibrated to a unit diagonal) means K is
 #: singular to working precision (a floating plate): the sparse method takes over. Measured: a
