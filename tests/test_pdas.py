@@ -348,6 +348,21 @@ def test_condensed_method_refuses_a_floating_plate():
     assert solve(triangle(100.0, 0.4, 0.3, gaps=(1e-4, 0, 0))).extras["method"] == "sparse"  # auto falls back
 
 
+def test_max_dense_auto_grows_with_the_mesh():
+    """max_dense="auto" (the default): 2000 on small meshes, 16·√n between, 4000 at most; an
+    integer is taken as given, anything else refused; the answer's extras say which applied."""
+    from plateqp.backends.pdas.driver import auto_max_dense
+
+    assert auto_max_dense(12_159) == 2000  # 64²
+    assert auto_max_dense(48_895) == int(16 * np.sqrt(48_895)) == 3537  # 128²
+    assert auto_max_dense(196_095) == 4000  # 256²
+    sc = grid_rigid(12, 3)
+    assert solve(sc).extras["max_dense"] == 2000
+    assert solve(sc, {"max_dense": 5}).extras["max_dense"] == 5
+    with pytest.raises(ProblemError, match="max_dense"):
+        solve(sc, {"max_dense": "big"})
+
+
 def test_registered():
     b = pq.get_backend("pdas")
     assert b.accepts == frozenset({"qp"}) and b.available()

@@ -51,7 +51,8 @@ Two ways to solve a step
 ------------------------
 ``method="condensed"`` (:mod:`.dense`; the default where CHOLMOD is at hand, through
 scikit-sparse or the copy in cvxopt's wheels, ``K`` is definite and the rows touch at most
-``max_dense`` dofs: discrete supports on a held plate). The dofs the rows act on go *last* in
+``max_dense`` dofs ("auto": 2000 to 4000 as the mesh grows, :data:`.options.MAX_DENSE_AUTO`):
+discrete supports on a held plate). The dofs the rows act on go *last* in
 the elimination order (AMD order on the rest); one sparse Cholesky ``K = L Lᵀ``
 (:class:`plateqp.linalg.SchurFactor`) then holds, in its trailing dense block ``L_cc``, the
 static condensation of every other dof: ``L_cc L_ccᵀ`` is the condensed stiffness. With ``Z = L_cc⁻¹ B_cᵀ`` (a dense triangular solve) the dual LCP

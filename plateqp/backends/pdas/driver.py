@@ -11,7 +11,7 @@ import numpy as np
 from ...errors import ProblemError, SolverError
 from ..base import QP, RawSolution, Status, preset
 from .dense import DenseDual, NotApplicable, run_dense
-from .options import ACCURACY, OPTIONS, SETTINGS
+from .options import ACCURACY, MAX_DENSE_AUTO, OPTIONS, SETTINGS
 from .reduced import ReducedQP, force_scale, natural_residuals
 from .sparse import SpringFactor, run_sparse
 
@@ -27,6 +27,12 @@ def _option(settings: dict, key: str, ok, what: str):
 
 def _is_int(v, lo):
     return not isinstance(v, bool) and isinstance(v, (int, np.integer)) and v >= lo
+
+
+def auto_max_dense(n: int) -> int:
+    """``max_dense="auto"`` for ``n`` coupled dofs (:data:`.options.MAX_DENSE_AUTO`)."""
+    lo, hi, per_root = MAX_DENSE_AUTO
+    return max(lo, min(hi, int(per_root * np.sqrt(n))))
 
 
 def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> RawSolution:
@@ -80,7 +86,8 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     kappa = _option(settings, "penalty", number(1.0), "a number > 1")
     sigma = _option(settings, "prox", number(0.0), "a number > 0")
     p = _option(settings, "p", lambda v: _is_int(v, 0), "an integer ≥ 0")
-    max_dense = _option(settings, "max_dense", lambda v: _is_int(v, 0), "an integer ≥ 0")
+    max_dense = _option(settings, "max_dense", lambda v: (isinstance(v, str) and v == "auto") or _is_int(v, 0),
+                        "'auto' or an integer ≥ 0")
     max_rows = _option(settings, "max_rows", lambda v: _is_int(v, 1), "a positive integer")
     _option(settings, "dual_start", lambda v: isinstance(v, (bool, np.bool_)), "True or False")
     if not isinstance(trace, (bool, np.bool_)):
@@ -88,6 +95,8 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
 
     pb = ReducedQP(qp, max_rows)
     m = pb.m
+    if max_dense == "auto":
+        max_dense = auto_max_dense(pb.K.shape[0])
     max_iter = settings["max_iter"] if settings["max_iter"] is not None else 50 + 2 * m
     if not _is_int(max_iter, 1):
         raise ProblemError(f"option max_iter must be a positive integer, got {max_iter!r}")
@@ -99,7 +108,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     steps: list[dict] | None = [] if trace else None
 
     out = None
-    extras: dict = {}
+    extras: dict = {"max_dense": max_dense}
     if method in ("auto", "condensed"):
         try:
             cond = DenseDual(pb, max_dense)
