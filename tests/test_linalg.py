@@ -168,6 +168,23 @@ def test_trailing_block_is_the_dense_factors(lib):
     assert rel(chol.solve(b), np.linalg.solve(Ad, b)) < 1e-10
 
 
+def test_factor_flops_of_a_dense_matrix():
+    """Cholesky.flops on a dense SPD matrix (one supernode, natural order): n(n+1)(2n+1)/6
+    multiply-adds, the textbook count Σ_k (n − k)²."""
+    if not getattr(linalg, "HAVE_CVXOPT", False):
+        pytest.skip("the direct seam needs cvxopt's CHOLMOD")
+    n = 40
+    G = np.random.default_rng(0).standard_normal((n, n))
+    K = sp.csc_matrix(G @ G.T + n * np.eye(n))
+    chol = Cholesky("cvxopt")
+    if chol.direct is None:
+        pytest.skip("the direct seam does not load here")
+    A = lower(K, 1.0 / np.sqrt(K.diagonal()), upper=chol.upper)
+    chol.analyse(A, natural=True)
+    chol.factor(A)
+    assert chol.flops() == n * (n + 1) * (2 * n + 1) / 6
+
+
 # --------------------------------------------------------------------------- SchurFactor
 
 

@@ -356,6 +356,26 @@ class Cholesky:
         scale = np.abs(T) @ np.abs(y[no:]) + np.abs(v)
         return bool(np.all(np.abs(y[:no]) == 0) and np.all(np.abs(r) <= 1e-10 * scale.max()))
 
+    def flops(self) -> float | None:
+        """The numeric factorisation's multiply-adds, counted from the factor's supernodes:
+        Σ over supernodes of Σ over their columns of (rows from that column down)², the count
+        ``n³/3 + …`` of a dense Cholesky (exactly n(n+1)(2n+1)/6 for one dense supernode).
+        None unless the factor is a supernodal one read through the direct seam."""
+        if self.direct is None or not self.direct.L:
+            return None
+        ptr = self.direct.L.value
+        h = _view(ptr, 22, np.uint64)
+        is_super = int(_view(ptr + 22 * 8, 7, np.int32)[2])
+        if not is_super or int(h[_MINOR]) != int(h[_N]):
+            return None
+        ns = int(h[_NSUPER])
+        sup = _view(int(h[_SUPER]), ns + 1, np.int64).astype(float)
+        pi = _view(int(h[_PI]), ns + 1, np.int64).astype(float)
+        nc, nr = np.diff(sup), np.diff(pi)
+        # Σ_{k<nc} (nr − k)² in closed form, per supernode
+        k = nc - 1
+        return float(np.sum(nc * nr**2 - 2 * nr * k * (k + 1) / 2 + k * (k + 1) * (2 * k + 1) / 6))
+
     def update(self, C: sp.csc_matrix, subtract: bool) -> None:
         """``A ± C Cᵀ`` in place (scikit-sparse)."""
         if not self.can_update:
