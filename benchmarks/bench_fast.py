@@ -35,9 +35,15 @@ Parts (``--parts``, comma-separated):
   of one support (``plateqp.sweep``) through auto and through pdas.
 * ``mesh``: the grid scene's ``pq.solve`` ÷ raw for ``--scale-meshes`` (32,64,128,256,512;
   one run at 512²).
+* ``flops``: why the grid's condensed method costs what it does: at ``--meshes``, one
+  factorisation of the grid scene's equilibrated K in AMD order ("plain") and one with the 900
+  contact dofs moved last (the condensed method's), each through plateqp's CHOLMOD seam: CPU
+  time (median of ``--repeat``), multiply-adds counted from the factor's supernodes
+  (``plateqp.linalg.cholmod.Cholesky.flops``) and the rate.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_fast.py --parts goal
     python benchmarks/bench_fast.py --parts backends,mesh --scale-meshes 32,64,128,256
+    python benchmarks/bench_fast.py --parts flops --meshes 64,128,256
 
 Prints markdown tables, writes benchmarks/results/fast.csv (long format, one row per case).
 """
@@ -237,6 +243,41 @@ def _other(args, q):
         q.put({"status": f"error: {type(exn).__name__}: {str(exn)[:80]}"})
 
 
+# ----------------------------------------------------------------------------- flops
+
+
+def flops_row(n: int, repeat: int) -> dict:
+    """One factorisation of the grid scene's K in AMD order and one with the contact dofs last:
+    CPU time (medians, interleaved) and the multiply-adds read from each factor."""
+    from plateqp.linalg.cholmod import Cholesky, lower
+    from plateqp.linalg.factor import equilibration
+
+    model = build_model(make_scene("grid", n))
+    K = sp.csc_matrix(model.K)
+    last = np.unique(sp.csr_matrix(model.contacts.B).indices)
+    s = equilibration(K, None)
+    first = Cholesky("cvxopt")
+    if first.direct is None:
+        raise SystemExit("--parts flops needs plateqp's CHOLMOD seam (cvxopt's wheels)")
+    amd = first.order(lower(K, s, upper=first.upper))
+    mask = np.zeros(K.shape[0], dtype=bool)
+    mask[last] = True
+    orders = {"plain": amd, "last": np.concatenate([amd[~mask[amd]], last])}
+    times: dict[str, list[float]] = {k: [] for k in orders}
+    flops = {}
+    for r in range(repeat):
+        for name in (orders if r % 2 == 0 else reversed(list(orders))):
+            chol = Cholesky("cvxopt")
+            A = lower(K, s, upper=chol.upper)
+            chol.analyse(A, order=orders[name])
+            dt, _ = cpu(lambda: chol.factor(A))
+            times[name].append(dt)
+            flops[name] = chol.flops()
+    return {"part": "flops", "scene": "grid", "mesh": n, "dofs": K.shape[0], "rows": int(last.size),
+            "plain_s": statistics.median(times["plain"]), "last_s": statistics.median(times["last"]),
+            "plain_flops": flops["plain"], "last_flops": flops["last"], "repeat": repeat}
+
+
 # ----------------------------------------------------------------------------- backend="auto"
 
 ROUTES = (("auto", "auto"), ("pdas", "primal"), ("bpp", "condensed"), ("lemke", "condensed"), ("bpp", "dual"))
@@ -433,6 +474,21 @@ def main():
             print(f"| {n}² | {row['dofs']} | {row['backend']}/{row['formulation']} ({row['method']}) | "
                   f"{row['iterations']} | {row['kkt_worst']:.1e} | {row['raw_s']:.3f} | {row['two_sided_ratio']:.2f} | "
                   f"{row['solve_s']:.3f} | {row['solve_ratio']:.2f} |", flush=True)
+            write_csv(rows, args.out)
+
+    if "flops" in parts:
+        print("\n### grid_rigid(n, 30): CHOLMOD's factorisation of K, plain (AMD) and with the contact dofs last "
+              f"(CPU s, medians of {args.repeat})\n")
+        print("| mesh | dofs | contact dofs | plain s | plain G flops | GF/s | last s | last G flops | GF/s | "
+              "time ratio | flop ratio |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|")
+        for n in (int(v) for v in args.meshes.split(",")):
+            row = flops_row(n, args.repeat)
+            rows.append(row)
+            print(f"| {n}² | {row['dofs']} | {row['rows']} | {row['plain_s']:.3f} | {row['plain_flops'] / 1e9:.2f} | "
+                  f"{row['plain_flops'] / row['plain_s'] / 1e9:.1f} | {row['last_s']:.3f} | "
+                  f"{row['last_flops'] / 1e9:.2f} | {row['last_flops'] / row['last_s'] / 1e9:.1f} | "
+                  f"{row['last_s'] / row['plain_s']:.2f} | {row['last_flops'] / row['plain_flops']:.2f} |", flush=True)
             write_csv(rows, args.out)
 
     write_csv(rows, args.out)

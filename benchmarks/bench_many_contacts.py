@@ -4,9 +4,9 @@ post on every interior node, and on the tensionless bed.
 Scenes (:mod:`plateqp.families`, kN and m): ``grid_rigid(n, k)``, the slab on four walls and a
 k × k grid of rigid one-sided posts with mixed gaps, for k = 3, 10, 30, 45, 63 and ``"all"``
 (n − 1: every interior node a post), and ``bed(n)``, the free slab on a tensionless Winkler bed
-(a one-sided spring at every node). The scenes at k = 45, 63 and ``all`` touch more than the
-condensed method's ``max_dense`` = 2000 contact dofs, so pdas takes its sparse method there
-(and on the bed).
+(a one-sided spring at every node). pdas takes its condensed method up to ``max_dense``
+contact dofs ("auto": 2000 up to about 71², 3537 at 128², 4000 from about 144²) and its sparse method
+above that and on the bed (a floating plate).
 
 Each case runs ``pq.solve(scene, backend=B, formulation="primal", accuracy=tol)`` in a fresh
 interpreter (spawn) with a time limit (``--timeout``), after one small warm-up solve there;
