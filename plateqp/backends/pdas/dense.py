@@ -170,8 +170,9 @@ def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floo
     Returns ``(A, steps)``: the free rows (the active set; the caller checks it) and the sets
     solved; ``A`` is None when the work (3k² + 2mk + LH_OVERHEAD flops for a set of k rows) would
     pass ``budget``, or when, after LH_PROBE rows, the rows freed plus the rows still pressed
-    (about the final size) would need more than it. A row whose pivot vanishes (its row of ``M`` dependent on the free ones:
-    two supports at one point) is never freed; the caller's block steps see to it.
+    (about the final size) would need more than it. A row whose pivot vanishes (its row of
+    ``M`` dependent on the free ones: two supports at one point) is never freed; the caller's
+    block steps see to it.
     """
     m = d.size
     gap = d.astype(float, copy=True)
