@@ -460,6 +460,35 @@ def test_a_plate_free_to_turn_about_its_one_held_edge_goes_to_the_sparse_method(
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
 
 
+def test_dense_method_classifies_a_repeated_set_on_the_exact_equations():
+    """The dense method's safeguard, on a one-row LCP whose dense data disagree with the exact
+    equations (as M from the trailing block can, to cond(K)·ε): the dense classification calls
+    the row's gap negative without it and its reaction negative with it, so block and Murty
+    exchanges alike would toggle it for ever (MAX_ITER; seen with the rule removed). Met a second
+    time, the set is solved on the exact equations, where the row is inactive with a positive
+    gap: OPTIMAL after three sets."""
+    from types import SimpleNamespace
+
+    from plateqp.backends.pdas.dense import run_dense
+
+    pb = SimpleNamespace(rho=np.zeros(1), k=np.ones(1), c=np.ones(1), g=np.ones(1), f=np.ones(1),
+                         B=sp.csr_matrix(np.ones((1, 1))))
+
+    class Cond:
+        first: dict = {}
+
+        def basic(self, A):  # the dense data: infeasible either way
+            return (np.array([-1e-6]), np.zeros(1)) if A[0] else (np.zeros(1), np.array([-1e-6]))
+
+        def exact(self, A, lam):  # the exact equations: u = 0.5, gap = g − u = 0.5 > 0
+            return np.array([0.5]), np.where(A, -1e-6, 0.0)
+
+    steps: list = []
+    out = run_dense(pb, Cond(), np.zeros(1, dtype=bool), 1e-11, 50, 6, steps)
+    assert out.status == Status.OPTIMAL and not out.A[0]
+    assert [t["solve"] for t in steps] == ["dense", "dense", "exact"]
+
+
 def floating_bed(n, k):
     return pq.Scene(name="floating bed", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
                     edges={}, loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
