@@ -363,11 +363,10 @@ class Cholesky:
         None unless the factor is a supernodal one read through the direct seam."""
         if self.direct is None or not self.direct.L:
             return None
-        ptr = self.direct.L.value
-        h = _view(ptr, 22, np.uint64)
-        is_super = int(_view(ptr + 22 * 8, 7, np.int32)[2])
-        if not is_super or int(h[_MINOR]) != int(h[_N]):
+        head = _header(self.direct.L.value)
+        if head is None or not head[2]:
             return None
+        h = head[0]
         ns = int(h[_NSUPER])
         sup = _view(int(h[_SUPER]), ns + 1, np.int64).astype(float)
         pi = _view(int(h[_PI]), ns + 1, np.int64).astype(float)
@@ -415,12 +414,25 @@ def _cvx_trailing(F, no: int) -> np.ndarray | None:
     return _trailing_at(ptr, no) if ptr else None
 
 
-def _trailing_at(ptr: int, no: int) -> np.ndarray | None:
-    """``L[no:, no:]`` of the ``cholmod_factor`` at ``ptr`` (see :func:`_cvx_trailing`)."""
+def _header(ptr: int) -> tuple[np.ndarray, int, int] | None:
+    """The ``cholmod_factor`` at ``ptr``: its 22 size/pointer fields, ``is_ll`` and
+    ``is_super``; None unless it is a complete numeric factor of the kind read here (64-bit
+    indices, real, double)."""
     h = _view(ptr, 22, np.uint64)
     _ordering, is_ll, is_super, _monotonic, itype, xtype, dtype = _view(ptr + 22 * 8, 7, np.int32)
+    if int(h[_MINOR]) != int(h[_N]) or itype != _LONG or xtype != _REAL or dtype != _DOUBLE:
+        return None
+    return h, int(is_ll), int(is_super)
+
+
+def _trailing_at(ptr: int, no: int) -> np.ndarray | None:
+    """``L[no:, no:]`` of the ``cholmod_factor`` at ``ptr`` (see :func:`_cvx_trailing`)."""
+    head = _header(ptr)
+    if head is None:
+        return None
+    h, is_ll, is_super = head
     n = int(h[_N])
-    if int(h[_MINOR]) != n or itype != _LONG or xtype != _REAL or dtype != _DOUBLE or not 0 <= no <= n:
+    if not 0 <= no <= n:
         return None
     k = n - no
     out = np.zeros((k, k))
