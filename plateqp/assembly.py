@@ -87,8 +87,18 @@ class Model:
     cell_dofs: np.ndarray  # (n_kept_cells, ndof) full dof indices
     cells: np.ndarray  # kept cell indices
     f_full: np.ndarray  # consistent loads on all dofs (for reactions at prescribed dofs)
-    K_full: sp.csr_matrix = field(repr=False)
+    # all dofs × all dofs, or a function that assembles it (:attr:`K_full`, on first use)
+    _K_full: sp.csr_matrix | Callable[[], sp.csr_matrix] = field(repr=False)
     contacts: ContactOperator | None = None
+
+    @property
+    def K_full(self) -> sp.csr_matrix:
+        """The stiffness on every dof (prescribed ones and those off the plate included: their
+        rows give the reactions at prescribed dofs, ``K_full @ expand(u) − f_full``). Assembled
+        on first use: a solve needs it only where a prescribed value is not zero."""
+        if callable(self._K_full):
+            self._K_full = self._K_full()
+        return self._K_full
 
     @property
     def n_free(self) -> int:
@@ -233,13 +243,20 @@ def build_model(scene: Scene) -> Model:
 
     # stiffness: every cell has the same element matrix; CSR built directly from node blocks
     V, cnode = _node_blocks(grid, el.stiffness(hx, hy, p.D, p.nu), nd)
-    K_full = _csr_from_blocks(V, cnode, np.arange(n_full), n_full)  # off-plate rows empty
+
+    def K_full():  # off-plate rows empty; the node blocks made again (not kept with the model)
+        Vf, cf = _node_blocks(grid, el.stiffness(hx, hy, p.D, p.nu), nd)
+        return _csr_from_blocks(Vf, cf, np.arange(n_full), n_full)
+
     pos = np.full(n_full, -1)
     pos[free] = np.arange(free.size)
     K = _csr_from_blocks(V, cnode, pos, free.size)
-    u_c = np.zeros(n_full)
-    u_c[fixed] = values
-    f = f_full[free] - (K_full @ u_c)[free]
+    f = f_full[free].copy()
+    if np.any(values != 0):  # the prescribed values' loads on the free dofs
+        u_c = np.zeros(n_full)
+        u_c[fixed] = values
+        K_full = K_full()
+        f -= (K_full @ u_c)[free]
     model = Model(scene, grid, el, K, f, free, fixed, values, n_full, cell_dofs, cells, f_full, K_full)
     model.contacts = _contacts(scene, model)
     return model

@@ -30,6 +30,7 @@ import plateqp as pq
 from plateqp import linalg
 from plateqp.backends import pdas as PD
 from plateqp.backends.base import LCP, QP, Status
+from plateqp.backends.pdas.reduced import ReducedQP
 from plateqp.errors import NoEquilibriumError, ProblemError, SolverError
 from plateqp.families import grid_rigid
 
@@ -298,6 +299,20 @@ def test_separable_variable_is_a_spring():
     raw = PD.solve(qp, "high")
     np.testing.assert_allclose(raw.x, [1.25, 0.75], atol=1e-14)
     np.testing.assert_allclose(raw.z, [0.75], atol=1e-14)
+
+
+def test_separable_variable_with_stored_zeros_is_a_spring():
+    # as above with u = (u0, u1) coupled, ½(2u0² − 2u0u1 + 2u1²) − 2u0 + ½t²  s.t.  u0 − t ≤ 0.5,
+    # and P storing zeros between u0 and t (a formulation's pattern): t is still separable (a
+    # spring). u1 = u0/2; active: 1.5 u0 − 2 + z = 0, t = z, u0 − t = 0.5 ⇒ z = 0.5, u0 = 1.
+    P = sp.csc_matrix((np.array([2.0, -1.0, 0.0, -1.0, 2.0, 0.0, 1.0]),
+                       np.array([0, 1, 2, 0, 1, 0, 2]), np.array([0, 3, 5, 7])), shape=(3, 3))
+    assert P.nnz == 7  # the zeros stored
+    qp = QP(P=P, q=[-2.0, 0.0, 0.0], G=sp.csr_matrix([[1.0, 0.0, -1.0]]), h=[0.5])
+    assert ReducedQP(qp, 10).sep.tolist() == [2]
+    raw = PD.solve(qp, "high")
+    np.testing.assert_allclose(raw.x, [1.0, 0.5, 0.5], atol=1e-14)
+    np.testing.assert_allclose(raw.z, [0.5], atol=1e-14)
 
 
 # ----------------------------------------------------------------------------- refusals

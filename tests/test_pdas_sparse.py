@@ -168,6 +168,34 @@ def _h_inverse(K, B, Kd, w, sigma, b):
 
 
 @pytest.mark.parametrize("method", ["cvxopt", "linalg"])
+@pytest.mark.parametrize("rows", ["within", "across"])
+def test_the_factor_solves_h_whether_the_rows_lie_in_k_pattern_or_not(bed_8_matrices, method, rows):
+    """The matrix the factor is built on, against SciPy's LU of ``H(w)``: bed rows (each within
+    one element: built on K's triangle alone) and rows that couple dofs K does not (K's
+    pattern plus ``|B|ᵀ|B|``)."""
+    from plateqp.linalg import bindings
+
+    if method == "cvxopt" and "cvxopt" not in bindings():
+        pytest.skip("cvxopt's CHOLMOD is not installed")
+    K, B, Kd = bed_8_matrices
+    n = K.shape[0]
+    if rows == "across":  # and ten rows each on two dofs at opposite ends of the plate
+        i = np.arange(10)
+        B = sp.vstack([B, sp.csr_matrix((np.tile([1.0, -0.5], 10), (np.repeat(i, 2), np.column_stack(
+            [i, n - 1 - i]).ravel())), shape=(10, n))], format="csr")
+    m, sigma = B.shape[0], 1e-12
+    rng = np.random.default_rng(5)
+    w = rng.uniform(0.5, 2.0, m) * Kd.max()
+    w[::7] = 0.0  # some rows off (the bed's others hold the plate)
+    fac = pdas_factor.SpringFactor(K, B, Kd, np.full(m, Kd.max()), sigma, method)
+    assert (fac.pattern_nnz == K.nnz) == (rows == "within")
+    fac.set(w)
+    b = rng.standard_normal(n)
+    ref = _h_inverse(K, B, Kd, w, sigma, b)
+    np.testing.assert_allclose(fac.solve(b), ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("method", ["cvxopt", "linalg"])
 def test_a_few_changed_rows_solve_by_woodbury_on_the_factor_in_hand(bed_8_matrices, method, monkeypatch):
     from plateqp.linalg import bindings
 

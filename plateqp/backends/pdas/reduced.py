@@ -57,14 +57,19 @@ class ReducedQP:
         G = sp.csc_matrix(qp.G, dtype=float)
         G.eliminate_zeros()
         v, w = np.random.default_rng(0).standard_normal((2, n))
-        if abs(v @ (P @ w) - w @ (P @ v)) > 1e-10 * np.sqrt((P @ v) @ (P @ v) * (w @ w)) + 1e-300:
+        Pv = P @ v
+        if abs(v @ (P @ w) - w @ Pv) > 1e-10 * np.sqrt((Pv @ Pv) * (w @ w)) + 1e-300:
             raise SolverError("the pdas backend needs a symmetric P")  # a randomised check, O(nnz)
         d = P.diagonal()
-        # non-zero entries per column, by a running count (0.1 s → 0.03 s at 256² against the
-        # bincount of every entry's column)
-        nz = np.concatenate([[0], np.cumsum(P.data != 0, dtype=np.int32 if P.nnz < 2**31 else np.int64)])
-        stored = nz[P.indptr[1:]] - nz[P.indptr[:-1]]
-        sep = (stored == 1) & (d > 0) & (np.diff(G.indptr) == 1)
+        # separable: a positive diagonal, one row of G, no other non-zero in its column; the
+        # non-zeros counted in the columns of the first two kinds only (O(their entries), not
+        # O(nnz P): 12 ms at 128²)
+        sep = (d > 0) & (np.diff(G.indptr) == 1)
+        cand = np.flatnonzero(sep)
+        lo, length = P.indptr[cand], np.diff(P.indptr)[cand]
+        at = np.arange(length.sum()) + np.repeat(lo - (np.cumsum(length) - length), length)
+        nz = np.bincount(np.repeat(np.arange(cand.size), length), weights=P.data[at] != 0, minlength=cand.size)
+        sep[cand] = nz == 1
         # a row left with no coupled variable keeps its separable ones (as plain variables)
         coupled = np.bincount(G.indices, weights=~sep[np.repeat(np.arange(n), np.diff(G.indptr))], minlength=m)
         lone = coupled[G.indices] == 0
