@@ -51,7 +51,7 @@ class SpringFactor:
                               f"(plateqp.linalg found: {libs or 'none'})")
         self.method = method
         self.chol = Cholesky(lib) if lib else None
-        n, m = K.shape[0], B.shape[0]
+        m = B.shape[0]
         self.B, self.c = B, c
         self.s = 1.0 / np.sqrt(Kd)
         Ks = sp.csc_matrix(K)
