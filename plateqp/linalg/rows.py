@@ -32,7 +32,11 @@ def row_stiffness(K, B, kind: str = "rayleigh", rho: np.ndarray | None = None) -
         k = np.asarray(B.multiply(B) @ K.diagonal()).ravel()
     else:
         bb = np.asarray(B.multiply(B).sum(axis=1)).ravel()
-        bKb = np.asarray((B @ K).multiply(B).sum(axis=1)).ravel()
+        if sp.issparse(K) and K.format == "csc":  # K symmetric: (K Bᵀ)ᵀ = B K, no CSR copy of K
+            Bt = B.T.tocsc()
+            bKb = np.asarray((K @ Bt).multiply(Bt).sum(axis=0)).ravel()
+        else:
+            bKb = np.asarray((B @ K).multiply(B).sum(axis=1)).ravel()
         k = bKb / np.maximum(bb, 1e-300) ** 2
     if rho is not None:
         k = k / (1.0 + rho * k)
