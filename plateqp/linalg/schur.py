@@ -232,7 +232,10 @@ class SchurFactor:
             dof, b = Bl.indices, Bl.data
             Sinv = sla.lapack.dpotri(self.Lll, lower=1)[0]  # (L Lᵀ)⁻¹, lower triangle
             Sinv = np.tril(Sinv) + np.tril(Sinv, -1).T
-            return Sinv[np.ix_(dof, dof)] * np.outer(b, b)
+            if not np.array_equal(dof, np.arange(m)):  # rows in another order than their unknowns
+                Sinv = Sinv[np.ix_(dof, dof)]
+            Sinv *= np.outer(b, b)
+            return Sinv
         Z = sla.solve_triangular(self.Lll, Bl.T.toarray(), lower=True, check_finite=False)
         M = sla.blas.dsyrk(1.0, Z, trans=1, lower=1)
         return np.tril(M) + np.tril(M, -1).T

@@ -183,6 +183,7 @@ def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floo
     cap = 16
     L = np.zeros((cap, cap))  # Cholesky factor of M_FF in L[:k, :k]
     R = np.zeros((cap, m))  # the rows M_F·, so gap = d + λ_Fᵀ M_F· is one matrix-vector product
+    y = np.zeros(cap)  # L⁻¹ (−d_F), grown by one entry per row freed
     work, steps = 0.0, 0
     tiny = np.finfo(float).tiny
     sizes = np.arange(m + 1, dtype=float)
@@ -201,9 +202,9 @@ def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floo
             return None, steps
         if k == cap:  # grow the buffers
             cap *= 2
-            L2, R2 = np.zeros((cap, cap)), np.zeros((cap, m))
-            L2[:k, :k], R2[:k] = L[:k, :k], R[:k]
-            L, R = L2, R2
+            L2, R2, y2 = np.zeros((cap, cap)), np.zeros((cap, m)), np.zeros(cap)
+            L2[:k, :k], R2[:k], y2[:k] = L[:k, :k], R[:k], y[:k]
+            L, R, y = L2, R2, y2
         row = M[j]
         ell = sla.solve_triangular(L[:k, :k], row[F], lower=True, check_finite=False) if k else np.zeros(0)
         pivot = row[j] - ell @ ell
@@ -211,13 +212,13 @@ def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floo
             barred[j] = True
             continue
         L[k, :k], L[k, k], R[k] = ell, np.sqrt(pivot), row
+        y[k] = (-d[j] - ell @ y[:k]) / L[k, k]  # the forward solve's new last entry
         F = np.append(F, j)
         free[j] = True
         while True:  # the free rows' reactions; step back while one of them would be negative
             steps += 1
             k = F.size
-            y = sla.solve_triangular(L[:k, :k], -d[F], lower=True, check_finite=False)
-            z = sla.solve_triangular(L[:k, :k], y, lower=True, trans="T", check_finite=False)
+            z = sla.solve_triangular(L[:k, :k], y[:k], lower=True, trans="T", check_finite=False)
             if np.all(z > 0):
                 lam[F] = z
                 break
@@ -240,6 +241,7 @@ def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floo
                     L[:k, :k] = np.linalg.cholesky(M[np.ix_(F, F)])
                 except np.linalg.LinAlgError:  # M_FF singular to rounding: leave it to the block steps
                     return None, steps
+                y[:k] = sla.solve_triangular(L[:k, :k], -d[F], lower=True, check_finite=False)
         gap = d + lam[F] @ R[:F.size] if F.size else d.astype(float, copy=True)
 
 
