@@ -62,11 +62,19 @@ def assert_contact_physics(res, gap0):
     assert np.abs(R * gap).max() <= 1e-9 * scale_R * scale_g
 
 
+#: Lawson–Hanson's first phase gives up after LH_TIME factorisations' time, measured: tests that
+#: expect it to finish lift the limit (a loaded machine must not change the path they check).
+NO_LH_LIMIT = 1e9
+
+
 @pytest.fixture(scope="module")
 def every_node_16():
     """A post on every interior node of a 16² slab: pdas's sparse method and Lemke."""
     sc = F.grid_rigid(16, "all")
-    return sc, solve(sc, options=SPARSE), solve(sc, "lemke", "condensed", "high")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(pdas_sparse, "LH_TIME", NO_LH_LIMIT)
+        res = solve(sc, options=SPARSE)
+    return sc, res, solve(sc, "lemke", "condensed", "high")
 
 
 def test_every_node_a_post_agrees_with_lemke_on_the_condensed_lcp(every_node_16):
@@ -79,19 +87,102 @@ def test_every_node_a_post_agrees_with_lemke_on_the_condensed_lcp(every_node_16)
     assert 0.05 < res.active.mean() < 0.9  # mixed gaps: many posts but not all carry load
 
 
-def test_every_node_a_post_takes_the_dual_first_phase(every_node_16):
+def test_every_node_a_post_takes_the_lawson_hanson_first_phase(every_node_16):
+    """The flexibility's rows are computed only for the rows the method frees: about as many
+    as end in contact, far fewer than the 225 rows; the exact steps confirm its set."""
     _, res, _ = every_node_16
     ex = res.extras
-    assert ex["method"] == "sparse" and ex["first_phase"] == "dual"
+    assert ex["method"] == "sparse" and ex["first_phase"] == "lawson-hanson"
+    in_contact = int(res.active.sum())
+    assert in_contact <= ex["lh_columns"] < 0.6 * res.active.size
+    assert ex["first_phase_steps"] >= in_contact
+    assert res.iterations - ex["first_phase_steps"] <= 2  # one exact step (two if it exchanges)
+
+
+def test_every_node_a_post_takes_the_dual_first_phase_without_lawson_hanson(every_node_16):
+    sc, _, ref = every_node_16
+    res = solve(sc, options={**SPARSE, "lh_start": False})
+    ex = res.extras
+    assert ex["method"] == "sparse" and ex["first_phase"] == "dual" and "lh_columns" not in ex
     assert ex["first_phase_steps"] >= 2
     assert res.iterations - ex["first_phase_steps"] <= 4  # the exact steps confirm a near set
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
 
 
-def test_every_node_a_post_statics_24():
+def test_lawson_hanson_giving_up_hands_its_reactions_to_the_dual_phase(every_node_16, monkeypatch):
+    """No time at all for Lawson–Hanson: it gives up at its first row; the projected Newton
+    phase starts from the reactions it reached and the answer is still Lemke's."""
+    sc, _, ref = every_node_16
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", 0.0)
+    res = solve(sc, options={**SPARSE, "trace": True})
+    ex = res.extras
+    assert res.status == pq.Status.OPTIMAL and ex["first_phase"] == "dual"
+    lh = [s for s in ex["trace"] if s["step"] == "lawson-hanson"]
+    assert len(lh) == 1 and lh[0]["gave_up"]
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+
+
+def test_dual_phase_from_lawson_hanson_reactions_reaches_the_same_answer(every_node_16):
+    """Lawson–Hanson stopped after 40 rows (its function gives None): the reactions it reached
+    are feasible; the projected Newton phase from them ends at a set from which the exact steps
+    give Lemke's answer, in fewer steps than from zero."""
+    from plateqp.assembly import build_model
+    from plateqp.backends.pdas.dense import first_set
+    from plateqp.backends.pdas.reduced import ReducedQP
+    from plateqp.contact.formulations import formulate
+    from plateqp.contact.scaling import Scaled
+
+    sc, _, ref = every_node_16
+    pb = ReducedQP(formulate(Scaled.from_model(build_model(sc)), "primal").qp, 10**6)
+    sigma = 1e-12
+    W = 1.0 / (pb.rho + 1.0 / (1e8 * pb.k))
+    kfac = pdas_factor.SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, "auto")
+    uf = pdas_sparse.held_plate(pb, kfac, sigma)
+    assert uf is not None
+    cols = pdas_sparse._Columns(pb, kfac, np.inf)
+    asked = []
+
+    def forty(j, force):
+        asked.append(j)
+        return cols(j, force) if len(asked) <= 40 else None
+
+    out: dict = {}
+    A, _ = first_set(forty, pb.g - pb.B @ uf, pb.c, 1e-11, 1e-12 * np.abs(pb.f).sum(), np.inf, out)
+    lam0 = out["lam"]
+    assert A is None and lam0.min() >= 0 and (lam0 > 0).sum() >= 20
+    steps = {}
+    for name, start in (("zero", None), ("lh", lam0)):
+        fac = pdas_factor.SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, "auto")
+        _, _, A, steps[name] = pdas_sparse.dual_newton(pb, fac, kfac, W, sigma, 1e-11, None, uf, start)
+        res = solve(sc, options={**SPARSE, "active": A})
+        assert res.status == pq.Status.OPTIMAL and res.iterations <= 4
+        np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+    assert steps["lh"] < steps["zero"], steps
+
+
+@pytest.mark.parametrize("stiffness", [1e7, 1e8])
+def test_stiff_elastic_posts_lawson_hanson_on_their_flexibility(stiffness, monkeypatch):
+    """Elastic posts stiffer than the plate under them (ρ k < 1): the rows of M carry the
+    posts' flexibility ρ on their diagonal; the first set is the final one (one exact step)
+    and the reactions are Lemke's on the condensed LCP."""
+    import dataclasses
+
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", NO_LH_LIMIT)
+    base = F.grid_rigid(16, "all")
+    sc = dataclasses.replace(base, supports=F._grid_supports(16, "all", stiffness, interior=True))
+    res = solve(sc, options=SPARSE)
+    ref = solve(sc, "lemke", "condensed", "high")
+    assert res.status == pq.Status.OPTIMAL and res.extras["first_phase"] == "lawson-hanson"
+    assert res.iterations - res.extras["first_phase_steps"] == 1
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+
+
+def test_every_node_a_post_statics_24(monkeypatch):
     """24²: 529 posts, walls on four sides; force and moment balance by hand, contact physics."""
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", NO_LH_LIMIT)
     sc = F.grid_rigid(24, "all")
     res = solve(sc, options=SPARSE)
-    assert res.status == pq.Status.OPTIMAL and res.kkt.ok and res.extras["first_phase"] == "dual"
+    assert res.status == pq.Status.OPTIMAL and res.kkt.ok and res.extras["first_phase"] == "lawson-hanson"
     Rw, xyw = wall_reactions(res)
     xy = support_xy(res)
     R = res.reactions
@@ -107,7 +198,7 @@ def test_monotone_steps_alone_reach_the_same_answer(every_node_16, monkeypatch):
     branch alone finds the set; the answer is Lemke's."""
     sc, _, ref = every_node_16
     monkeypatch.setattr(pdas_sparse, "DUAL_RISES", -1)
-    res = solve(sc, options={**SPARSE, "trace": True})
+    res = solve(sc, options={**SPARSE, "trace": True, "lh_start": False})
     assert res.status == pq.Status.OPTIMAL and res.extras["first_phase"] == "dual"
     alphas = [s["alpha"] for s in res.extras["trace"] if str(s["step"]).startswith("dual") and "alpha" in s]
     assert alphas and min(alphas) < 1.0  # the arc was searched back
@@ -117,13 +208,18 @@ def test_monotone_steps_alone_reach_the_same_answer(every_node_16, monkeypatch):
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * scale)
 
 
-def test_plain_pdas_without_the_dual_start_agrees(every_node_16):
+def test_plain_pdas_without_the_dual_start_agrees(every_node_16, monkeypatch):
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", NO_LH_LIMIT)
     sc, _, ref = every_node_16
-    res = solve(sc, options={**SPARSE, "dual_start": False})
+    res = solve(sc, options={**SPARSE, "dual_start": False, "lh_start": False})
     assert res.extras["first_phase"] == "none"
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
-    with pytest.raises(ProblemError, match="dual_start"):
-        solve(sc, options={**SPARSE, "dual_start": "yes"})
+    res = solve(sc, options={**SPARSE, "dual_start": False})  # Lawson–Hanson alone
+    assert res.extras["first_phase"] == "lawson-hanson"
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+    for key in ("dual_start", "lh_start"):
+        with pytest.raises(ProblemError, match=key):
+            solve(sc, options={**SPARSE, key: "yes"})
 
 
 def test_floating_plate_skips_the_dual_phase():

@@ -151,8 +151,8 @@ class DenseDual:
         return u, lam
 
 
-def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floor: float,
-              budget: float) -> tuple[np.ndarray | None, int]:
+def first_set(M, d: np.ndarray, c: np.ndarray, feas_tol: float, floor: float, budget: float,
+              out: dict | None = None) -> tuple[np.ndarray | None, int]:
     r"""A first active set for the dual LCP ``gap = d + Mλ ≥ 0, λ ≥ 0, λ·gap = 0`` (``M``
     symmetric positive definite): Lawson–Hanson's active-set method on ``min ½λᵀMλ + dᵀλ,
     λ ≥ 0`` (their NNLS algorithm with ``M`` for ``AᵀA``; Lawson & Hanson, *Solving Least
@@ -167,14 +167,22 @@ def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floo
     in contact it takes about as many cheap steps as there are contacts, where the block steps
     from ``d < 0`` take many dense Cholesky factorisations of large sets.
 
+    ``M`` is the matrix, or a function ``M(j, force)`` that gives its row ``j`` as it is
+    needed (``force``: every row's ``c_i gap_i`` at that moment, ``inf`` where free or barred,
+    for the function to choose which other rows to compute with it) or None once its own
+    budget is spent (:func:`.sparse.lawson_hanson`: only the rows freed are ever needed).
+
     Returns ``(A, steps)``: the free rows (the active set; the caller checks it) and the sets
-    solved; ``A`` is None when the work (3k² + 2mk + LH_OVERHEAD flops for a set of k rows) would
-    pass ``budget``, or when, after LH_PROBE rows, the rows freed plus the rows still pressed
-    (about the final size) would need more than it. A row whose pivot vanishes (its row of
-    ``M`` dependent on the free ones: two supports at one point) is never freed; the caller's
-    block steps see to it.
+    solved, and in ``out`` (a dict, if given) ``"lam"``, the set's reactions (also where the
+    function gave None: those of the set reached, a warm start). ``A`` is None
+    when the work (3k² + 2mk + LH_OVERHEAD flops for a set of k rows) would pass ``budget``, or
+    when, after LH_PROBE rows, the rows freed plus the rows still pressed (about the final size)
+    would need more than it (a matrix ``M``), or when the function gave None. A row whose pivot
+    vanishes (its row of ``M`` dependent on the free ones: two supports at one point) is never
+    freed; the caller's block steps see to it.
     """
     m = d.size
+    lazy = callable(M)
     gap = d.astype(float, copy=True)
     lam = np.zeros(m)
     free = np.zeros(m, dtype=bool)
@@ -192,20 +200,27 @@ def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floo
         force = np.where(free | barred, np.inf, c * gap)
         bad = force < -feas_tol * max(np.abs(lam).max(initial=0.0), floor, tiny)
         if not bad.any():
+            if out is not None:
+                out["lam"] = lam
             return free, steps
         j = int(np.argmin(force))
         k = F.size
         work += 3.0 * k * k + 2.0 * m * k + LH_OVERHEAD
         # past the probe, k + (rows still pressed) foretells the final size: each row freed
-        # then relieves about one other (measured on post grids and beds)
-        if work > budget or (k >= LH_PROBE and k + int(bad.sum()) > kmax):
+        # then relieves about one other (measured on post grids and beds; not on a post at
+        # every node, where each relieves many: the function's own budget rules there)
+        if not lazy and (work > budget or (k >= LH_PROBE and k + int(bad.sum()) > kmax)):
             return None, steps
         if k == cap:  # grow the buffers
             cap *= 2
             L2, R2, y2 = np.zeros((cap, cap)), np.zeros((cap, m)), np.zeros(cap)
             L2[:k, :k], R2[:k], y2[:k] = L[:k, :k], R[:k], y[:k]
             L, R, y = L2, R2, y2
-        row = M[j]
+        row = M(j, force) if lazy else M[j]
+        if row is None:
+            if out is not None:
+                out["lam"] = lam  # feasible, and the minimum of the dual QP on its face
+            return None, steps
         ell = sla.solve_triangular(L[:k, :k], row[F], lower=True, check_finite=False) if k else np.zeros(0)
         pivot = row[j] - ell @ ell
         if not pivot > 1e-12 * row[j]:
@@ -232,13 +247,16 @@ def first_set(M: np.ndarray, d: np.ndarray, c: np.ndarray, feas_tol: float, floo
                 barred[F[-1]] = True
             lam[F] = np.where(keep, new, 0.0)
             free[F[~keep]] = False
-            R[:int(keep.sum())] = R[:k][keep]
-            F = F[keep]
-            k = F.size
+            # the rows kept past the new end fill the holes (the order of F is free: L is made
+            # anew below); moving the kept rows down copied R whole (0.25 s at 128², every node)
+            k = int(keep.sum())
+            holes, fill = np.flatnonzero(~keep[:k]), k + np.flatnonzero(keep[k:])
+            R[holes], F[holes] = R[fill], F[fill]
+            F = F[:k].copy()
             work += k ** 3 / 3.0
             if k:
                 try:
-                    L[:k, :k] = np.linalg.cholesky(M[np.ix_(F, F)])
+                    L[:k, :k] = np.linalg.cholesky(R[:k][:, F])  # M_FF: the rows kept
                 except np.linalg.LinAlgError:  # M_FF singular to rounding: leave it to the block steps
                     return None, steps
                 y[:k] = sla.solve_triangular(L[:k, :k], -d[F], lower=True, check_finite=False)

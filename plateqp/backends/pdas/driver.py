@@ -89,7 +89,8 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     max_dense = _option(settings, "max_dense", lambda v: (isinstance(v, str) and v == "auto") or _is_int(v, 0),
                         "'auto' or an integer ≥ 0")
     max_rows = _option(settings, "max_rows", lambda v: _is_int(v, 1), "a positive integer")
-    _option(settings, "dual_start", lambda v: isinstance(v, (bool, np.bool_)), "True or False")
+    for key in ("dual_start", "lh_start"):
+        _option(settings, key, lambda v: isinstance(v, (bool, np.bool_)), "True or False")
     if not isinstance(trace, (bool, np.bool_)):
         raise ProblemError(f"option trace must be True or False, got {trace!r}")
 
@@ -123,10 +124,11 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k))
         fac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
         kfac = None
-        if settings["dual_start"] and A is None and not np.all(pb.rho * pb.k >= 1.0):
+        lh, dual = bool(settings["lh_start"]), bool(settings["dual_start"])
+        if (lh or dual) and A is None and not np.all(pb.rho * pb.k >= 1.0):
             kfac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
         info: dict = {}
-        out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac, info)
+        out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac, info, lh, dual)
         stats = dict(fac.stats, **info)
         if kfac is not None:  # the factor of K alone (phase 1's line search) counts too
             for key, val in kfac.stats.items():

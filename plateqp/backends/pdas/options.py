@@ -38,11 +38,14 @@ ACCURACY: dict[str, dict[str, float]] = {
 #:                else measured changed (other post grids, beds, 45² and 63² posts at 128²).
 #: ``max_rows``   refuse a ``G`` with more rows than ``min(n, max_rows)``.
 #: ``max_iter``   active sets solved before ``Status.MAX_ITER``; default 50 + 2 m.
-#: ``dual_start`` (sparse, stiff rows, cold start) find the active set first by projected Newton
-#:                on the dual energy (:func:`.sparse.dual_newton`); False: plain PDAS from the
-#:                two-sided problem (every row active).
+#: ``lh_start``   (sparse, stiff rows, held plate, cold start) find the active set first by
+#:                Lawson–Hanson's method with the flexibility's rows computed as it frees them
+#:                (:func:`.sparse.lawson_hanson`, within LH_TIME factorisations' time).
+#: ``dual_start`` (sparse, stiff rows, cold start) where that is off or gave up, find it by
+#:                projected Newton on the dual energy (:func:`.sparse.dual_newton`); with both
+#:                False: plain PDAS from the two-sided problem (every row active).
 SETTINGS: dict = {"method": "auto", "max_dense": "auto", "penalty": 1e8, "prox": 1e-12, "factor": "auto",
-                  "p": 6, "max_rows": 100_000, "max_iter": None, "dual_start": True}
+                  "p": 6, "max_rows": 100_000, "max_iter": None, "dual_start": True, "lh_start": True}
 
 #: ``max_dense="auto"``: ``max(lo, min(hi, per_root · √n))`` for ``n`` coupled dofs. The condensed
 #: method costs one contacts-last factorisation and about m³ dense flops (the trailing block and
@@ -110,6 +113,17 @@ DUAL_FLAT = 1e-7
 #: posts at 128² (1936 rows, 177 at the end): 48 block sets. Where most rows end in contact
 #: (stiff beds on a held plate: 193 of 529, 1091 of 1521), it gives up at the probe.
 LH_BUDGET, LH_OVERHEAD, LH_PROBE = 0.5, 5e4, 24
+#: (sparse, stiff rows, held plate, cold start) Lawson–Hanson's first set with the rows of M
+#: computed as they are freed (:func:`.sparse.lawson_hanson`): LH_BLOCK rows a block solve,
+#: while the method has taken at most LH_TIME factorisations' time (then the projected Newton
+#: phase, from the reactions reached). Measured at 128² (CPU): a post on every node, 16 129
+#: rows, 209 in contact at the end: 261 sets, 348 rows computed, 2.5–3 s in all (12–16
+#: factorisations; the projected Newton phase took 54 factorisations, 12.7 s in all); one block
+#: solve of 1, 4, 8, 16 right-hand sides cost 12, 5.8, 5.1, 3.8 ms a column, and 16 computed
+#: more rows never freed than 8 saved. Where most rows end in contact (stiff beds on a held
+#: plate: 864 of 1521) it gives up, and the projected Newton phase from its reactions took 4
+#: sets instead of 15 (0.19 s against 0.22 s in all at 40²).
+LH_BLOCK, LH_TIME = 8, 30.0
 #: (condensed) A trailing pivot L_ii², or the estimate of the trailing block's smallest
 #: eigenvalue (two inverse iterations), below this (K equilibrated to a unit diagonal) means K is
 #: singular to working precision (a floating plate): the sparse method takes over. Measured: a

@@ -5,6 +5,8 @@ docstring: "Two ways to solve a step", "Singular steps and no equilibrium")."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from ..base import Status
@@ -22,6 +24,8 @@ from .options import (
     FREE_WORK,
     INNER_EXACT,
     INNER_LOOSE,
+    LH_BLOCK,
+    LH_TIME,
     LOOSE_TOL,
     NEWTON_BUDGET,
     NEWTON_SETTLED,
@@ -32,6 +36,7 @@ from .options import (
     RAY_MESSAGE,
     SINGULAR_QUOTIENT,
 )
+from .dense import first_set
 from .factor import SpringFactor
 from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
 
@@ -189,8 +194,80 @@ def _dual_energy(pb: ReducedQP, uf: np.ndarray, lam: np.ndarray, u: np.ndarray) 
     return float(-0.5 * (pb.B.T @ lam) @ (uf + u) + 0.5 * lam @ (pb.rho * lam) + pb.g @ lam)
 
 
+def held_plate(pb: ReducedQP, kfac: SpringFactor, sigma: float) -> np.ndarray | None:
+    """``u_f = K⁻¹ f`` with ``kfac`` set to ``K`` alone, or None where ``K`` is (nearly)
+    singular: a floating plate, recognised by two inverse iterations (its softest mode's
+    Rayleigh quotient below DUAL_DEFINITE·σ). The stiff rows' first phases need a held plate."""
+    kfac.set(np.zeros(pb.m))
+    uf = kfac.solve(pb.f)
+    v = kfac.solve(pb.Kd * np.cos(np.arange(uf.size)))  # two inverse iterations: the softest mode of K
+    v = kfac.solve(pb.Kd * v)
+    if float(v @ (pb.K @ v)) < DUAL_DEFINITE * sigma * float(v @ (pb.Kd * v)):
+        return None
+    return uf
+
+
+class _Columns:
+    """The rows of the flexibility ``M = B K⁻¹ Bᵀ + diag(ρ)`` (symmetric: its columns) as
+    Lawson–Hanson's method asks for them (:func:`lawson_hanson`): row ``j`` by a solve with the
+    factor of ``K``, LH_BLOCK rows in one block solve (``j`` and the rows of most negative
+    force after it, kept until asked for: a block of 8 cost 5 ms a row against 12 ms for one
+    at 128²); None once the method has taken ``budget`` seconds since this was made (its own
+    steps included: on small plates they cost more than the solves)."""
+
+    def __init__(self, pb: ReducedQP, kfac: SpringFactor, budget: float) -> None:
+        self.pb, self.kfac, self.budget = pb, kfac, budget
+        self.BT = pb.B.T.tocsc()
+        self.kept: dict[int, np.ndarray] = {}
+        self.start = time.perf_counter()
+        self.spent = 0.0  # in the block solves
+        self.columns = 0
+
+    def __call__(self, j: int, force: np.ndarray) -> np.ndarray | None:
+        t0 = time.perf_counter()
+        if t0 - self.start > self.budget:
+            return None
+        row = self.kept.pop(j, None)
+        if row is not None:
+            return row
+        pressed = np.flatnonzero(force < 0)
+        nxt = pressed[np.argsort(force[pressed], kind="stable")[:2 * LH_BLOCK]]
+        rows = [j] + [i for i in nxt.tolist() if i != j and i not in self.kept][:LH_BLOCK - 1]
+        Wt = np.ascontiguousarray((self.pb.B @ self.kfac.solve(self.BT[:, rows].toarray())).T)
+        Wt[np.arange(len(rows)), rows] += self.pb.rho[rows]
+        for q, i in enumerate(rows[1:], 1):
+            self.kept[i] = Wt[q]
+        self.columns += len(rows)
+        self.spent += time.perf_counter() - t0
+        return Wt[0]
+
+
+def lawson_hanson(pb: ReducedQP, kfac: SpringFactor, uf: np.ndarray, feas_tol: float, steps,
+                  info: dict) -> tuple | None:
+    """Phase 1 of the sparse method for stiff rows on a held plate: Lawson–Hanson's first set
+    (:func:`.dense.first_set`) with the rows of the flexibility ``M`` computed as the method
+    frees them (:class:`_Columns`), never all of ``M``: where few of many rows end in contact
+    (a post at every node: 209 of 16 129 at 128²) that is about as many solves as contacts.
+    Its time is held to LH_TIME factorisations of ``K`` (measured as it goes); past that it
+    gives up and returns ``(None, λ)``, the reactions of the set it reached (the projected
+    Newton phase starts from them). Returns ``(u, λ, A, steps)``. ``info`` receives
+    ``lh_columns`` (rows of ``M`` computed) and ``lh_s`` (their solves' time)."""
+    cols = _Columns(pb, kfac, LH_TIME * kfac.t_factor)
+    d = pb.g - pb.B @ uf
+    out: dict = {}
+    A, n = first_set(cols, d, pb.c, feas_tol, 1e-12 * np.abs(pb.f).sum(), np.inf, out)
+    info.update(lh_columns=cols.columns, lh_s=cols.spent)
+    if steps is not None:
+        steps.append({"step": "lawson-hanson", "active": None if A is None else int(A.sum()), "sets": n,
+                      "columns": cols.columns, "gave_up": A is None})
+    if A is None:
+        return None, out.get("lam")
+    lam = out["lam"]
+    return kfac.solve(pb.f - pb.B.T @ lam), lam, A, n
+
+
 def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndarray, sigma: float,
-                feas_tol: float, steps) -> tuple | None:
+                feas_tol: float, steps, uf: np.ndarray, lam0: np.ndarray | None = None) -> tuple | None:
     """Phase 1 of the sparse method for stiff rows on a held plate: projected Newton on the
     dual energy ``ψ(λ) = ½λᵀMλ + dᵀλ`` over ``λ ≥ 0`` (Bertsekas 1982), ``M`` never formed.
 
@@ -207,20 +284,19 @@ def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndar
     Murty's one-row-per-step way out. It ends when a step clips nothing and no zero row has
     a negative gap (the exact steps then confirm the set), or after :data:`DUAL_STEPS` steps.
 
-    Returns ``(u, λ, A, steps)``, or None where it does not apply: ``K`` singular (a floating
-    plate, recognised by inverse iteration as in the exact steps) or a step that the active
-    rows do not hold.
+    ``uf = K⁻¹ f`` (:func:`held_plate`: the plate is held); ``lam0``: reactions ``≥ 0`` to
+    start from instead of 0 (where Lawson–Hanson gave up). Returns ``(u, λ, A, steps)``, or
+    None where a step's active rows do not hold the plate.
     """
     B, g, rho, f = pb.B, pb.g, pb.rho, pb.f
-    kfac.set(np.zeros(pb.m))
-    uf = kfac.solve(f)
-    v = kfac.solve(pb.Kd * np.cos(np.arange(uf.size)))  # two inverse iterations: the softest mode of K
-    v = kfac.solve(pb.Kd * v)
-    if float(v @ (pb.K @ v)) < DUAL_DEFINITE * sigma * float(v @ (pb.Kd * v)):
-        return None  # K (nearly) singular: a floating plate, left to the exact steps
-    lam = np.zeros(pb.m)
-    u = uf.copy()
-    psi = 0.0  # ψ(0)
+    if lam0 is None or not np.any(lam0 > 0):
+        lam = np.zeros(pb.m)
+        u = uf.copy()
+        psi = 0.0  # ψ(0)
+    else:
+        lam = lam0.copy()
+        u = kfac.solve(f - B.T @ lam)
+        psi = _dual_energy(pb, uf, lam, u)
     best = (psi, lam, u)  # the lowest ψ met so far, and where
     rises = 0  # full steps that raised ψ
     flat = 0  # steps in a row that left ψ as it was
@@ -273,11 +349,13 @@ def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndar
 
 
 def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter, p, steps,
-               kfac: SpringFactor | None = None, info: dict | None = None) -> Outcome:
+               kfac: SpringFactor | None = None, info: dict | None = None, lh: bool = True,
+               dual: bool = True) -> Outcome:
     """The sparse method: a first phase where it applies (soft rows: :func:`newton_pcg`; stiff
-    rows with ``kfac``, a factor for ``K`` alone: :func:`dual_newton`), then exact steps.
-    ``info`` (a dict) receives ``first_phase`` ("newton", "dual" or "none") and
-    ``first_phase_steps``."""
+    rows on a held plate with ``kfac``, a factor for ``K`` alone: :func:`lawson_hanson` if
+    ``lh``, then, where it gave up, :func:`dual_newton` if ``dual``), then exact steps. ``info``
+    (a dict) receives ``first_phase`` ("newton", "lawson-hanson", "dual" or "none"),
+    ``first_phase_steps`` and, where Lawson–Hanson ran, ``lh_columns`` and ``lh_s``."""
     info = {} if info is None else info
     info.update(first_phase="none", first_phase_steps=0)
     ex = Exchange(p)
@@ -290,12 +368,21 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         lam = np.where(A, W * (pb.B @ u - pb.g), 0.0)
         exact = True
         info.update(first_phase="newton", first_phase_steps=newton)
-    elif A is None and kfac is not None:  # stiff rows, cold start: phase 1 on the dual energy
-        first = dual_newton(pb, fac, kfac, W, sigma, feas_tol, steps)
+    elif A is None and kfac is not None:  # stiff rows, cold start: a first phase on the dual
+        uf = held_plate(pb, kfac, sigma)  # None: a floating plate, left to the exact steps
+        first = lam0 = None
+        if uf is not None and lh:
+            first = lawson_hanson(pb, kfac, uf, feas_tol, steps, info)
+            phase = "lawson-hanson"
+            if first[0] is None:  # gave up: its reactions start the projected Newton phase
+                first, lam0 = None, first[1]
+        if first is None and uf is not None and dual:
+            first = dual_newton(pb, fac, kfac, W, sigma, feas_tol, steps, uf, lam0)
+            phase = "dual"
         if first is not None:
             u, lam, A, newton = first
             exact = True
-            info.update(first_phase="dual", first_phase_steps=newton)
+            info.update(first_phase=phase, first_phase_steps=newton)
     elif A is not None:
         exact = True  # a warm start is meant to be (nearly) right: solve it exactly at once
     A = np.ones(pb.m, dtype=bool) if A is None else A.copy()
