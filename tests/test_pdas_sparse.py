@@ -118,7 +118,7 @@ def test_lawson_hanson_giving_up_hands_its_reactions_to_the_dual_phase(every_nod
     ex = res.extras
     assert res.status == pq.Status.OPTIMAL and ex["first_phase"] == "dual"
     lh = [s for s in ex["trace"] if s["step"] == "lawson-hanson"]
-    assert len(lh) == 1 and lh[0]["gave_up"]
+    assert len(lh) == 1 and lh[0]["gave_up"] == "time" and ex["lh_gave_up"] == "time"
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
 
 
@@ -174,6 +174,25 @@ def test_stiff_elastic_posts_lawson_hanson_on_their_flexibility(stiffness, monke
     ref = solve(sc, "lemke", "condensed", "high")
     assert res.status == pq.Status.OPTIMAL and res.extras["first_phase"] == "lawson-hanson"
     assert res.iterations - res.extras["first_phase_steps"] == 1
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+
+
+def test_lawson_hanson_gives_up_on_a_broad_contact(monkeypatch):
+    """A stiff bed on a simply supported plate, 287 of 361 springs in contact at the end: with
+    LH_PROBE rows freed most rows are still pressed, so Lawson–Hanson (one row a step) gives up
+    there, having computed one row a solve; the projected Newton phase finishes, and the
+    reactions are Lemke's."""
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", NO_LH_LIMIT)
+    walls = {e: "simple" for e in ("left", "right", "bottom", "top")}
+    sc = pq.Scene(name="stiff bed", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(20, 20, "acm"),
+                  edges=walls, loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
+                  foundation=pq.Foundation(1e9, gap={"profile": "linear", "g0": -1e-6, "gx": 1e-5, "gy": 0.5e-5}))
+    res = solve(sc, options=SPARSE)
+    ref = solve(sc, "lemke", "condensed", "high")
+    ex = res.extras
+    assert res.status == pq.Status.OPTIMAL and ex["first_phase"] == "dual" and ex["lh_gave_up"] == "pressed"
+    assert ex["lh_columns"] == pdas_sparse.LH_PROBE
+    assert res.active.sum() > 0.5 * res.active.size
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
 
 

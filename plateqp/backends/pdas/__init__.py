@@ -148,9 +148,10 @@ frees computed as it frees them, by solves with a factor of ``K`` alone
 pressed hardest after it): where few of many rows end in contact that is about as many
 solves as contacts, never all of ``M`` (a post on every node of a 128 × 128 slab: 261 sets,
 348 of 16 129 rows computed, 209 in contact; the exact steps then confirm the set in one
-step). Its time is held to ``LH_TIME`` factorisations (measured as it goes); where most rows
-end in contact it gives up there and hands the reactions it reached, feasible, to projected
-Newton on the dual energy ``ψ(λ) = ½λᵀMλ + dᵀλ`` over ``λ ≥ 0`` (Bertsekas 1982; :func:`.sparse.dual_newton`),
+step). Its time is held to ``LH_TIME`` factorisations (measured as it goes), and where most
+rows stay pressed after ``LH_PROBE`` rows freed (a broad contact, as on a stiff bed: one row a
+step would take hundreds of steps) it stops there; either way it hands the reactions it
+reached, feasible, to projected Newton on the dual energy ``ψ(λ) = ½λᵀMλ + dᵀλ`` over ``λ ≥ 0`` (Bertsekas 1982; :func:`.sparse.dual_newton`),
 ``M`` never formed: from ``λ = 0`` (or those reactions) each step solves the active set ``F = {λ > 0} ∪ {gap ≤ 0}``
 (the Newton step of ``ψ`` on that face) and clips its negative reactions to zero; ``ψ`` and
 the gaps at a clipped point take one solve with a second factor, of ``K`` alone. Full steps
@@ -162,7 +163,8 @@ all; from Lawson–Hanson's reactions on a stiff bed at 40², 4 steps instead of
 plain PDAS); options ``lh_start=False`` and ``dual_start=False`` turn them off.
 ``extras["first_phase"]`` says which first phase ran ("newton", "lawson-hanson", "dual" or
 "none"), ``extras["first_phase_steps"]`` its steps, and ``extras["lh_columns"]``,
-``extras["lh_s"]`` the rows of ``M`` Lawson–Hanson computed and their solves' time.
+``extras["lh_s"]`` the rows of ``M`` Lawson–Hanson computed and their solves' time
+(``extras["lh_gave_up"]``: "time" or "pressed", where it gave up).
 
 Singular steps and no equilibrium (sparse method)
 -------------------------------------------------

@@ -121,9 +121,11 @@ LH_BUDGET, LH_OVERHEAD, LH_PROBE = 0.5, 5e4, 24
 #: factorisations; the projected Newton phase took 54 factorisations, 12.7 s in all); one block
 #: solve of 1, 4, 8, 16 right-hand sides cost 12, 5.8, 5.1, 3.8 ms a column, and 16 computed
 #: more rows never freed than 8 saved. Where most rows end in contact (stiff beds on a held
-#: plate: 864 of 1521) it gives up, and the projected Newton phase from its reactions took 4
-#: sets instead of 15 (0.19 s against 0.22 s in all at 40²).
-LH_BLOCK, LH_TIME = 8, 30.0
+#: plate: 864 of 1521 at 40², 5272 of 9025 at 96²) it would take one step a row (387 s at 96²):
+#: it gives up when, LH_PROBE rows freed, more than LH_PRESSED of all rows are still pressed
+#: (post grids and a post on every node: 10–15 %; those beds: 82 %, 87 %), and the projected
+#: Newton phase starts from its reactions.
+LH_BLOCK, LH_TIME, LH_PRESSED = 8, 30.0, 0.5
 #: (condensed) A trailing pivot L_ii², or the estimate of the trailing block's smallest
 #: eigenvalue (two inverse iterations), below this (K equilibrated to a unit diagonal) means K is
 #: singular to working precision (a floating plate): the sparse method takes over. Measured: a

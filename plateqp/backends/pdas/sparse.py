@@ -25,6 +25,8 @@ from .options import (
     INNER_EXACT,
     INNER_LOOSE,
     LH_BLOCK,
+    LH_PRESSED,
+    LH_PROBE,
     LH_TIME,
     LOOSE_TOL,
     NEWTON_BUDGET,
@@ -212,8 +214,11 @@ class _Columns:
     Lawson–Hanson's method asks for them (:func:`lawson_hanson`): row ``j`` by a solve with the
     factor of ``K``, LH_BLOCK rows in one block solve (``j`` and the rows of most negative
     force after it, kept until asked for: a block of 8 cost 5 ms a row against 12 ms for one
-    at 128²); None once the method has taken ``budget`` seconds since this was made (its own
-    steps included: on small plates they cost more than the solves)."""
+    at 128²; one row a solve while more than LH_PRESSED of the rows are pressed); None once the method has taken ``budget`` seconds since this was made (its own
+    steps included: on small plates they cost more than the solves), or when, asked for its
+    LH_PROBE + 1-th row, more than LH_PRESSED of all rows are still pressed (a broad contact,
+    as on a stiff bed: most rows will end in contact, one row a step is the wrong tool).
+    ``why`` says which."""
 
     def __init__(self, pb: ReducedQP, kfac: SpringFactor, budget: float) -> None:
         self.pb, self.kfac, self.budget = pb, kfac, budget
@@ -221,18 +226,28 @@ class _Columns:
         self.kept: dict[int, np.ndarray] = {}
         self.start = time.perf_counter()
         self.spent = 0.0  # in the block solves
-        self.columns = 0
+        self.columns = self.asked = 0
+        self.why = None
 
     def __call__(self, j: int, force: np.ndarray) -> np.ndarray | None:
         t0 = time.perf_counter()
+        self.asked += 1
         if t0 - self.start > self.budget:
+            self.why = "time"
+            return None
+        pressed = np.flatnonzero(force < 0)
+        broad = pressed.size > LH_PRESSED * force.size
+        if self.asked == LH_PROBE + 1 and broad:
+            self.why = "pressed"
             return None
         row = self.kept.pop(j, None)
         if row is not None:
             return row
-        pressed = np.flatnonzero(force < 0)
-        nxt = pressed[np.argsort(force[pressed], kind="stable")[:2 * LH_BLOCK]]
-        rows = [j] + [i for i in nxt.tolist() if i != j and i not in self.kept][:LH_BLOCK - 1]
+        # rows ahead only where few rows are pressed: while most are (a stiff bed; a post grid's
+        # first rows) each row freed relieves the rows pressed next to it, and they are not asked for
+        block = 1 if broad else LH_BLOCK
+        nxt = pressed[np.argsort(force[pressed], kind="stable")[:2 * block]]
+        rows = [j] + [i for i in nxt.tolist() if i != j and i not in self.kept][:block - 1]
         Wt = np.ascontiguousarray((self.pb.B @ self.kfac.solve(self.BT[:, rows].toarray())).T)
         Wt[np.arange(len(rows)), rows] += self.pb.rho[rows]
         for q, i in enumerate(rows[1:], 1):
@@ -248,18 +263,22 @@ def lawson_hanson(pb: ReducedQP, kfac: SpringFactor, uf: np.ndarray, feas_tol: f
     (:func:`.dense.first_set`) with the rows of the flexibility ``M`` computed as the method
     frees them (:class:`_Columns`), never all of ``M``: where few of many rows end in contact
     (a post at every node: 209 of 16 129 at 128²) that is about as many solves as contacts.
-    Its time is held to LH_TIME factorisations of ``K`` (measured as it goes); past that it
-    gives up and returns ``(None, λ)``, the reactions of the set it reached (the projected
-    Newton phase starts from them). Returns ``(u, λ, A, steps)``. ``info`` receives
-    ``lh_columns`` (rows of ``M`` computed) and ``lh_s`` (their solves' time)."""
+    Its time is held to LH_TIME factorisations of ``K`` (measured as it goes), and it stops
+    early where most rows stay pressed (:class:`_Columns`); then it gives up and returns
+    ``(None, λ)``, the reactions of the set it reached (the projected Newton phase starts from
+    them). Returns ``(u, λ, A, steps)``. ``info`` receives ``lh_columns`` (rows of ``M``
+    computed), ``lh_s`` (their solves' time) and, where it gave up, ``lh_gave_up`` ("time" or
+    "pressed")."""
     cols = _Columns(pb, kfac, LH_TIME * kfac.t_factor)
     d = pb.g - pb.B @ uf
     out: dict = {}
     A, n = first_set(cols, d, pb.c, feas_tol, 1e-12 * np.abs(pb.f).sum(), np.inf, out)
     info.update(lh_columns=cols.columns, lh_s=cols.spent)
+    if A is None:
+        info["lh_gave_up"] = cols.why
     if steps is not None:
         steps.append({"step": "lawson-hanson", "active": None if A is None else int(A.sum()), "sets": n,
-                      "columns": cols.columns, "gave_up": A is None})
+                      "columns": cols.columns, "gave_up": cols.why})
     if A is None:
         return None, out.get("lam")
     lam = out["lam"]
