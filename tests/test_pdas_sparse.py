@@ -122,6 +122,20 @@ def test_lawson_hanson_giving_up_hands_its_reactions_to_the_dual_phase(every_nod
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
 
 
+def test_lawson_hanson_keeps_its_rows_within_memory(every_node_16, monkeypatch):
+    """The rows of M it would keep may take LH_MEMORY bytes per dof: with 16 rows' worth allowed
+    it gives up before the 9th row (its buffer doubles) and projected Newton finishes."""
+    sc, _, ref = every_node_16
+    m, n = ref.active.size, len(ref.model.free)
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", NO_LH_LIMIT)
+    monkeypatch.setattr(pdas_sparse, "LH_MEMORY", 16 * m * 8 / n)
+    res = solve(sc, options=SPARSE)
+    ex = res.extras
+    assert res.status == pq.Status.OPTIMAL and ex["first_phase"] == "dual" and ex["lh_gave_up"] == "memory"
+    assert ex["lh_columns"] <= 8 * pdas_sparse.LH_BLOCK
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())
+
+
 def test_dual_phase_from_lawson_hanson_reactions_reaches_the_same_answer(every_node_16):
     """Lawson–Hanson stopped after 40 rows (its function gives None): the reactions it reached
     are feasible; the projected Newton phase from them ends at a set from which the exact steps

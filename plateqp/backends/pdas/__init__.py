@@ -164,7 +164,8 @@ plain PDAS); options ``lh_start=False`` and ``dual_start=False`` turn them off.
 ``extras["first_phase"]`` says which first phase ran ("newton", "lawson-hanson", "dual" or
 "none"), ``extras["first_phase_steps"]`` its steps, and ``extras["lh_columns"]``,
 ``extras["lh_s"]`` the rows of ``M`` Lawson–Hanson computed and their solves' time
-(``extras["lh_gave_up"]``: "time" or "pressed", where it gave up).
+(``extras["lh_gave_up"]``: "time", "pressed" or "memory", where it gave up: the rows it keeps
+may take ``LH_MEMORY`` bytes per dof).
 
 Singular steps and no equilibrium (sparse method)
 -------------------------------------------------

@@ -125,7 +125,11 @@ LH_BUDGET, LH_OVERHEAD, LH_PROBE = 0.5, 5e4, 24
 #: it gives up when, LH_PROBE rows freed, more than LH_PRESSED of all rows are still pressed
 #: (post grids and a post on every node: 10–15 %; those beds: 82 %, 87 %), and the projected
 #: Newton phase starts from its reactions.
-LH_BLOCK, LH_TIME, LH_PRESSED = 8, 30.0, 0.5
+#: The rows of M it keeps (m doubles each, in a buffer that doubles) may take at most LH_MEMORY
+#: bytes per dof of the plate, a quarter of what plateqp plans for a whole solve
+#: (:data:`plateqp.assembly.BYTES_PER_DOF`): a post on every node needs 33 MB at 128², 416 MB at
+#: 256² (389 rows in contact, 590 MB allowed); at 512² it would give up.
+LH_BLOCK, LH_TIME, LH_PRESSED, LH_MEMORY = 8, 30.0, 0.5, 3000
 #: (condensed) A trailing pivot L_ii², or the estimate of the trailing block's smallest
 #: eigenvalue (two inverse iterations), below this (K equilibrated to a unit diagonal) means K is
 #: singular to working precision (a floating plate): the sparse method takes over. Measured: a

@@ -25,6 +25,7 @@ from .options import (
     INNER_EXACT,
     INNER_LOOSE,
     LH_BLOCK,
+    LH_MEMORY,
     LH_PRESSED,
     LH_PROBE,
     LH_TIME,
@@ -217,8 +218,9 @@ class _Columns:
     at 128²; one row a solve while more than LH_PRESSED of the rows are pressed); None once the method has taken ``budget`` seconds since this was made (its own
     steps included: on small plates they cost more than the solves), or when, asked for its
     LH_PROBE + 1-th row, more than LH_PRESSED of all rows are still pressed (a broad contact,
-    as on a stiff bed: most rows will end in contact, one row a step is the wrong tool).
-    ``why`` says which."""
+    as on a stiff bed: most rows will end in contact, one row a step is the wrong tool), or
+    when the rows of M kept (m doubles each, in a buffer that doubles) would pass LH_MEMORY
+    bytes per dof of the plate. ``why`` says which."""
 
     def __init__(self, pb: ReducedQP, kfac: SpringFactor, budget: float) -> None:
         self.pb, self.kfac, self.budget = pb, kfac, budget
@@ -234,6 +236,10 @@ class _Columns:
         self.asked += 1
         if t0 - self.start > self.budget:
             self.why = "time"
+            return None
+        m, n = force.size, self.pb.K.shape[0]
+        if 2 * self.asked * m * 8 > LH_MEMORY * n:  # first_set's rows, in a buffer that doubles
+            self.why = "memory"
             return None
         pressed = np.flatnonzero(force < 0)
         broad = pressed.size > LH_PRESSED * force.size
@@ -267,8 +273,8 @@ def lawson_hanson(pb: ReducedQP, kfac: SpringFactor, uf: np.ndarray, feas_tol: f
     early where most rows stay pressed (:class:`_Columns`); then it gives up and returns
     ``(None, λ)``, the reactions of the set it reached (the projected Newton phase starts from
     them). Returns ``(u, λ, A, steps)``. ``info`` receives ``lh_columns`` (rows of ``M``
-    computed), ``lh_s`` (their solves' time) and, where it gave up, ``lh_gave_up`` ("time" or
-    "pressed")."""
+    computed), ``lh_s`` (their solves' time) and, where it gave up, ``lh_gave_up`` ("time",
+    "pressed" or "memory")."""
     cols = _Columns(pb, kfac, LH_TIME * kfac.t_factor)
     d = pb.g - pb.B @ uf
     out: dict = {}
