@@ -139,33 +139,33 @@ When a Newton step changes few rows (``NEWTON_SETTLED``), the factor is rebuilt 
 active set and exact steps finish as above. On the 128 × 128 bed: three Newton steps, 13 PCG
 iterations, then one exact step and two rows exchanged (a Woodbury correction).
 
-Stiff rows (rigid posts) on a held plate, cold start: plain PDAS from the two-sided start
-cycles and falls back to Murty's one row per step (a 64 × 64 slab with 45 × 45 posts: 407
-steps, each a refactorisation). So a first phase finds the contact. First Lawson–Hanson's
-method as in the condensed method (:func:`.dense.first_set`), but with the rows of ``M`` it
-frees computed as it frees them, by solves with a factor of ``K`` alone
-(:func:`.sparse.lawson_hanson`; eight rows in one block solve, the freed row and the rows
-pressed hardest after it): where few of many rows end in contact that is about as many
-solves as contacts, never all of ``M`` (a post on every node of a 128 × 128 slab: 261 sets,
-348 of 16 129 rows computed, 209 in contact; the exact steps then confirm the set in one
-step). Its time is held to ``LH_TIME`` factorisations (measured as it goes), and where most
-rows stay pressed after ``LH_PROBE`` rows freed (a broad contact, as on a stiff bed: one row a
-step would take hundreds of steps) it stops there; either way it hands the reactions it
-reached, feasible, to projected Newton on the dual energy ``ψ(λ) = ½λᵀMλ + dᵀλ`` over ``λ ≥ 0`` (Bertsekas 1982; :func:`.sparse.dual_newton`),
-``M`` never formed: from ``λ = 0`` (or those reactions) each step solves the active set ``F = {λ > 0} ∪ {gap ≤ 0}``
-(the Newton step of ``ψ`` on that face) and clips its negative reactions to zero; ``ψ`` and
-the gaps at a clipped point take one solve with a second factor, of ``K`` alone. Full steps
-are taken until ``DUAL_RISES`` of them have raised ``ψ``; then monotone steps (the arc
-searched back to Armijo's decrease) from the lowest point met. It hands its set to the exact
-steps when a step leaves few rows infeasible or ``ψ`` stops moving (same slab: 21 steps in
-all; from Lawson–Hanson's reactions on a stiff bed at 40², 4 steps instead of 15). Both need
-``K`` definite (two inverse iterations tell, :func:`.sparse.held_plate`; a floating plate keeps
-plain PDAS); options ``lh_start=False`` and ``dual_start=False`` turn them off.
+Stiff rows (rigid posts) on a held plate, cold start: plain PDAS from the two-sided start cycles
+and falls back to Murty's one row per step (a 64 × 64 slab with 45 × 45 posts: 407 steps, each a
+refactorisation). So a first phase finds the contact. First Lawson–Hanson's method as in the
+condensed method (:func:`.dense.first_set`), but with the rows of ``M`` it frees computed as it
+frees them, by solves with a factor of ``K`` alone (:func:`.sparse.lawson_hanson`; eight rows in
+one block solve, the freed row and the rows pressed hardest after it): where few of many rows
+end in contact that is about as many solves as contacts, never all of ``M`` (a post on every
+node of a 128 × 128 slab: 261 sets, 348 of 16 129 rows computed, 209 in contact; the exact steps
+then confirm the set in one step). Its time is held to ``LH_TIME`` factorisations (measured as
+it goes), and where most rows stay pressed after ``LH_PROBE`` rows freed (a broad contact, as on
+a stiff bed: one row a step would take hundreds of steps) it stops there; either way it hands
+the reactions it reached, feasible, to projected Newton on the dual energy
+``ψ(λ) = ½λᵀMλ + dᵀλ`` over ``λ ≥ 0`` (Bertsekas 1982; :func:`.sparse.dual_newton`), ``M`` never
+formed: from ``λ = 0`` (or those reactions) each step solves the active set
+``F = {λ > 0} ∪ {gap ≤ 0}`` (the Newton step of ``ψ`` on that face) and clips its negative
+reactions to zero; ``ψ`` and the gaps at a clipped point take one solve with a second factor, of
+``K`` alone. Full steps are taken until ``DUAL_RISES`` of them have raised ``ψ``; then monotone
+steps (the arc searched back to Armijo's decrease) from the lowest point met. It hands its set
+to the exact steps when a step leaves few rows infeasible or ``ψ`` stops moving (same slab: 21
+steps in all; from Lawson–Hanson's reactions on a stiff bed at 40², 4 steps instead of 15). Both
+need ``K`` definite (two inverse iterations tell, :func:`.sparse.held_plate`; a floating plate
+keeps plain PDAS); options ``lh_start=False`` and ``dual_start=False`` turn them off.
 ``extras["first_phase"]`` says which first phase ran ("newton", "lawson-hanson", "dual" or
-"none"), ``extras["first_phase_steps"]`` its steps, and ``extras["lh_columns"]``,
-``extras["lh_s"]`` the rows of ``M`` Lawson–Hanson computed and their solves' time
-(``extras["lh_gave_up"]``: "time", "pressed" or "memory", where it gave up: the rows it keeps
-may take ``LH_MEMORY`` bytes per dof).
+"none"), ``extras["first_phase_steps"]`` its steps, and ``extras["lh_sets"]``,
+``extras["lh_columns"]``, ``extras["lh_s"]`` the sets Lawson–Hanson solved, the rows of ``M`` it
+computed and their solves' time (``extras["lh_gave_up"]``: "time", "pressed" or "memory", where
+it gave up: the rows it keeps may take ``LH_MEMORY`` bytes per dof).
 
 Singular steps and no equilibrium (sparse method)
 -------------------------------------------------
@@ -196,7 +196,7 @@ first phase applies); ``extras["active"]`` holds the final set,
 so a sweep can warm start each solve from the previous one. ``x`` (``u`` with the eliminated
 variables restored), ``z = λ ≥ 0`` (one per row of ``G``, the qpsolvers sign convention),
 ``iterations`` (active sets solved, the steps of the first phase and Lawson–Hanson's
-included: ``extras["first_set_steps"]``, even where it gave up),
+included: ``extras["first_set_steps"]``, ``extras["lh_sets"]``, even where it gave up),
 ``solve_time``; ``extras`` has the method and the counts and times of the linear algebra
 (``extras["trace"]`` each step, with option ``trace``).
 

@@ -215,12 +215,14 @@ class _Columns:
     Lawson–Hanson's method asks for them (:func:`lawson_hanson`): row ``j`` by a solve with the
     factor of ``K``, LH_BLOCK rows in one block solve (``j`` and the rows of most negative
     force after it, kept until asked for: a block of 8 cost 5 ms a row against 12 ms for one
-    at 128²; one row a solve while more than LH_PRESSED of the rows are pressed); None once the method has taken ``budget`` seconds since this was made (its own
-    steps included: on small plates they cost more than the solves), or when, asked for its
-    LH_PROBE + 1-th row, more than LH_PRESSED of all rows are still pressed (a broad contact,
-    as on a stiff bed: most rows will end in contact, one row a step is the wrong tool), or
-    when the rows of M kept (m doubles each, in a buffer that doubles) would pass LH_MEMORY
-    bytes per dof of the plate. ``why`` says which."""
+    at 128²), one row a solve while more than LH_PRESSED of the rows are pressed.
+
+    None (and ``why`` says which) once the method has taken ``budget`` seconds since this was
+    made (its own steps included: on small plates they cost more than the solves); when,
+    asked for its LH_PROBE + 1-th row, more than LH_PRESSED of all rows are still pressed (a
+    broad contact, as on a stiff bed: most rows will end in contact, and one row a step is the
+    wrong tool); or when the rows of M held (m doubles each: first_set's, in a buffer that
+    doubles, and those computed ahead) would pass LH_MEMORY bytes per dof of the plate."""
 
     def __init__(self, pb: ReducedQP, kfac: SpringFactor, budget: float) -> None:
         self.pb, self.kfac, self.budget = pb, kfac, budget
@@ -238,7 +240,7 @@ class _Columns:
             self.why = "time"
             return None
         m, n = force.size, self.pb.K.shape[0]
-        if 2 * self.asked * m * 8 > LH_MEMORY * n:  # first_set's rows, in a buffer that doubles
+        if (2 * self.asked + len(self.kept)) * m * 8 > LH_MEMORY * n:
             self.why = "memory"
             return None
         pressed = np.flatnonzero(force < 0)
@@ -264,29 +266,29 @@ class _Columns:
 
 
 def lawson_hanson(pb: ReducedQP, kfac: SpringFactor, uf: np.ndarray, feas_tol: float, steps,
-                  info: dict) -> tuple | None:
+                  info: dict) -> tuple:
     """Phase 1 of the sparse method for stiff rows on a held plate: Lawson–Hanson's first set
     (:func:`.dense.first_set`) with the rows of the flexibility ``M`` computed as the method
     frees them (:class:`_Columns`), never all of ``M``: where few of many rows end in contact
     (a post at every node: 209 of 16 129 at 128²) that is about as many solves as contacts.
     Its time is held to LH_TIME factorisations of ``K`` (measured as it goes), and it stops
-    early where most rows stay pressed (:class:`_Columns`); then it gives up and returns
-    ``(None, λ)``, the reactions of the set it reached (the projected Newton phase starts from
-    them). Returns ``(u, λ, A, steps)``. ``info`` receives ``lh_columns`` (rows of ``M``
+    early where most rows stay pressed (:class:`_Columns`). Returns ``(u, λ, A, steps)``, or
+    where it gave up ``(None, λ, None, steps)``, ``λ`` the reactions of the set it reached (the
+    projected Newton phase starts from them). ``info`` receives ``lh_sets``, ``lh_columns`` (rows of ``M``
     computed), ``lh_s`` (their solves' time) and, where it gave up, ``lh_gave_up`` ("time",
     "pressed" or "memory")."""
     cols = _Columns(pb, kfac, LH_TIME * kfac.t_factor)
     d = pb.g - pb.B @ uf
     out: dict = {}
     A, n = first_set(cols, d, pb.c, feas_tol, 1e-12 * np.abs(pb.f).sum(), np.inf, out)
-    info.update(lh_columns=cols.columns, lh_s=cols.spent)
+    info.update(lh_sets=n, lh_columns=cols.columns, lh_s=cols.spent)
     if A is None:
         info["lh_gave_up"] = cols.why
     if steps is not None:
         steps.append({"step": "lawson-hanson", "active": None if A is None else int(A.sum()), "sets": n,
                       "columns": cols.columns, "gave_up": cols.why})
     if A is None:
-        return None, out.get("lam")
+        return None, out.get("lam"), None, n
     lam = out["lam"]
     return kfac.solve(pb.f - pb.B.T @ lam), lam, A, n
 
@@ -380,7 +382,7 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
     rows on a held plate with ``kfac``, a factor for ``K`` alone: :func:`lawson_hanson` if
     ``lh``, then, where it gave up, :func:`dual_newton` if ``dual``), then exact steps. ``info``
     (a dict) receives ``first_phase`` ("newton", "lawson-hanson", "dual" or "none"),
-    ``first_phase_steps`` and, where Lawson–Hanson ran, ``lh_columns`` and ``lh_s``."""
+    ``first_phase_steps`` and, where Lawson–Hanson ran, ``lh_sets``, ``lh_columns`` and ``lh_s``."""
     info = {} if info is None else info
     info.update(first_phase="none", first_phase_steps=0)
     ex = Exchange(p)
@@ -396,18 +398,21 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
     elif A is None and kfac is not None:  # stiff rows, cold start: a first phase on the dual
         uf = held_plate(pb, kfac, sigma)  # None: a floating plate, left to the exact steps
         first = lam0 = None
+        spent = 0  # the sets Lawson–Hanson solved before it gave up (iterations count them)
         if uf is not None and lh:
             first = lawson_hanson(pb, kfac, uf, feas_tol, steps, info)
             phase = "lawson-hanson"
             if first[0] is None:  # gave up: its reactions start the projected Newton phase
-                first, lam0 = None, first[1]
+                first, lam0, spent = None, first[1], first[3]
         if first is None and uf is not None and dual:
             first = dual_newton(pb, fac, kfac, W, sigma, feas_tol, steps, uf, lam0)
             phase = "dual"
+        newton = spent
         if first is not None:
-            u, lam, A, newton = first
+            u, lam, A, k = first
+            newton += k
             exact = True
-            info.update(first_phase=phase, first_phase_steps=newton)
+            info.update(first_phase=phase, first_phase_steps=k)
     elif A is not None:
         exact = True  # a warm start is meant to be (nearly) right: solve it exactly at once
     A = np.ones(pb.m, dtype=bool) if A is None else A.copy()
