@@ -87,8 +87,14 @@ class Futures:
 
     def abort(self, grace: float = 2.0):
         """Cancel every task not yet started; stop our own worker processes (SIGTERM, then
-        SIGKILL after ``grace`` seconds), without waiting for the tasks they run. A user's
-        executor or Dask client is left running (only our tasks are cancelled)."""
+        SIGKILL after ``grace`` seconds), without waiting for the tasks they run, and then the
+        executor's manager thread (``grace`` seconds at most). A user's executor or Dask client
+        is left running (only our tasks are cancelled).
+
+        The manager thread is joined because the interpreter's exit wakes it through a pipe
+        that the thread closes as it ends: left running, the two raced and an exit after
+        SIGTERM printed ``OSError: [Errno 9] Bad file descriptor`` with a traceback
+        (concurrent.futures in Python 3.11; seen in a CI run of the SIGTERM interrupt test)."""
         for fut in self.submitted:
             try:
                 fut.cancel()
@@ -97,6 +103,7 @@ class Futures:
         if not self.own:
             return
         procs = list((getattr(self.ex, "_processes", None) or {}).values())
+        manager = getattr(self.ex, "_executor_manager_thread", None)  # shutdown() forgets it
         self.ex.shutdown(wait=False, cancel_futures=True)
         for p in procs:
             if p.is_alive():
@@ -106,6 +113,8 @@ class Futures:
             if p.is_alive():
                 p.kill()
                 p.join(grace)
+        if manager is not None:
+            manager.join(grace)
 
 
 def _ignore_sigint():
