@@ -251,7 +251,7 @@ def build_model(scene: Scene) -> Model:
     pos = np.full(n_full, -1)
     pos[free] = np.arange(free.size)
     K = _csr_from_blocks(V, cnode, pos, free.size)
-    f = f_full[free].copy()
+    f = f_full[free]  # (a copy)
     if np.any(values != 0):  # the prescribed values' loads on the free dofs
         u_c = np.zeros(n_full)
         u_c[fixed] = values

@@ -325,6 +325,31 @@ def test_the_factor_solves_h_whether_the_rows_lie_in_k_pattern_or_not(bed_8_matr
 
 
 @pytest.mark.parametrize("method", ["cvxopt", "linalg"])
+def test_a_twin_factor_shares_the_pattern_and_solves_its_own_matrix(bed_8_matrices, method):
+    """The sparse method's factor of K alone is a twin of its active-set factor: the pattern
+    arrays are the same objects (built once), each factor solves its own H(w) (SciPy's LU)."""
+    from plateqp.linalg import bindings
+
+    if method == "cvxopt" and "cvxopt" not in bindings():
+        pytest.skip("cvxopt's CHOLMOD is not installed")
+    K, B, Kd = bed_8_matrices
+    m, sigma = B.shape[0], 1e-12
+    fac = pdas_factor.SpringFactor(K, B, Kd, np.full(m, Kd.max()), sigma, method)
+    twin = fac.twin()
+    assert twin.base is fac.base and twin.pair_pos is fac.pair_pos and twin.chol is not fac.chol or fac.chol is None
+    rng = np.random.default_rng(7)
+    w = rng.uniform(0.5, 2.0, m) * Kd.max()
+    w2 = rng.uniform(0.1, 0.3, m) * Kd.max()  # other springs (K alone is singular: a free plate)
+    fac.set(w)
+    twin.set(w2)
+    b = rng.standard_normal(K.shape[0])
+    for f, ww in ((fac, w), (twin, w2), (fac, w)):
+        ref = _h_inverse(K, B, Kd, ww, sigma, b)
+        np.testing.assert_allclose(f.solve(b), ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+    assert fac.stats["factorisations"] == 1 and twin.stats["factorisations"] == 1
+
+
+@pytest.mark.parametrize("method", ["cvxopt", "linalg"])
 def test_a_few_changed_rows_solve_by_woodbury_on_the_factor_in_hand(bed_8_matrices, method, monkeypatch):
     from plateqp.linalg import bindings
 

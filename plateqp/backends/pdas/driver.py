@@ -126,7 +126,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         kfac = None
         lh, dual = bool(settings["lh_start"]), bool(settings["dual_start"])
         if (lh or dual) and A is None and not np.all(pb.rho * pb.k >= 1.0):
-            kfac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
+            kfac = fac.twin()  # K alone: the same pattern, not built again
         info: dict = {}
         out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac, info, lh, dual)
         stats = dict(fac.stats, **info)

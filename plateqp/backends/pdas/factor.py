@@ -4,6 +4,7 @@ correction on the factor in hand; see the package docstring, "The method")."""
 
 from __future__ import annotations
 
+import copy
 import time
 
 import numpy as np
@@ -49,7 +50,7 @@ class SpringFactor:
         if lib is not None and lib not in libs:
             raise SolverError(f"option factor={method!r}: that CHOLMOD binding is not in use here "
                               f"(plateqp.linalg found: {libs or 'none'})")
-        self.method = method
+        self.method, self._lib = method, lib
         self.chol = Cholesky(lib) if lib else None
         m = B.shape[0]
         self.B, self.c = B, c
@@ -68,6 +69,10 @@ class SpringFactor:
         self.pattern_nnz = Ks.nnz  # entries of K + BᵀB's pattern (K's own, stored zeros too, where B lies in it)
         if self.chol is None or not self._triangle(Ks, Kd, sigma, pr, pair_r, pair_c, pair_val):
             self._whole(Ks, Kd, sigma, pr, pair_r, pair_c, pair_val)
+        self._fresh()
+
+    def _fresh(self) -> None:
+        """No factor yet: nothing measured or counted."""
         self.w = None
         self.fac = None  # a plateqp.linalg.Factor (linalg, superlu)
         self.loss = 0.0
@@ -80,6 +85,15 @@ class SpringFactor:
         self.stats = {"analyse_s": 0.0, "factorisations": 0, "factor_s": 0.0, "updates": 0, "updated_rows": 0,
                       "update_s": 0.0, "lowrank": 0, "lowrank_rows": 0, "lowrank_s": 0.0, "solves": 0,
                       "solve_s": 0.0}
+
+    def twin(self) -> SpringFactor:
+        """A second factor of the same ``H(w)`` family (the sparse method's factor of ``K``
+        alone beside its active-set one): the pattern, its equilibration and the rows'
+        positions are shared (read only), not built again; the factor is its own."""
+        other = copy.copy(self)
+        other.chol = Cholesky(self._lib) if self._lib else None
+        other._fresh()
+        return other
 
     def _triangle(self, Ks, Kd, sigma, pr, pair_r, pair_c, pair_val) -> bool:
         """CHOLMOD's triangle of ``K + σ diag(K)`` equilibrated, and where each product of a
