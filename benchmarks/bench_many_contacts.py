@@ -19,6 +19,8 @@ tolerance asked (``kkt_ok``) and 1e-10, and the status.
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_many_contacts.py            # 128², 1e-9 and 1e-6
     python benchmarks/bench_many_contacts.py --quick                           # 64², short
     python benchmarks/bench_many_contacts.py --mesh 128 --ks 63,all --backends pdas,clarabel
+    python benchmarks/bench_many_contacts.py --edges one --ks 10,30,45 --backends pdas \
+        --pdas-options anchor_start=false --tag one-plain     # a slab free to turn, plain PDAS
 
 Prints a markdown table and writes ``benchmarks/results/many_contacts-<mesh>[-<tag>].csv``
 (one row per case).
@@ -48,15 +50,29 @@ FIELDS = ("mesh", "scene", "k", "contacts", "backend", "accuracy", "cpu_s", "run
           "factorisations", "method", "kkt_max", "kkt_ok", "kkt_1e-10", "status")
 
 
-def make_scene(name: str, n: int, k):
+EDGES = ("four", "one", "free")
+
+
+def make_scene(name: str, n: int, k, edges: str = "four"):
+    """``bed(n)``, or ``grid_rigid(n, k)`` on its four walls, simply supported on its left edge
+    only (``edges="one"``: free to turn about it) or on none (``"free"``: a floating slab on
+    the posts alone): K singular in the last two."""
+    import plateqp as pq
     from plateqp.families import bed, grid_rigid
 
-    return bed(n) if name == "bed" else grid_rigid(n, k)
+    if name == "bed":
+        return bed(n)
+    sc = grid_rigid(n, k)
+    if edges == "four":
+        return sc
+    held = {"left": pq.Edge("simple")} if edges == "one" else {}
+    return pq.Scene(name=f"{sc.name}-{edges}", plate=sc.plate, mesh=sc.mesh, edges=held, loads=sc.loads,
+                    supports=sc.supports)
 
 
 def _run(args, q):
     """In the child: warm up, then time ``repeat`` solves of one case."""
-    name, n, k, backend, acc, repeat = args
+    name, n, k, backend, acc, repeat, edges, options = args
     try:
         import warnings
 
@@ -66,12 +82,12 @@ def _run(args, q):
 
         warnings.simplefilter("ignore")  # an inaccurate answer is reported in the table
         pq.solve(make_scene("grid", 8, 3), backend=backend, formulation="primal", accuracy=acc)  # warm-up
-        scene = make_scene(name, n, k)
+        scene = make_scene(name, n, k, edges)
         times = []
         r = None
         for i in range(repeat):
             t0 = time.process_time()
-            r = pq.solve(scene, backend=backend, formulation="primal", accuracy=acc)
+            r = pq.solve(scene, backend=backend, formulation="primal", accuracy=acc, options=options)
             times.append(time.process_time() - t0)
             if times[0] > 60.0:
                 break
@@ -95,7 +111,24 @@ def main():
     ap.add_argument("--timeout", type=float, default=400.0)
     ap.add_argument("--quick", action="store_true", help="64², repeat 1, timeout 120 s")
     ap.add_argument("--tag", default="", help="suffix of the CSV name (e.g. baseline)")
+    ap.add_argument("--edges", default="four", choices=EDGES,
+                    help="the post grids' slab on four walls, on its left edge only, or on none")
+    ap.add_argument("--pdas-options", default="", metavar="KEY=VALUE,...",
+                    help="options for pdas only, e.g. anchor_start=false (true/false, numbers, words)")
     a = ap.parse_args()
+    pdas_options = {}
+    for item in filter(None, a.pdas_options.split(",")):
+        key, sep, val = item.partition("=")
+        if not sep or not key:
+            ap.error(f"--pdas-options: {item!r} is not KEY=VALUE")
+        low = val.strip().lower()
+        if low in ("true", "false"):
+            pdas_options[key.strip()] = low == "true"
+        else:
+            try:
+                pdas_options[key.strip()] = float(val) if any(c in val for c in ".eE") else int(val)
+            except ValueError:
+                pdas_options[key.strip()] = val.strip()
     if a.quick:
         a.mesh, a.repeat, a.timeout = 64, 1, 120.0
     n = a.mesh
@@ -114,8 +147,10 @@ def main():
     print("| scene | k | contacts | backend | accuracy | CPU s | iterations | factorisations | method | "
           "KKT max | ok | status |\n|---|---|---|---|---|---|---|---|---|---|---|---|", flush=True)
     for name, n_, k, b, acc in cases:
-        res = run_in_subprocess(_run, (name, n_, k, b, acc, a.repeat), a.timeout)
-        row = {"mesh": n_, "scene": "bed" if name == "bed" else "grid_rigid", "k": "" if k is None else k,
+        opts = pdas_options if b == "pdas" else None
+        res = run_in_subprocess(_run, (name, n_, k, b, acc, a.repeat, a.edges, opts), a.timeout)
+        scene = "bed" if name == "bed" else ("grid_rigid" if a.edges == "four" else f"grid_rigid-{a.edges}")
+        row = {"mesh": n_, "scene": scene, "k": "" if k is None else k,
                "backend": b, "accuracy": acc, **res}
         rows.append(row)
         kk = row.get("kkt_max")

@@ -82,6 +82,10 @@ class QP:
     b: np.ndarray | None = None
     lb: np.ndarray | None = None
     ub: np.ndarray | None = None
+    #: True where the caller knows P to be singular (a floating plate's stiffness: rigid
+    #: motions), False where it knows P definite, None (the default) where it does not say. A
+    #: hint only: pdas skips a factorisation that would fail; no backend trusts it for an answer.
+    singular: bool | None = None
 
     def __post_init__(self) -> None:
         self.q = np.asarray(self.q, dtype=float).reshape(-1)

@@ -130,7 +130,7 @@ class Primal(Formulation):
         q = np.concatenate([-data.f, np.zeros(ne)])
         T = sp.csr_matrix((-np.sqrt(data.rho[el]), (el, np.arange(ne))), shape=(m, ne))
         G = sp.hstack([data.B, T], format="csc")
-        super().__init__("primal", data, qp=QP(P=P, q=q, G=G, h=data.g0.copy()))
+        super().__init__("primal", data, qp=QP(P=P, q=q, G=G, h=data.g0.copy(), singular=data.floating))
         self._el = el
 
     def recover(self, raw: RawSolution) -> ContactSolution:

@@ -198,7 +198,7 @@ class SchurFactor:
         sl = 1.0 / self.s[self.last]
         return S * np.outer(sl, sl)
 
-    def flexibility(self, B, refine: int = 0) -> np.ndarray:
+    def flexibility(self, B, refine: int = 0, shifted: bool = False) -> np.ndarray:
         """``B K⁻¹ Bᵀ`` (dense m × m) for rows ``B`` (m × n, sparse) acting on ``last`` only.
 
         ``refine = 0``: from the trailing block alone, ``Z = L_ll⁻¹ B_lᵀ``, ``ZᵀZ`` (where each
@@ -210,8 +210,11 @@ class SchurFactor:
         takes the trailing block's and corrects its answer instead). Measured on a 6 × 6 plate with 34
         supports (cond K 1.8e5): relative error 6e-14 from the trailing block, 1e-16 refined,
         and the dual formulation's KKT natural residual 1.1e-10 against 2e-11.
+
+        ``shifted``: a shifted factor's ``B K̂⁻¹ Bᵀ`` (``K̂ = K + shift·diag(K)`` on ``last``;
+        from the trailing block only), which a shifted factor otherwise refuses.
         """
-        if self.shift:
+        if self.shift and not (shifted and refine == 0):
             raise ValueError("flexibility needs an unshifted factor (K definite)")
         B = sp.csr_matrix(B)
         if np.any(B.data[~self._mask[B.indices]] != 0):
@@ -253,6 +256,13 @@ class SchurFactor:
         x = s * self.chol.solve(s * b)
         self._count(t0)
         return x
+
+    def solve_shifted(self, b: np.ndarray) -> np.ndarray:
+        """``K̂⁻¹ b`` (``K̂ = K + shift·diag(K)`` on ``last``; ``K`` itself if unshifted), one
+        solve with the factor itself, unrefined."""
+        if self.chol is None or self.chol.spent:
+            raise ValueError("solve_shifted needs this factor's own CHOLMOD factor, not spent")
+        return self._raw_full(b)
 
     # the two halves of a solve with ``K = D⁻¹ Pᵀ L Lᵀ P D⁻¹`` (``D = diag(s)``), for a caller
     # that needs only the trailing part of one half: ``y = L⁻¹ P D b`` is in the factor's order,

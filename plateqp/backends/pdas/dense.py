@@ -28,18 +28,27 @@ from ..base import Status
 from .options import INNER_EXACT, LH_BUDGET, LH_OVERHEAD, LH_PROBE, PIVOT_TOL
 from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
 
-__all__ = ["DenseDual", "NotApplicable", "first_set", "run_dense"]
+__all__ = ["DenseDual", "NotApplicable", "anchored_set", "first_set", "run_dense"]
 
 
 class NotApplicable(Exception):
-    """The dense method does not apply (too many contact dofs, K singular, no CHOLMOD)."""
+    """The dense method does not apply (too many contact dofs, K singular, no CHOLMOD);
+    ``singular``: because K is singular (a floating plate)."""
+
+    def __init__(self, message: str, singular: bool = False) -> None:
+        super().__init__(message)
+        self.singular = singular
 
 
 class DenseDual:
     """The dual LCP ``(M, d)`` of a reduced QP, from the trailing block of one factorisation of
-    ``K`` with the rows' dofs last, and the exact solve of an active set with that factor."""
+    ``K`` with the rows' dofs last, and the exact solve of an active set with that factor.
 
-    def __init__(self, pb: ReducedQP, max_dense: int) -> None:
+    ``anchor > 0``: the LCP of the plate with each of the rows' dofs held by a spring of
+    ``anchor·K_jj`` (``K + anchor·diag(K)`` on those dofs: definite for a floating plate whose
+    rows, held, hold it), for :func:`anchored_set`; no exact steps (:meth:`exact` refuses)."""
+
+    def __init__(self, pb: ReducedQP, max_dense: int, anchor: float = 0.0) -> None:
         libs = bindings()
         if not libs:
             raise NotApplicable("no CHOLMOD binding (scikit-sparse or cvxopt) is in use here")
@@ -48,18 +57,25 @@ class DenseDual:
         if c.size > max_dense:
             raise NotApplicable(f"the rows touch {c.size} dofs (max_dense = {max_dense})")
         try:
-            self.fac = SchurFactor(pb.K, c, pivot_tol=PIVOT_TOL, method=libs[0], diagonal=pb.Kd)
+            self.fac = SchurFactor(pb.K, c, shift=anchor, pivot_tol=PIVOT_TOL, method=libs[0], diagonal=pb.Kd)
         except SingularMatrixError as exn:
-            raise NotApplicable(f"K is singular ({exn})") from exn
+            raise NotApplicable(f"K is singular ({exn})", singular=True) from exn
         t0 = time.perf_counter()
-        M = self.fac.flexibility(B)
+        M = self.fac.flexibility(B, shifted=anchor > 0)
         M[np.diag_indices(pb.m)] += pb.rho
         self.M = M
         self.pb = pb
         self._dense_s = time.perf_counter() - t0
         self.Bc = B[:, c].tocsr()  # the rows on the trailing unknowns, in the factor's order of them
-        self.yf = self._forward(pb.f)
-        self.d = pb.g - self.Bc @ self._tail(self.yf)  # g − B K⁻¹ f: half a solve
+        if anchor > 0:
+            try:
+                self.d = pb.g - B @ self.fac.solve_shifted(pb.f)  # g − B K̂⁻¹ f: one solve
+            except ValueError as exn:  # cvxopt's factor spent by reading it
+                raise NotApplicable(str(exn)) from exn
+            self.yf = None
+        else:
+            self.yf = self._forward(pb.f)
+            self.d = pb.g - self.Bc @ self._tail(self.yf)  # g − B K⁻¹ f: half a solve
         self._chol = None
         self.first: dict = {}  # how run_dense found its first set (extras)
 
@@ -123,6 +139,8 @@ class DenseDual:
         iterative refinement with ``K⁻¹`` and the Cholesky factor of ``M_AA`` while the
         residuals are above rounding (:func:`.reduced.at_rounding`) and still halve: for
         residuals ``r_u``, ``r_A``, ``v = K⁻¹ r_u``, ``M_AA δλ = r_A + B_A v``, ``δu = v − K⁻¹ B_Aᵀ δλ``."""
+        if self.yf is None:
+            raise ValueError("an anchored LCP has no exact steps (its K is not the plate's)")
         pb = self.pb
         idx = np.flatnonzero(A)
         BA, BcA = pb.B[idx], self.Bc[idx]
@@ -263,7 +281,9 @@ def first_set(M, d: np.ndarray, c: np.ndarray, feas_tol: float, floor: float, bu
         gap = d + lam[F] @ R[:F.size] if F.size else d.astype(float, copy=True)
 
 
-def run_dense(pb: ReducedQP, cond: DenseDual, A, feas_tol, max_iter, p, steps) -> Outcome:
+def _start(pb: ReducedQP, cond: DenseDual, A, feas_tol) -> tuple[np.ndarray, int]:
+    """The dense method's first set (given; Lawson–Hanson's for stiff rows; else ``d < 0``) and
+    Lawson–Hanson's steps; ``cond.first`` says which."""
     first = 0
     if A is not None:
         A = A.copy()
@@ -281,6 +301,32 @@ def run_dense(pb: ReducedQP, cond: DenseDual, A, feas_tol, max_iter, p, steps) -
     else:
         A = cond.d < 0
         cond.first = {"first_set": "d < 0"}
+    return A, first
+
+
+def anchored_set(pb: ReducedQP, cond: DenseDual, feas_tol, max_iter, p, steps) -> tuple[np.ndarray, int]:
+    """A first set for a floating plate (``K`` singular, no dual LCP): the contact set of the
+    anchored plate (``cond`` made with ``anchor > 0``), by the dense method's first set and
+    block steps on its LCP, without exact steps; the sparse method's exact steps then solve
+    the plate itself from that set. Returns the set and the sets solved."""
+    A, first = _start(pb, cond, None, feas_tol)
+    ex = Exchange(p)
+    for it in range(1, max_iter + 1):
+        lam, gap = cond.basic(A)
+        bad = infeasible(pb, A, lam, gap, feas_tol)
+        if steps is not None:
+            steps.append({"step": f"anchored {it}", "active": int(A.sum()), "infeasible": int(bad.sum()),
+                          "solve": "dense"})
+        if not bad.any() or A.tobytes() in ex.seen:
+            return A, first + it
+        A, mode = ex.next(A, bad)
+        if steps is not None:
+            steps[-1]["exchange"] = mode
+    return A, first + max_iter
+
+
+def run_dense(pb: ReducedQP, cond: DenseDual, A, feas_tol, max_iter, p, steps) -> Outcome:
+    A, first = _start(pb, cond, A, feas_tol)
     ex = Exchange(p)
     for it in range(1, max_iter + 1):
         lam, gap = cond.basic(A)

@@ -10,8 +10,8 @@ import numpy as np
 
 from ...errors import ProblemError, SolverError
 from ..base import QP, RawSolution, Status, preset
-from .dense import DenseDual, NotApplicable, run_dense
-from .options import ACCURACY, MAX_DENSE_AUTO, OPTIONS, SETTINGS
+from .dense import DenseDual, NotApplicable, anchored_set, run_dense
+from .options import ACCURACY, ANCHOR, MAX_DENSE_AUTO, OPTIONS, SETTINGS
 from .reduced import ReducedQP, force_scale, natural_residuals
 from .sparse import SpringFactor, run_sparse
 
@@ -33,6 +33,19 @@ def auto_max_dense(n: int) -> int:
     """``max_dense="auto"`` for ``n`` coupled dofs (:data:`.options.MAX_DENSE_AUTO`)."""
     lo, hi, per_root = MAX_DENSE_AUTO
     return max(lo, min(hi, int(per_root * np.sqrt(n))))
+
+
+def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: int, steps):
+    """``(A, sets, seconds)``: the anchored plate's contact set (:func:`.dense.anchored_set`),
+    a first set for a floating plate; None where the anchored plate is singular too (the rows,
+    held, do not hold it) or the condensed method does not apply to it."""
+    t0 = time.perf_counter()
+    try:
+        cond = DenseDual(pb, max_dense, anchor=ANCHOR)
+    except NotApplicable:
+        return None
+    A, sets = anchored_set(pb, cond, feas_tol, max_iter, p, steps)
+    return A, sets, time.perf_counter() - t0
 
 
 def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> RawSolution:
@@ -89,7 +102,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     max_dense = _option(settings, "max_dense", lambda v: (isinstance(v, str) and v == "auto") or _is_int(v, 0),
                         "'auto' or an integer ≥ 0")
     max_rows = _option(settings, "max_rows", lambda v: _is_int(v, 1), "a positive integer")
-    for key in ("dual_start", "lh_start"):
+    for key in ("dual_start", "lh_start", "anchor_start"):
         _option(settings, key, lambda v: isinstance(v, (bool, np.bool_)), "True or False")
     if not isinstance(trace, (bool, np.bool_)):
         raise ProblemError(f"option trace must be True or False, got {trace!r}")
@@ -108,15 +121,22 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             raise ProblemError(f"option active must be a bool array with one entry per row of G ({m})")
     steps: list[dict] | None = [] if trace else None
 
-    out = None
+    out = anchored = None
     extras: dict = {"max_dense": max_dense}
     if method in ("auto", "condensed"):
         try:
+            if method == "auto" and qp.singular is True:  # a floating plate: its factorisation would fail
+                raise NotApplicable("K is singular (the QP says so: a floating plate)", singular=True)
             cond = DenseDual(pb, max_dense)
         except NotApplicable as why:
             if method == "condensed":
                 raise SolverError(f"pdas: the condensed method does not apply here: {why}") from None
             extras["condensed_skipped"] = str(why)
+            if (why.singular and method == "auto" and A is None and settings["anchor_start"]
+                    and np.median(pb.rho * pb.k) < 1.0):
+                anchored = _anchored(pb, max_dense, tol["feas_tol"], max_iter, p, steps)
+                if anchored is not None:
+                    A = anchored[0]
         else:
             out = run_dense(pb, cond, A, tol["feas_tol"], max_iter, p, steps)
             extras.update(method="condensed", **cond.stats)
@@ -133,6 +153,10 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         if kfac is not None:  # the factor of K alone (phase 1's line search) counts too
             for key, val in kfac.stats.items():
                 stats[key] += val
+        if anchored is not None:  # its set started the exact steps; its factorisation counts
+            stats.update(first_phase="anchored", first_phase_steps=anchored[1], anchored_s=anchored[2])
+            stats["factorisations"] += 1
+            out.it += anchored[1]
         extras.update(method="sparse", factor=fac.method, **stats)
 
     extras["active"] = out.A.copy()

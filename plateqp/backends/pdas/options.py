@@ -44,8 +44,13 @@ ACCURACY: dict[str, dict[str, float]] = {
 #: ``dual_start`` (sparse, stiff rows, cold start) where that is off or gave up, find it by
 #:                projected Newton on the dual energy (:func:`.sparse.dual_newton`); with both
 #:                False: plain PDAS from the two-sided problem (every row active).
+#: ``anchor_start`` (method "auto", stiff rows, K singular: a floating plate, cold start) find
+#:                the active set first as the condensed method's on the plate with the rows'
+#:                dofs anchored by soft springs (:func:`.dense.anchored_set`, ANCHOR), then
+#:                the sparse method's exact steps from it.
 SETTINGS: dict = {"method": "auto", "max_dense": "auto", "penalty": 1e8, "prox": 1e-12, "factor": "auto",
-                  "p": 6, "max_rows": 100_000, "max_iter": None, "dual_start": True, "lh_start": True}
+                  "p": 6, "max_rows": 100_000, "max_iter": None, "dual_start": True, "lh_start": True,
+                  "anchor_start": True}
 
 #: ``max_dense="auto"``: ``max(lo, min(hi, per_root · √n))`` for ``n`` coupled dofs. The condensed
 #: method costs one contacts-last factorisation and about m³ dense flops (the trailing block and
@@ -137,6 +142,12 @@ LH_BLOCK, LH_TIME, LH_PRESSED, LH_MEMORY = 8, 30.0, 0.5, 3000
 #: let a bed at 24² and 40² through, and with springs of 1e9 the dense method then ran to
 #: MAX_ITER); held plates 7e-8 (256², 1936 posts) to 4e-6.
 PIVOT_TOL = 1e-11
+#: (method "auto", stiff rows, K singular, cold start) The anchored plate's springs, ANCHOR·K_jj
+#: on each dof the rows act on (K equilibrated: ANCHOR is the trailing block's shift). Small,
+#: so its contact set is the plate's but for rows whose gap and force are both within about
+#: ANCHOR of their scale; not so small that its rigid motions, at ANCHOR, fall below the held
+#: plates' softest modes (7e-8–4e-6, see PIVOT_TOL) by more than a few decades.
+ANCHOR = 1e-8
 
 RAY_MESSAGE = ("the active rows leave a null direction d of K that no inactive row is pressed along: "
                "K d = 0, G d ≤ 0, qᵀd < 0 (the QP is unbounded below)")

@@ -1,0 +1,172 @@
+"""pdas on plates K does not hold: floating on posts, or free to turn about one held edge.
+
+The condensed method needs ``K⁻¹``; for such a plate pdas (method "auto") first finds the contact
+set of the *anchored* plate (each post's dof held by a spring of ``ANCHOR·K_jj``, definite) by
+the condensed method's dense steps, then the sparse method's exact steps solve the plate itself
+from that set (``extras["first_phase"] == "anchored"``). Before, plain PDAS from every row
+active took one factorisation a set (29 at 128² with the plate held on one edge).
+
+References, none of them pdas's own earlier output: Lemke's method on the condensed LCP (an
+independent algorithm on another formulation); statics by hand (the total load and its moments
+against the posts' reactions plus the held edge's); SciPy's sparse LU for the shifted factor.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+import plateqp as pq
+from plateqp import families as F
+from plateqp.assembly import build_model
+from plateqp.backends.base import QP
+from plateqp.backends.pdas import options as pdas_options
+from plateqp.backends.pdas.driver import pdas
+from plateqp.contact.formulations import Primal
+from plateqp.contact.scaling import Scaled
+from plateqp.linalg import SchurFactor, bindings
+
+TOTAL = F.Q * F.A * F.A + F.P  # kN: 10 kN/m² on 8 m × 8 m plus the 300 kN column
+MOMENT_X = F.Q * F.A**3 / 2 + F.P * F.PX  # Σ load · x
+MOMENT_Y = F.Q * F.A**3 / 2 + F.P * F.PY
+
+needs_cholmod = pytest.mark.skipif(not bindings(), reason="the condensed method needs a CHOLMOD binding")
+
+
+def solve(scene, backend="pdas", formulation="primal", accuracy=1e-10, options=None):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        return pq.solve(scene, backend=backend, formulation=formulation, accuracy=accuracy, options=options)
+
+
+def one_edge(n: int, k: int) -> pq.Scene:
+    """grid_rigid's slab simply supported on its left edge only: free to turn about it."""
+    sc = F.grid_rigid(n, k)
+    return pq.Scene(name=f"one-edge-{n}-{k}", plate=sc.plate, mesh=sc.mesh, edges={"left": pq.Edge("simple")},
+                    loads=sc.loads, supports=sc.supports)
+
+
+def wall_reactions(res):
+    """Upward forces of the held edge at its w-dofs, and where (from the full stiffness)."""
+    m = res.model
+    nd = m.element.ndof_node
+    e = m.K_full @ res.u - m.f_full  # −(edge reaction) at prescribed dofs
+    fixed_w = m.fixed[m.fixed % nd == 0]
+    return -e[fixed_w], m.grid.node_xy()[fixed_w // nd]
+
+
+SCENES = {"floating": lambda: F.floating(16, 9), "one edge": lambda: one_edge(16, 12)}
+
+
+@pytest.fixture(scope="module", params=sorted(SCENES))
+def solved(request):
+    sc = SCENES[request.param]()
+    return (request.param, sc, solve(sc), solve(sc, options={"anchor_start": False}),
+            solve(sc, "lemke", "condensed", "high"))
+
+
+@needs_cholmod
+def test_anchored_first_set_then_exact_steps_agree_with_lemke(solved):
+    name, sc, res, plain, ref = solved
+    assert res.status == pq.Status.OPTIMAL and res.kkt.ok
+    assert res.extras["method"] == "sparse" and res.extras["first_phase"] == "anchored"
+    assert "singular" in res.extras["condensed_skipped"]
+    scale = np.abs(ref.reactions).max()
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
+    np.testing.assert_array_equal(res.reactions > 1e-9 * scale, ref.reactions > 1e-9 * scale)
+    # plain PDAS (no first set) reaches the same answer, by more factorisations
+    assert plain.status == pq.Status.OPTIMAL and plain.extras["first_phase"] == "none"
+    np.testing.assert_allclose(plain.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
+    assert res.extras["factorisations"] <= 3 < plain.extras["factorisations"]
+
+
+@needs_cholmod
+def test_anchored_answer_carries_the_load_by_statics(solved):
+    name, sc, res, _, _ = solved
+    xy = res.model.contacts.xy
+    R = res.reactions
+    if name == "floating":  # the posts carry everything
+        np.testing.assert_allclose(R.sum(), TOTAL, rtol=1e-9)
+        np.testing.assert_allclose(R @ xy[:, 0], MOMENT_X, rtol=1e-9)
+        np.testing.assert_allclose(R @ xy[:, 1], MOMENT_Y, rtol=1e-9)
+    else:  # the left edge (x = 0) carries the rest, up or down: moments about it are the posts' alone
+        # (about the x axis the edge's prescribed slopes ∂w/∂y carry moments too: not checked)
+        np.testing.assert_allclose(R @ xy[:, 0], MOMENT_X, rtol=1e-9)
+        wall, wxy = wall_reactions(res)
+        assert np.all(wxy[:, 0] == 0.0)
+        np.testing.assert_allclose(R.sum() + wall.sum(), TOTAL, rtol=1e-9)
+    assert R.min() >= -1e-10 * R.max()
+
+
+def _primal_qp(scene, singular):
+    qp = Primal(Scaled.from_model(build_model(scene))).qp
+    return QP(P=qp.P, q=qp.q, G=qp.G, h=qp.h, singular=singular)
+
+
+@needs_cholmod
+def test_the_singular_hint_only_skips_a_factorisation():
+    """Without the hint the condensed factorisation is tried and fails (CHOLMOD stops), and the
+    anchored route follows; with a wrong hint on a held plate the anchored route still ends at
+    the held plate's answer (the exact steps decide, not the hint)."""
+    floating = F.floating(16, 9)
+    hinted = pdas(_primal_qp(floating, True), accuracy=1e-10)
+    unknown = pdas(_primal_qp(floating, None), accuracy=1e-10)
+    for raw in (hinted, unknown):
+        assert raw.status == pq.Status.OPTIMAL and raw.extras["first_phase"] == "anchored"
+    assert "the QP says so" in hinted.extras["condensed_skipped"]
+    assert "the QP says so" not in unknown.extras["condensed_skipped"]
+    np.testing.assert_allclose(unknown.z, hinted.z, rtol=0, atol=1e-9 * np.abs(hinted.z).max())
+
+    held = F.grid_rigid(16, 9)
+    right = pdas(_primal_qp(held, None), accuracy=1e-10)
+    wrong = pdas(_primal_qp(held, True), accuracy=1e-10)
+    assert right.extras["method"] == "condensed"
+    assert wrong.status == pq.Status.OPTIMAL and wrong.extras["first_phase"] == "anchored"
+    np.testing.assert_allclose(wrong.z, right.z, rtol=0, atol=1e-9 * np.abs(right.z).max())
+
+
+@needs_cholmod
+def test_no_anchored_route_where_the_posts_cannot_hold_the_plate():
+    """Three collinear posts under a free slab: even held, they leave it free to turn about their
+    line, so the anchored plate is singular too (K_oo); pdas says there is no equilibrium."""
+    sc = F.floating(16, 9)
+    xy = np.array([[2.0, 4.0], [4.0, 4.0], [6.0, 4.0]])
+    sc = pq.Scene(name="three-in-a-row", plate=sc.plate, mesh=sc.mesh, loads=sc.loads,
+                  supports=[pq.Support(x, y, gap=0.0) for x, y in xy])
+    with pytest.raises(pq.NoEquilibriumError):
+        solve(sc)
+
+
+@needs_cholmod
+def test_a_shifted_factor_gives_the_anchored_flexibility_and_solve():
+    """SchurFactor(shift=a): ``B K̂⁻¹ Bᵀ`` and ``K̂⁻¹ b`` for ``K̂ = K + a·diag(K)`` on the dofs
+    ordered last, against SciPy's LU of ``K̂`` (a floating slab: K itself is singular)."""
+    m = build_model(F.floating(8, 5))
+    K, B = m.K.tocsc(), m.contacts.B.tocsr()
+    last = np.unique(B.indices)
+    a = 1e-3
+    Kd = K.diagonal()
+    shift = np.zeros(K.shape[0])
+    shift[last] = a * Kd[last]
+    Khat = sp.csc_matrix(K + sp.diags(shift))
+    fac = SchurFactor(K, last, shift=a)
+    ref = B @ spla.spsolve(Khat, B.T.toarray())
+    M = fac.flexibility(B, shifted=True)
+    np.testing.assert_allclose(M, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
+    b = np.random.default_rng(1).standard_normal(K.shape[0])
+    x = spla.spsolve(Khat, b)
+    np.testing.assert_allclose(fac.solve_shifted(b), x, rtol=0, atol=1e-9 * np.abs(x).max())
+    with pytest.raises(ValueError):
+        fac.flexibility(B)  # unshifted asked of a shifted factor
+    with pytest.raises(ValueError):
+        fac.solve(b)
+
+
+def test_anchor_start_is_an_option():
+    assert pdas_options.SETTINGS["anchor_start"] is True
+    with pytest.raises(pq.ProblemError):
+        solve(F.floating(8, 5), options={"anchor_start": "yes"})
