@@ -170,3 +170,22 @@ def test_anchor_start_is_an_option():
     assert pdas_options.SETTINGS["anchor_start"] is True
     with pytest.raises(pq.ProblemError):
         solve(F.floating(8, 5), options={"anchor_start": "yes"})
+
+
+@needs_cholmod
+def test_the_final_set_must_hold_a_floating_plate():
+    """Four corner posts of [0.25, 0.75]², a point load 1e-10 outside their hull: the anchored
+    set (the two posts under the load) leaves the plate free to tip about their line, and the
+    load works along that motion, but too little for the first correction of the exact step to
+    show it. The final set's check (two inverse iterations with H_A) finds it: unbounded, with
+    a ray, as Lemke and BPP say (tests/test_statics.py: exit code 3). Without that check the
+    anchored route answered OPTIMAL."""
+    sc = pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(8, 8),
+                  loads=[pq.PointLoad(10.0, 0.75 + 1e-10, 0.5)],
+                  supports=[pq.Support(x, y) for x, y in [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]])
+    raw = pdas(_primal_qp(sc, True), accuracy="default", trace=True)
+    steps = [s["solve"] for s in raw.extras["trace"]]
+    assert raw.status == pq.Status.UNBOUNDED and "ray" in raw.extras
+    assert steps[0] == "dense" and "singular" in steps  # anchored first, then the motion found
+    with pytest.raises(pq.NoEquilibriumError):
+        solve(sc, accuracy="default")

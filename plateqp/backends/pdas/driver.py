@@ -148,7 +148,9 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         if (lh or dual) and A is None and not np.all(pb.rho * pb.k >= 1.0):
             kfac = fac.twin()  # K alone: the same pattern, not built again
         info: dict = {}
-        out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac, info, lh, dual)
+        floating = qp.singular is True or "K is singular" in extras.get("condensed_skipped", "")
+        out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac, info, lh, dual,
+                         floating)
         stats = dict(fac.stats, **info)
         if kfac is not None:  # the factor of K alone (phase 1's line search) counts too
             for key, val in kfac.stats.items():

@@ -105,6 +105,23 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     return Step(u, out, res, solves)
 
 
+def _free_mode(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray, null: list,
+               sigma: float) -> np.ndarray | None:
+    """A rigid motion the active rows ``A`` leave free (besides ``null``), or None: two inverse
+    iterations with ``H_A`` from a fixed start, judged by their Rayleigh quotient as
+    :func:`solve_active` judges its first correction (below SINGULAR_QUOTIENT)."""
+    WA = np.where(A, W, 0.0)
+    v = np.cos(np.arange(pb.K.shape[0], dtype=float))
+    for _ in range(2):
+        v = _project(null, pb.Kd, fac.solve(pb.Kd * v))
+    Dv = float(v @ (pb.Kd * v))
+    Bv = pb.B @ v
+    energy = float(v @ (pb.K @ v)) + float(Bv @ (WA * Bv))
+    if Dv > 0 and energy < SINGULAR_QUOTIENT * sigma * Dv:
+        return v / np.abs(v).max()
+    return None
+
+
 def _free_motion(pb: ReducedQP, fac: SpringFactor, null: list, d: np.ndarray) -> np.ndarray:
     """The rigid motion ``d`` sharpened by inverse iteration with ``H_A`` (its error in the held
     modes falls by ``σ/λ`` each time) and ``D``-normalised against ``null``."""
@@ -377,12 +394,14 @@ def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndar
 
 def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter, p, steps,
                kfac: SpringFactor | None = None, info: dict | None = None, lh: bool = True,
-               dual: bool = True) -> Outcome:
+               dual: bool = True, floating: bool = False) -> Outcome:
     """The sparse method: a first phase where it applies (soft rows: :func:`newton_pcg`; stiff
     rows on a held plate with ``kfac``, a factor for ``K`` alone: :func:`lawson_hanson` if
     ``lh``, then, where it gave up, :func:`dual_newton` if ``dual``), then exact steps. ``info``
     (a dict) receives ``first_phase`` ("newton", "lawson-hanson", "dual" or "none"),
-    ``first_phase_steps`` and, where Lawson–Hanson ran, ``lh_sets``, ``lh_columns`` and ``lh_s``."""
+    ``first_phase_steps`` and, where Lawson–Hanson ran, ``lh_sets``, ``lh_columns`` and ``lh_s``.
+    ``floating``: ``K`` is known to be singular (as where :func:`held_plate` finds it so): the
+    final set is checked to hold the plate (:func:`_free_mode`) before it is called optimal."""
     info = {} if info is None else info
     info.update(first_phase="none", first_phase_steps=0)
     ex = Exchange(p)
@@ -397,6 +416,7 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         info.update(first_phase="newton", first_phase_steps=newton)
     elif A is None and kfac is not None:  # stiff rows, cold start: a first phase on the dual
         uf = held_plate(pb, kfac, sigma)  # None: a floating plate, left to the exact steps
+        floating = floating or uf is None
         first = lam0 = None
         spent = 0  # the sets Lawson–Hanson solved before it gave up (iterations count them)
         if uf is not None and lh:
@@ -416,25 +436,34 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
     elif A is not None:
         exact = True  # a warm start is meant to be (nearly) right: solve it exactly at once
     A = np.ones(pb.m, dtype=bool) if A is None else A.copy()
+    null: list = []  # free rigid motions of A along which the load does no work
+    held = True  # the final set's hold on a floating plate checked (or not needed)
+    pending = None  # a free rigid motion found by that check, to be judged
+    prev = None
     for it in range(1, max_iter + 1):
         fac.set(np.where(A, W, 0.0))
-        null: list = []  # free rigid motions of A along which the load does no work
+        if prev is None or not np.array_equal(prev, A):
+            null, held = [], not floating
+        prev = A.copy()
         entered = False
         while True:
-            step = solve_active(pb, fac, W, A, u, lam, sigma, exact, null)
-            if step.ray is not None and not fac.clean:  # judge a free rigid motion on a clean factor
-                fac.refactor(np.where(A, W, 0.0))
+            if pending is not None:
+                d, pending, solves = pending, None, 0
+            else:
                 step = solve_active(pb, fac, W, A, u, lam, sigma, exact, null)
-            if step.ray is None:
-                break
+                if step.ray is not None and not fac.clean:  # judge a free rigid motion on a clean factor
+                    fac.refactor(np.where(A, W, 0.0))
+                    step = solve_active(pb, fac, W, A, u, lam, sigma, exact, null)
+                if step.ray is None:
+                    break
+                d, solves = step.ray, step.solves
             # the active rows do not hold the plate: it can move along d
-            d = step.ray
             Bd = pb.B @ d
             scale = np.abs(Bd).max(initial=0.0)
             hit = ~A & (Bd > 1e-9 * scale)
             if steps is not None:
                 steps.append({"step": it, "active": int(A.sum()), "infeasible": None, "solve": "singular",
-                              "solves": step.solves, "entering": int(hit.sum())})
+                              "solves": solves, "entering": int(hit.sum())})
             if hit.any():
                 A = A | hit
                 exact = False
@@ -473,6 +502,16 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
             steps.append({"step": it, "active": int(A.sum()), "infeasible": int(bad.sum()),
                           "solve": "exact" if exact else "loose", "solves": step.solves})
         if not bad.any():
+            if exact and not held:
+                # a floating plate: do the active rows hold it? A rigid motion the load barely
+                # works along can escape the first correction's test (the elastic part of that
+                # correction outweighs it): two inverse iterations with H_A find it
+                held = True
+                if not fac.clean:
+                    fac.refactor(np.where(A, W, 0.0))
+                pending = _free_mode(pb, fac, W, A, null, sigma)
+                if pending is not None:
+                    continue
             if exact:
                 return Outcome(Status.OPTIMAL, "no infeasible row", A, u, lam, newton + it)
             exact = True  # the set looks right: solve it to rounding and look again
