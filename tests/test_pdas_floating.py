@@ -189,3 +189,45 @@ def test_the_final_set_must_hold_a_floating_plate():
     assert steps[0] == "dense" and "singular" in steps  # anchored first, then the motion found
     with pytest.raises(pq.NoEquilibriumError):
         solve(sc, accuracy="default")
+
+
+@pytest.fixture(scope="module")
+def one_edge_every_node():
+    """A post on every interior node of a 16² slab held on one edge only, by the sparse method
+    (as above ``max_dense`` rows): Lawson–Hanson on the anchored plate's flexibility, and
+    plain PDAS, and Lemke."""
+    from plateqp.backends.pdas import sparse as pdas_sparse
+
+    sc = one_edge(16, "all")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(pdas_sparse, "LH_ANCHORED", 1e9)  # a loaded machine must not change the path checked
+        res = solve(sc, options={"method": "sparse"})
+    plain = solve(sc, options={"method": "sparse", "anchor_start": False})
+    return res, plain, solve(sc, "lemke", "condensed", "high")
+
+
+def test_sparse_method_lawson_hanson_on_the_anchored_plate(one_edge_every_node):
+    res, plain, ref = one_edge_every_node
+    assert res.status == pq.Status.OPTIMAL and res.kkt.ok
+    assert res.extras["first_phase"] == "anchored lawson-hanson" and "lh_gave_up" not in res.extras
+    scale = np.abs(ref.reactions).max()
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
+    assert plain.status == pq.Status.OPTIMAL and plain.extras["first_phase"] == "none"
+    np.testing.assert_allclose(plain.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
+    assert res.extras["factorisations"] < plain.extras["factorisations"]
+    xy = res.model.contacts.xy
+    np.testing.assert_allclose(res.reactions @ xy[:, 0], MOMENT_X, rtol=1e-9)  # about the held edge
+
+
+def test_anchored_lawson_hanson_giving_up_starts_the_exact_steps_from_its_set(one_edge_every_node, monkeypatch):
+    """Lawson–Hanson on the anchored plate out of memory (LH_MEMORY made tiny): the exact steps
+    start from the rows it holds and those still pressed, and end at Lemke's answer."""
+    from plateqp.backends.pdas import sparse as pdas_sparse
+
+    _, _, ref = one_edge_every_node
+    monkeypatch.setattr(pdas_sparse, "LH_MEMORY", 200)
+    res = solve(one_edge(16, "all"), options={"method": "sparse"})
+    assert res.status == pq.Status.OPTIMAL and res.kkt.ok
+    assert res.extras["first_phase"] == "anchored lawson-hanson (gave up)" and res.extras["lh_gave_up"] == "memory"
+    scale = np.abs(ref.reactions).max()
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)

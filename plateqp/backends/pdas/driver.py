@@ -150,7 +150,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         info: dict = {}
         floating = qp.singular is True or "K is singular" in extras.get("condensed_skipped", "")
         out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac, info, lh, dual,
-                         floating)
+                         floating, bool(settings["anchor_start"]))
         stats = dict(fac.stats, **info)
         if kfac is not None:  # the factor of K alone (phase 1's line search) counts too
             for key, val in kfac.stats.items():

@@ -135,6 +135,14 @@ LH_BUDGET, LH_OVERHEAD, LH_PROBE = 0.5, 5e4, 24
 #: (:data:`plateqp.assembly.BYTES_PER_DOF`): a post on every node needs 33 MB at 128², 416 MB at
 #: 256² (389 rows in contact, 590 MB allowed); at 512² it would give up.
 LH_BLOCK, LH_TIME, LH_PRESSED, LH_MEMORY = 8, 30.0, 0.5, 3000
+#: (sparse, stiff rows, floating plate, cold start) Lawson–Hanson on the anchored plate's
+#: flexibility (:func:`.sparse.anchored_plate`) may take LH_ANCHORED factorisations' time: where
+#: it gives up, the exact steps start from every row (plain PDAS: 18–155 factorisations on the
+#: floating and one-edge slabs measured), not from the projected Newton phase. Measured (CPU,
+#: one run each), a post on every node, slab simply supported on one edge only: 48², 402 sets
+#: took 0.44 s in all, past 30 factorisations' time (it gave up at 381 sets, 1.33 s in all;
+#: plain 1.25 s); 128² with 63 × 63 posts, 624 sets, 6.7 s in all (plain 31 s).
+LH_ANCHORED = 100.0
 #: (condensed) A trailing pivot L_ii², or the estimate of the trailing block's smallest
 #: eigenvalue (two inverse iterations), below this (K equilibrated to a unit diagonal) means K is
 #: singular to working precision (a floating plate): the sparse method takes over. Measured: a

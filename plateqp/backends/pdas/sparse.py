@@ -12,6 +12,7 @@ import numpy as np
 from ..base import Status
 from .options import (
     ALPHA_MAX,
+    ANCHOR,
     ALPHA_MIN,
     ARMIJO,
     DUAL_DEFINITE,
@@ -24,6 +25,7 @@ from .options import (
     FREE_WORK,
     INNER_EXACT,
     INNER_LOOSE,
+    LH_ANCHORED,
     LH_BLOCK,
     LH_MEMORY,
     LH_PRESSED,
@@ -227,6 +229,24 @@ def held_plate(pb: ReducedQP, kfac: SpringFactor, sigma: float) -> np.ndarray | 
     return uf
 
 
+def anchored_plate(pb: ReducedQP, kfac: SpringFactor, sigma: float) -> np.ndarray | None:
+    """For a floating plate: ``u_a = K_a⁻¹ f`` with ``kfac`` set to ``K_a = K + Bᵀ diag(w) B``,
+    each row held by a spring ``w_i = ANCHOR·k_i`` (a soft anchor: the anchored plate's contact
+    set is the plate's but for rows within about ANCHOR of a change; the exact steps decide),
+    or None where ``K_a`` is (nearly) singular too (two inverse iterations, as
+    :func:`held_plate`): the rows, held, do not hold the plate, or too few of them to lift its
+    rigid motions above DUAL_DEFINITE·σ."""
+    w = ANCHOR * pb.k
+    kfac.set(w)
+    uf = kfac.solve(pb.f)
+    v = kfac.solve(pb.Kd * np.cos(np.arange(uf.size)))
+    v = kfac.solve(pb.Kd * v)
+    Bv = pb.B @ v
+    if float(v @ (pb.K @ v)) + float(Bv @ (w * Bv)) < DUAL_DEFINITE * sigma * float(v @ (pb.Kd * v)):
+        return None
+    return uf
+
+
 class _Columns:
     """The rows of the flexibility ``M = B K⁻¹ Bᵀ + diag(ρ)`` (symmetric: its columns) as
     Lawson–Hanson's method asks for them (:func:`lawson_hanson`): row ``j`` by a solve with the
@@ -241,8 +261,8 @@ class _Columns:
     wrong tool); or when the rows of M held (m doubles each: first_set's, in a buffer that
     doubles, and those computed ahead) would pass LH_MEMORY bytes per dof of the plate."""
 
-    def __init__(self, pb: ReducedQP, kfac: SpringFactor, budget: float) -> None:
-        self.pb, self.kfac, self.budget = pb, kfac, budget
+    def __init__(self, pb: ReducedQP, kfac: SpringFactor, budget: float, probe: bool = True) -> None:
+        self.pb, self.kfac, self.budget, self.probe = pb, kfac, budget, probe
         self.BT = pb.B.T.tocsc()
         self.kept: dict[int, np.ndarray] = {}
         self.start = time.perf_counter()
@@ -262,7 +282,7 @@ class _Columns:
             return None
         pressed = np.flatnonzero(force < 0)
         broad = pressed.size > LH_PRESSED * force.size
-        if self.asked == LH_PROBE + 1 and broad:
+        if self.probe and self.asked == LH_PROBE + 1 and broad:
             self.why = "pressed"
             return None
         row = self.kept.pop(j, None)
@@ -283,18 +303,19 @@ class _Columns:
 
 
 def lawson_hanson(pb: ReducedQP, kfac: SpringFactor, uf: np.ndarray, feas_tol: float, steps,
-                  info: dict) -> tuple:
+                  info: dict, budget: float | None = None) -> tuple:
     """Phase 1 of the sparse method for stiff rows on a held plate: Lawson–Hanson's first set
     (:func:`.dense.first_set`) with the rows of the flexibility ``M`` computed as the method
     frees them (:class:`_Columns`), never all of ``M``: where few of many rows end in contact
     (a post at every node: 209 of 16 129 at 128²) that is about as many solves as contacts.
-    Its time is held to LH_TIME factorisations of ``K`` (measured as it goes), and it stops
+    Its time is held to LH_TIME factorisations of ``K`` (``budget`` of them if given; measured
+    as it goes), and it stops
     early where most rows stay pressed (:class:`_Columns`). Returns ``(u, λ, A, steps)``, or
     where it gave up ``(None, λ, None, steps)``, ``λ`` the reactions of the set it reached (the
     projected Newton phase starts from them). ``info`` receives ``lh_sets``, ``lh_columns`` (rows of ``M``
     computed), ``lh_s`` (their solves' time) and, where it gave up, ``lh_gave_up`` ("time",
     "pressed" or "memory")."""
-    cols = _Columns(pb, kfac, LH_TIME * kfac.t_factor)
+    cols = _Columns(pb, kfac, (LH_TIME if budget is None else budget) * kfac.t_factor, probe=budget is None)
     d = pb.g - pb.B @ uf
     out: dict = {}
     A, n = first_set(cols, d, pb.c, feas_tol, 1e-12 * np.abs(pb.f).sum(), np.inf, out)
@@ -394,14 +415,17 @@ def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndar
 
 def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter, p, steps,
                kfac: SpringFactor | None = None, info: dict | None = None, lh: bool = True,
-               dual: bool = True, floating: bool = False) -> Outcome:
+               dual: bool = True, floating: bool = False, anchor: bool = True) -> Outcome:
     """The sparse method: a first phase where it applies (soft rows: :func:`newton_pcg`; stiff
     rows on a held plate with ``kfac``, a factor for ``K`` alone: :func:`lawson_hanson` if
     ``lh``, then, where it gave up, :func:`dual_newton` if ``dual``), then exact steps. ``info``
     (a dict) receives ``first_phase`` ("newton", "lawson-hanson", "dual" or "none"),
     ``first_phase_steps`` and, where Lawson–Hanson ran, ``lh_sets``, ``lh_columns`` and ``lh_s``.
     ``floating``: ``K`` is known to be singular (as where :func:`held_plate` finds it so): the
-    final set is checked to hold the plate (:func:`_free_mode`) before it is called optimal."""
+    final set is checked to hold the plate (:func:`_free_mode`) before it is called optimal.
+    ``anchor``: on such a plate, Lawson–Hanson (if ``lh``) runs on the anchored plate's
+    flexibility (:func:`anchored_plate`); where it gives up, the exact steps start from every
+    row (the projected Newton phase needs the plate's own ``K⁻¹``)."""
     info = {} if info is None else info
     info.update(first_phase="none", first_phase_steps=0)
     ex = Exchange(p)
@@ -415,19 +439,29 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         exact = True
         info.update(first_phase="newton", first_phase_steps=newton)
     elif A is None and kfac is not None:  # stiff rows, cold start: a first phase on the dual
-        uf = held_plate(pb, kfac, sigma)  # None: a floating plate, left to the exact steps
+        uf = held_plate(pb, kfac, sigma)  # None: a floating plate
         floating = floating or uf is None
+        anchored = False
+        if uf is None and lh and anchor:  # Lawson–Hanson on the anchored plate's flexibility
+            uf = anchored_plate(pb, kfac, sigma)
+            anchored = uf is not None
         first = lam0 = None
         spent = 0  # the sets Lawson–Hanson solved before it gave up (iterations count them)
         if uf is not None and lh:
-            first = lawson_hanson(pb, kfac, uf, feas_tol, steps, info)
-            phase = "lawson-hanson"
+            first = lawson_hanson(pb, kfac, uf, feas_tol, steps, info, LH_ANCHORED if anchored else None)
+            phase = "anchored lawson-hanson" if anchored else "lawson-hanson"
             if first[0] is None:  # gave up: its reactions start the projected Newton phase
                 first, lam0, spent = None, first[1], first[3]
-        if first is None and uf is not None and dual:
+        if first is None and uf is not None and dual and not anchored:  # (its ψ is the held plate's)
             first = dual_newton(pb, fac, kfac, W, sigma, feas_tol, steps, uf, lam0)
             phase = "dual"
         newton = spent
+        if first is None and anchored and lam0 is not None and np.any(lam0 > 0):
+            # Lawson–Hanson gave up on the anchored plate: the exact steps start from the rows it
+            # holds and the rows still pressed at its reactions (not from every row)
+            ua = kfac.solve(pb.f - pb.B.T @ lam0)
+            A = (lam0 > 0) | (pb.g + pb.rho * lam0 - pb.B @ ua <= 0)
+            info.update(first_phase="anchored lawson-hanson (gave up)")
         if first is not None:
             u, lam, A, k = first
             newton += k
