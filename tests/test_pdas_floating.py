@@ -231,3 +231,20 @@ def test_anchored_lawson_hanson_giving_up_starts_the_exact_steps_from_its_set(on
     assert res.extras["first_phase"] == "anchored lawson-hanson (gave up)" and res.extras["lh_gave_up"] == "memory"
     scale = np.abs(ref.reactions).max()
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
+
+
+def test_anchored_lawson_hanson_stops_on_a_broad_contact():
+    """A floating slab with a post on every interior node (24²): about 44 % of the rows end in
+    contact, one row a Lawson–Hanson step would take hundreds of steps; with 96 rows freed
+    more than 30 % are still pressed (LH_ANCHORED_PROBE), so it stops there and the exact
+    steps start from its set, ending at Lemke's answer."""
+    sc = F.grid_rigid(24, "all")
+    sc = pq.Scene(name="free-every-node", plate=sc.plate, mesh=sc.mesh, loads=sc.loads, supports=sc.supports)
+    res = solve(sc, options={"method": "sparse"})
+    ref = solve(sc, "lemke", "condensed", "high")
+    assert res.status == pq.Status.OPTIMAL and res.kkt.ok
+    assert res.extras["first_phase"] == "anchored lawson-hanson (gave up)" and res.extras["lh_gave_up"] == "pressed"
+    assert res.extras["lh_sets"] < 200
+    scale = np.abs(ref.reactions).max()
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
+    np.testing.assert_allclose(res.reactions.sum(), TOTAL, rtol=1e-9)

@@ -168,12 +168,17 @@ reactions to zero; ``ψ`` and the gaps at a clipped point take one solve with a 
 steps (the arc searched back to Armijo's decrease) from the lowest point met. It hands its set
 to the exact steps when a step leaves few rows infeasible or ``ψ`` stops moving (same slab: 21
 steps in all; from Lawson–Hanson's reactions on a stiff bed at 40², 4 steps instead of 15). Both
-need ``K`` definite (two inverse iterations tell, :func:`.sparse.held_plate`; a floating plate
-gets the anchored plate's set where method "auto" made it, above: with ``method="sparse"``, or
-above ``max_dense`` rows, plain PDAS); options ``lh_start=False`` and ``dual_start=False`` turn
-them off.
+need ``K`` definite (two inverse iterations tell, :func:`.sparse.held_plate`). On a floating
+plate (where method "auto" has not found the anchored plate's set already, above: with
+``method="sparse"``, or above ``max_dense`` rows) Lawson–Hanson runs on the anchored plate's
+flexibility instead (:func:`.sparse.anchored_plate`: each row held by a spring of
+``ANCHOR·k_i``), without the probe for a broad contact (the anchored plate starts sunk, every
+row pressed) and within ``LH_ANCHORED`` factorisations' time; where it gives up, the exact
+steps start from the rows it holds and those still pressed (the projected Newton phase needs
+the plate's own ``K⁻¹``). Options ``lh_start=False`` and ``dual_start=False`` turn the first
+phases off, ``anchor_start=False`` the anchored ones (plain PDAS from every row).
 ``extras["first_phase"]`` says which first phase ran ("newton", "lawson-hanson", "dual",
-"anchored" or "none"), ``extras["first_phase_steps"]`` its steps (``extras["anchored_s"]``: the
+"anchored", "anchored lawson-hanson", "anchored lawson-hanson (gave up)" or "none"), ``extras["first_phase_steps"]`` its steps (``extras["anchored_s"]``: the
 anchored plate's time, its factorisation included), and ``extras["lh_sets"]``,
 ``extras["lh_columns"]``, ``extras["lh_s"]`` the sets Lawson–Hanson solved, the rows of ``M`` it
 computed and their solves' time (``extras["lh_gave_up"]``: "time", "pressed" or "memory", where

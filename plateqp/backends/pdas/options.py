@@ -44,10 +44,12 @@ ACCURACY: dict[str, dict[str, float]] = {
 #: ``dual_start`` (sparse, stiff rows, cold start) where that is off or gave up, find it by
 #:                projected Newton on the dual energy (:func:`.sparse.dual_newton`); with both
 #:                False: plain PDAS from the two-sided problem (every row active).
-#: ``anchor_start`` (method "auto", stiff rows, K singular: a floating plate, cold start) find
-#:                the active set first as the condensed method's on the plate with the rows'
-#:                dofs anchored by soft springs (:func:`.dense.anchored_set`, ANCHOR), then
-#:                the sparse method's exact steps from it.
+#: ``anchor_start`` (stiff rows, K singular: a floating plate, cold start) find the active set
+#:                first on the plate with its rows anchored by soft springs (ANCHOR): method
+#:                "auto", up to ``max_dense`` rows, by the condensed method's dense steps
+#:                (:func:`.dense.anchored_set`); else by Lawson–Hanson on the anchored plate's
+#:                flexibility (:func:`.sparse.anchored_plate`, with ``lh_start``); then the
+#:                sparse method's exact steps from that set.
 SETTINGS: dict = {"method": "auto", "max_dense": "auto", "penalty": 1e8, "prox": 1e-12, "factor": "auto",
                   "p": 6, "max_rows": 100_000, "max_iter": None, "dual_start": True, "lh_start": True,
                   "anchor_start": True}
@@ -143,6 +145,12 @@ LH_BLOCK, LH_TIME, LH_PRESSED, LH_MEMORY = 8, 30.0, 0.5, 3000
 #: took 0.44 s in all, past 30 factorisations' time (it gave up at 381 sets, 1.33 s in all;
 #: plain 1.25 s); 128² with 63 × 63 posts, 624 sets, 6.7 s in all (plain 31 s).
 LH_ANCHORED = 100.0
+#: ... and it gives up where, (rows freed, fraction) = LH_ANCHORED_PROBE, more than that
+#: fraction of the rows are still pressed: the anchored plate starts sunk (every row pressed),
+#: so LH_PROBE's test would stop it on every plate; by 96 rows freed the pressed fraction is
+#: near the fraction that ends in contact (measured: held on one edge 0.15–0.16, final
+#: 0.15–0.22; floating 0.38–0.45, final 0.38–0.41; held plates 0.04–0.06).
+LH_ANCHORED_PROBE = (96, 0.3)
 #: (condensed) A trailing pivot L_ii², or the estimate of the trailing block's smallest
 #: eigenvalue (two inverse iterations), below this (K equilibrated to a unit diagonal) means K is
 #: singular to working precision (a floating plate): the sparse method takes over. Measured: a

@@ -26,6 +26,7 @@ from .options import (
     INNER_EXACT,
     INNER_LOOSE,
     LH_ANCHORED,
+    LH_ANCHORED_PROBE,
     LH_BLOCK,
     LH_MEMORY,
     LH_PRESSED,
@@ -283,6 +284,10 @@ class _Columns:
         pressed = np.flatnonzero(force < 0)
         broad = pressed.size > LH_PRESSED * force.size
         if self.probe and self.asked == LH_PROBE + 1 and broad:
+            self.why = "pressed"
+            return None
+        if not self.probe and self.asked == LH_ANCHORED_PROBE[0] + 1 and \
+                pressed.size > LH_ANCHORED_PROBE[1] * force.size:  # an anchored plate: see LH_ANCHORED
             self.why = "pressed"
             return None
         row = self.kept.pop(j, None)
