@@ -75,6 +75,7 @@ def test_anchored_first_set_then_exact_steps_agree_with_lemke(solved):
     assert res.status == pq.Status.OPTIMAL and res.kkt.ok
     assert res.extras["method"] == "sparse" and res.extras["first_phase"] == "anchored"
     assert "singular" in res.extras["condensed_skipped"]
+    assert res.extras["anchored_first_set"] == "lawson-hanson"  # its probe waits for 96 rows freed
     scale = np.abs(ref.reactions).max()
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
     np.testing.assert_array_equal(res.reactions > 1e-9 * scale, ref.reactions > 1e-9 * scale)

@@ -178,8 +178,10 @@ steps start from the rows it holds and those still pressed (the projected Newton
 the plate's own ``K⁻¹``). Options ``lh_start=False`` and ``dual_start=False`` turn the first
 phases off, ``anchor_start=False`` the anchored ones (plain PDAS from every row).
 ``extras["first_phase"]`` says which first phase ran ("newton", "lawson-hanson", "dual",
-"anchored", "anchored lawson-hanson", "anchored lawson-hanson (gave up)" or "none"), ``extras["first_phase_steps"]`` its steps (``extras["anchored_s"]``: the
-anchored plate's time, its factorisation included), and ``extras["lh_sets"]``,
+"anchored", "anchored lawson-hanson", "anchored lawson-hanson (gave up)" or "none"),
+``extras["first_phase_steps"]`` its steps (``extras["anchored_s"]``: the anchored plate's time,
+its factorisation included; ``extras["anchored_first_set"]``: how its dense steps started, as
+the condensed method's ``extras["first_set"]``), and ``extras["lh_sets"]``,
 ``extras["lh_columns"]``, ``extras["lh_s"]`` the sets Lawson–Hanson solved, the rows of ``M`` it
 computed and their solves' time (``extras["lh_gave_up"]``: "time", "pressed" or "memory", where
 it gave up: the rows it keeps may take ``LH_MEMORY`` bytes per dof).

@@ -25,7 +25,7 @@ import scipy.linalg as sla
 from ...errors import SingularMatrixError
 from ...linalg import SchurFactor, bindings
 from ..base import Status
-from .options import INNER_EXACT, LH_BUDGET, LH_OVERHEAD, LH_PROBE, PIVOT_TOL
+from .options import INNER_EXACT, LH_ANCHORED_PROBE, LH_BUDGET, LH_OVERHEAD, LH_PROBE, PIVOT_TOL
 from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
 
 __all__ = ["DenseDual", "NotApplicable", "anchored_set", "first_set", "run_dense"]
@@ -170,7 +170,7 @@ class DenseDual:
 
 
 def first_set(M, d: np.ndarray, c: np.ndarray, feas_tol: float, floor: float, budget: float,
-              out: dict | None = None) -> tuple[np.ndarray | None, int]:
+              out: dict | None = None, probe: int = LH_PROBE) -> tuple[np.ndarray | None, int]:
     r"""A first active set for the dual LCP ``gap = d + Mλ ≥ 0, λ ≥ 0, λ·gap = 0`` (``M``
     symmetric positive definite): Lawson–Hanson's active-set method on ``min ½λᵀMλ + dᵀλ,
     λ ≥ 0`` (their NNLS algorithm with ``M`` for ``AᵀA``; Lawson & Hanson, *Solving Least
@@ -194,8 +194,8 @@ def first_set(M, d: np.ndarray, c: np.ndarray, feas_tol: float, floor: float, bu
     solved, and in ``out`` (a dict, if given) ``"lam"``, the set's reactions (also where the
     function gave None: those of the set reached, a warm start). ``A`` is None
     when the work (3k² + 2mk + LH_OVERHEAD flops for a set of k rows) would pass ``budget``, or
-    when, after LH_PROBE rows, the rows freed plus the rows still pressed (about the final size)
-    would need more than it (a matrix ``M``), or when the function gave None. A row whose pivot
+    when, after ``probe`` rows (LH_PROBE), the rows freed plus the rows still pressed (about the
+    final size) would need more than it (a matrix ``M``), or when the function gave None. A row whose pivot
     vanishes (its row of ``M`` dependent on the free ones: two supports at one point) is never
     freed; the caller's block steps see to it.
     """
@@ -227,7 +227,7 @@ def first_set(M, d: np.ndarray, c: np.ndarray, feas_tol: float, floor: float, bu
         # past the probe, k + (rows still pressed) foretells the final size: each row freed
         # then relieves about one other (measured on post grids and beds; not on a post at
         # every node, where each relieves many: the function's own budget rules there)
-        if not lazy and (work > budget or (k >= LH_PROBE and k + int(bad.sum()) > kmax)):
+        if not lazy and (work > budget or (k >= probe and k + int(bad.sum()) > kmax)):
             return None, steps
         if k == cap:  # grow the buffers
             cap *= 2
@@ -281,9 +281,9 @@ def first_set(M, d: np.ndarray, c: np.ndarray, feas_tol: float, floor: float, bu
         gap = d + lam[F] @ R[:F.size] if F.size else d.astype(float, copy=True)
 
 
-def _start(pb: ReducedQP, cond: DenseDual, A, feas_tol) -> tuple[np.ndarray, int]:
-    """The dense method's first set (given; Lawson–Hanson's for stiff rows; else ``d < 0``) and
-    Lawson–Hanson's steps; ``cond.first`` says which."""
+def _start(pb: ReducedQP, cond: DenseDual, A, feas_tol, probe: int = LH_PROBE) -> tuple[np.ndarray, int]:
+    """The dense method's first set (given; Lawson–Hanson's for stiff rows, ``probe`` for
+    :func:`first_set`; else ``d < 0``) and Lawson–Hanson's steps; ``cond.first`` says which."""
     first = 0
     if A is not None:
         A = A.copy()
@@ -292,7 +292,7 @@ def _start(pb: ReducedQP, cond: DenseDual, A, feas_tol) -> tuple[np.ndarray, int
         A = cond.d < 0
         t0 = time.perf_counter()
         start, first = first_set(cond.M, cond.d, pb.c, feas_tol, 1e-12 * np.abs(pb.f).sum(),
-                                 LH_BUDGET * int(A.sum()) ** 3 / 3.0)
+                                 LH_BUDGET * int(A.sum()) ** 3 / 3.0, probe=probe)
         cond._dense_s += time.perf_counter() - t0
         cond.first = {"first_set": "d < 0 (lawson-hanson gave up)" if start is None else "lawson-hanson",
                       "first_set_steps": first}
@@ -308,8 +308,9 @@ def anchored_set(pb: ReducedQP, cond: DenseDual, feas_tol, max_iter, p, steps) -
     """A first set for a floating plate (``K`` singular, no dual LCP): the contact set of the
     anchored plate (``cond`` made with ``anchor > 0``), by the dense method's first set and
     block steps on its LCP, without exact steps; the sparse method's exact steps then solve
-    the plate itself from that set. Returns the set and the sets solved."""
-    A, first = _start(pb, cond, None, feas_tol)
+    the plate itself from that set. Returns the set and the sets solved. Lawson–Hanson's probe
+    waits for LH_ANCHORED_PROBE rows: the anchored plate starts sunk, every row pressed."""
+    A, first = _start(pb, cond, None, feas_tol, probe=LH_ANCHORED_PROBE[0])
     ex = Exchange(p)
     for it in range(1, max_iter + 1):
         lam, gap = cond.basic(A)

@@ -36,7 +36,7 @@ def auto_max_dense(n: int) -> int:
 
 
 def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: int, steps):
-    """``(A, sets, seconds)``: the anchored plate's contact set (:func:`.dense.anchored_set`),
+    """``(A, sets, seconds, how its first set was found)``: the anchored plate's contact set (:func:`.dense.anchored_set`),
     a first set for a floating plate; None where the anchored plate is singular too (the rows,
     held, do not hold it) or the condensed method does not apply to it."""
     t0 = time.perf_counter()
@@ -45,7 +45,7 @@ def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: 
     except NotApplicable:
         return None
     A, sets = anchored_set(pb, cond, feas_tol, max_iter, p, steps)
-    return A, sets, time.perf_counter() - t0
+    return A, sets, time.perf_counter() - t0, cond.first.get("first_set")
 
 
 def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> RawSolution:
@@ -156,7 +156,8 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             for key, val in kfac.stats.items():
                 stats[key] += val
         if anchored is not None:  # its set started the exact steps; its factorisation counts
-            stats.update(first_phase="anchored", first_phase_steps=anchored[1], anchored_s=anchored[2])
+            stats.update(first_phase="anchored", first_phase_steps=anchored[1], anchored_s=anchored[2],
+                         anchored_first_set=anchored[3])
             stats["factorisations"] += 1
             out.it += anchored[1]
         extras.update(method="sparse", factor=fac.method, **stats)
