@@ -75,7 +75,6 @@ def test_anchored_first_set_then_exact_steps_agree_with_lemke(solved):
     assert res.status == pq.Status.OPTIMAL and res.kkt.ok
     assert res.extras["method"] == "sparse" and res.extras["first_phase"] == "anchored"
     assert "singular" in res.extras["condensed_skipped"]
-    assert res.extras["anchored_first_set"] == "lawson-hanson"  # its probe waits for 96 rows freed
     scale = np.abs(ref.reactions).max()
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
     np.testing.assert_array_equal(res.reactions > 1e-9 * scale, ref.reactions > 1e-9 * scale)
@@ -249,3 +248,19 @@ def test_anchored_lawson_hanson_stops_on_a_broad_contact():
     scale = np.abs(ref.reactions).max()
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
     np.testing.assert_allclose(res.reactions.sum(), TOTAL, rtol=1e-9)
+
+
+@needs_cholmod
+def test_anchored_dense_first_set_by_lawson_hanson():
+    """900 posts under a slab held on one edge (32²): every row of the anchored plate starts
+    pressed, so Lawson–Hanson's probe waits for LH_ANCHORED_PROBE rows (at LH_PROBE it gave
+    up, and dense block steps from ``d < 0`` followed); its set then needs no exchange beyond
+    one. Against BPP on the condensed LCP (exact, another algorithm)."""
+    sc = one_edge(32, 20)
+    res = solve(sc)
+    ref = solve(sc, "bpp", "condensed", 1e-10)
+    assert res.status == pq.Status.OPTIMAL and res.extras["first_phase"] == "anchored"
+    assert res.extras["anchored_first_set"] == "lawson-hanson"
+    assert res.extras["factorisations"] == 2
+    scale = np.abs(ref.reactions).max()
+    np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * scale)
