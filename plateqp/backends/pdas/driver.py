@@ -36,9 +36,10 @@ def auto_max_dense(n: int) -> int:
 
 
 def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: int, steps):
-    """``(A, sets, seconds, how its first set was found)``: the anchored plate's contact set (:func:`.dense.anchored_set`),
-    a first set for a floating plate; None where the anchored plate is singular too (the rows,
-    held, do not hold it) or the condensed method does not apply to it."""
+    """``(A, sets, seconds, how its first set was found)``: the anchored plate's contact set
+    (:func:`.dense.anchored_set`), a first set for a floating plate; None where the anchored
+    plate is singular too (the rows, held, do not hold it) or the condensed method does not
+    apply to it."""
     t0 = time.perf_counter()
     try:
         cond = DenseDual(pb, max_dense, anchor=ANCHOR)
@@ -122,6 +123,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     steps: list[dict] | None = [] if trace else None
 
     out = anchored = None
+    singular = qp.singular is True  # K known singular: the caller's hint, or a failed factorisation
     extras: dict = {"max_dense": max_dense}
     if method in ("auto", "condensed"):
         try:
@@ -132,6 +134,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             if method == "condensed":
                 raise SolverError(f"pdas: the condensed method does not apply here: {why}") from None
             extras["condensed_skipped"] = str(why)
+            singular = singular or why.singular
             if (why.singular and method == "auto" and A is None and settings["anchor_start"]
                     and np.median(pb.rho * pb.k) < 1.0):
                 anchored = _anchored(pb, max_dense, tol["feas_tol"], max_iter, p, steps)
@@ -148,9 +151,8 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         if (lh or dual) and A is None and not np.all(pb.rho * pb.k >= 1.0):
             kfac = fac.twin()  # K alone: the same pattern, not built again
         info: dict = {}
-        floating = qp.singular is True or "K is singular" in extras.get("condensed_skipped", "")
         out = run_sparse(pb, fac, W, sigma, A, tol["feas_tol"], max_iter, p, steps, kfac, info, lh, dual,
-                         floating, bool(settings["anchor_start"]))
+                         singular, bool(settings["anchor_start"]))
         stats = dict(fac.stats, **info)
         if kfac is not None:  # the factor of K alone (phase 1's line search) counts too
             for key, val in kfac.stats.items():

@@ -12,8 +12,8 @@ import numpy as np
 from ..base import Status
 from .options import (
     ALPHA_MAX,
-    ANCHOR,
     ALPHA_MIN,
+    ANCHOR,
     ARMIJO,
     DUAL_DEFINITE,
     DUAL_FLAT,
@@ -313,9 +313,9 @@ def lawson_hanson(pb: ReducedQP, kfac: SpringFactor, uf: np.ndarray, feas_tol: f
     (:func:`.dense.first_set`) with the rows of the flexibility ``M`` computed as the method
     frees them (:class:`_Columns`), never all of ``M``: where few of many rows end in contact
     (a post at every node: 209 of 16 129 at 128²) that is about as many solves as contacts.
-    Its time is held to LH_TIME factorisations of ``K`` (``budget`` of them if given; measured
-    as it goes), and it stops
-    early where most rows stay pressed (:class:`_Columns`). Returns ``(u, λ, A, steps)``, or
+    Its time is held to LH_TIME factorisations of ``K`` (``budget`` of them if given: an
+    anchored plate, whose probe for a broad contact is LH_ANCHORED_PROBE; measured as it goes),
+    and it stops early where most rows stay pressed (:class:`_Columns`). Returns ``(u, λ, A, steps)``, or
     where it gave up ``(None, λ, None, steps)``, ``λ`` the reactions of the set it reached (the
     projected Newton phase starts from them). ``info`` receives ``lh_sets``, ``lh_columns`` (rows of ``M``
     computed), ``lh_s`` (their solves' time) and, where it gave up, ``lh_gave_up`` ("time",
@@ -429,8 +429,9 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
     ``floating``: ``K`` is known to be singular (as where :func:`held_plate` finds it so): the
     final set is checked to hold the plate (:func:`_free_mode`) before it is called optimal.
     ``anchor``: on such a plate, Lawson–Hanson (if ``lh``) runs on the anchored plate's
-    flexibility (:func:`anchored_plate`); where it gives up, the exact steps start from every
-    row (the projected Newton phase needs the plate's own ``K⁻¹``)."""
+    flexibility (:func:`anchored_plate`); where it gives up, the exact steps start from the
+    rows it holds and those still pressed at its reactions (the projected Newton phase needs
+    the plate's own ``K⁻¹``)."""
     info = {} if info is None else info
     info.update(first_phase="none", first_phase_steps=0)
     ex = Exchange(p)
@@ -487,7 +488,7 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         entered = False
         while True:
             if pending is not None:
-                d, pending, solves = pending, None, 0
+                d, pending, solves = pending, None, 2  # _free_mode's two solves
             else:
                 step = solve_active(pb, fac, W, A, u, lam, sigma, exact, null)
                 if step.ray is not None and not fac.clean:  # judge a free rigid motion on a clean factor
