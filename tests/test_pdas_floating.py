@@ -19,6 +19,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from test_pdas_sparse import (
+    wall_reactions,  # the held edge's upward forces, from the full stiffness
+)
 
 import plateqp as pq
 from plateqp import families as F
@@ -50,15 +53,6 @@ def one_edge(n: int, k: int) -> pq.Scene:
                     loads=sc.loads, supports=sc.supports)
 
 
-def wall_reactions(res):
-    """Upward forces of the held edge at its w-dofs, and where (from the full stiffness)."""
-    m = res.model
-    nd = m.element.ndof_node
-    e = m.K_full @ res.u - m.f_full  # −(edge reaction) at prescribed dofs
-    fixed_w = m.fixed[m.fixed % nd == 0]
-    return -e[fixed_w], m.grid.node_xy()[fixed_w // nd]
-
-
 SCENES = {"floating": lambda: F.floating(16, 9), "one edge": lambda: one_edge(16, 12)}
 
 
@@ -71,7 +65,7 @@ def solved(request):
 
 @needs_cholmod
 def test_anchored_first_set_then_exact_steps_agree_with_lemke(solved):
-    name, sc, res, plain, ref = solved
+    _, _, res, plain, ref = solved
     assert res.status == pq.Status.OPTIMAL and res.kkt.ok
     assert res.extras["method"] == "sparse" and res.extras["first_phase"] == "anchored"
     assert "singular" in res.extras["condensed_skipped"]
@@ -86,7 +80,7 @@ def test_anchored_first_set_then_exact_steps_agree_with_lemke(solved):
 
 @needs_cholmod
 def test_anchored_answer_carries_the_load_by_statics(solved):
-    name, sc, res, _, _ = solved
+    name, _, res, _, _ = solved
     xy = res.model.contacts.xy
     R = res.reactions
     if name == "floating":  # the posts carry everything

@@ -25,7 +25,14 @@ import scipy.linalg as sla
 from ...errors import SingularMatrixError
 from ...linalg import SchurFactor, bindings
 from ..base import Status
-from .options import INNER_EXACT, LH_ANCHORED_PROBE, LH_BUDGET, LH_OVERHEAD, LH_PROBE, PIVOT_TOL
+from .options import (
+    INNER_EXACT,
+    LH_ANCHORED_PROBE,
+    LH_BUDGET,
+    LH_OVERHEAD,
+    LH_PROBE,
+    PIVOT_TOL,
+)
 from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
 
 __all__ = ["DenseDual", "NotApplicable", "anchored_set", "first_set", "run_dense"]

@@ -10,6 +10,8 @@ import time
 import numpy as np
 
 from ..base import Status
+from .dense import first_set
+from .factor import SpringFactor
 from .options import (
     ALPHA_MAX,
     ALPHA_MIN,
@@ -42,8 +44,6 @@ from .options import (
     RAY_MESSAGE,
     SINGULAR_QUOTIENT,
 )
-from .dense import first_set
-from .factor import SpringFactor
 from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
 
 __all__ = ["SpringFactor", "run_sparse"]
