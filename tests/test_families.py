@@ -180,9 +180,9 @@ def choice(scene, backend="auto", formulation="auto"):
 
 
 @pytest.mark.parametrize("scene,backend,expected", [
-    # backend="auto" on a single solve: PDAS on the sparse primal; a floating plate: BPP on
-    # the condensed LCP while m ≤ 100 (repeated solves: see test_auto_rule_for_repeated_solves)
-    (lambda: F.floating(16, 5), "auto", ("bpp", "condensed")),  # m = 25
+    # backend="auto" on a single solve: PDAS on the sparse primal, a floating plate too
+    # (repeated solves: see test_auto_rule_for_repeated_solves)
+    (lambda: F.floating(16, 5), "auto", ("pdas", "primal")),  # m = 25
     (lambda: F.grid_rigid(16, 7), "auto", ("pdas", "primal")),  # m = 49
     (lambda: F.grid_rigid(64, 9), "auto", ("pdas", "primal")),  # m = 81
     (lambda: F.grid_rigid(32, 15), "auto", ("pdas", "primal")),  # m = 225
@@ -222,10 +222,9 @@ def test_auto_backend_for_an_explicit_formulation():
 
 def test_auto_end_to_end_agrees_with_an_exact_solver():
     """pq.solve with both "auto" reports what it chose, and the answer is Lemke's."""
-    for sc in (F.grid_rigid(16, 7), F.grid_rigid(16, 15), F.floating(16, 5)):  # m = 49, 225: primal; floating: condensed
+    for sc in (F.grid_rigid(16, 7), F.grid_rigid(16, 15), F.floating(16, 5)):  # m = 49, 225, 25
         res = solve(sc, backend="auto", formulation="auto", accuracy="high")
         ref = solve(sc, "lemke", "condensed")
         assert res.status == pq.Status.OPTIMAL
-        assert (res.backend, res.formulation) == (("bpp", "condensed") if sc.name.startswith("floating")
-                                                  else ("pdas", "primal"))
+        assert (res.backend, res.formulation) == ("pdas", "primal")
         np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * np.abs(ref.reactions).max())

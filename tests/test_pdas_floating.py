@@ -258,3 +258,15 @@ def test_anchored_dense_first_set_by_lawson_hanson():
     assert res.extras["factorisations"] == 2
     scale = np.abs(ref.reactions).max()
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-9 * scale)
+
+
+@needs_cholmod
+def test_auto_solves_a_floating_plate_by_pdas_to_a_tight_tolerance():
+    """backend="auto", one solve of a floating 128² slab on 5 × 5 posts at accuracy 1e-10: pdas
+    on the primal (the condensed LCP that auto took before ended INACCURATE here, KKT 1.7e-10:
+    the condensation of a singular K costs digits), OPTIMAL, and the posts carry the load."""
+    res = solve(F.floating(128, 5), backend="auto", formulation="auto", accuracy=1e-10)
+    assert (res.backend, res.formulation) == ("pdas", "primal")
+    assert res.status == pq.Status.OPTIMAL and res.kkt.worst <= 1e-10
+    assert res.extras["first_phase"] == "anchored"
+    np.testing.assert_allclose(res.reactions.sum(), TOTAL, rtol=1e-9)

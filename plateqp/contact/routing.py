@@ -26,8 +26,13 @@ from .scaling import Scaled
 #   cached and re-used by every solve that shares the model (a dense m × m solve per value
 #   instead of a factorisation: a sweep of 10 gaps at 128² took 0.45× PDAS's time), and BPP's answer did not depend on its warm start
 #   (bit-identical serial and parallel sweeps in tests/test_parallel.py, where warm-started
-#   PDAS differed at 1e-13). A floating plate (K singular: PDAS's dense method does not
-#   apply) keeps the condensed route too while m ≤ AUTO_LCP_MAX (not re-measured).
+#   PDAS differed at 1e-13). A single solve of a floating plate went to the condensed route
+#   too while m ≤ AUTO_LCP_MAX, while PDAS had no first phase for a singular K; since issue
+#   11's seventh session (the anchored first set) it goes to PDAS like any other: measured
+#   on families.floating(n, k), 9–81 posts, CPU medians of 3, accuracy 1e-10, PDAS took
+#   1.05–1.4× BPP's time (0.04–0.05 s at 32², 0.13–0.15 s at 64², 0.76–1.0 s at 128²), but at
+#   128² BPP's answers were INACCURATE (KKT 1–2e-10: the condensation of a singular K, shifted
+#   and unshifted, costs digits) where PDAS's were at 1–2e-11.
 # * which backend, read from the declared capabilities (plateqp.backends.base.Backend): an
 #   exact one that takes the formulation (answers exact to rounding at any tolerance), the
 #   warm-startable ones first (sweeps re-use their final active set; of the exact LCP solvers
@@ -69,12 +74,12 @@ def repeated_solves():
 def condensed_pays(data: Scaled, backend: str = "auto") -> bool:
     """True where formulation="auto" condenses (see the rules above).
 
-    ``backend="auto"``: m ≤ AUTO_LCP_MAX for repeated solves (:func:`repeated_solves`) or a
-    floating plate, else never; a named QP backend: m ≤ AUTO_CONDENSED_FRACTION × free dofs
-    and m ≤ AUTO_CONDENSED_MAX.
+    ``backend="auto"``: m ≤ AUTO_LCP_MAX for repeated solves (:func:`repeated_solves`), else
+    never; a named QP backend: m ≤ AUTO_CONDENSED_FRACTION × free dofs and m ≤
+    AUTO_CONDENSED_MAX.
     """
     if backend == "auto":
-        return data.m <= AUTO_LCP_MAX and (_REPEATED[0] > 0 or data.floating)
+        return data.m <= AUTO_LCP_MAX and _REPEATED[0] > 0
     return data.m <= min(AUTO_CONDENSED_MAX, AUTO_CONDENSED_FRACTION * data.n)
 
 
