@@ -108,21 +108,27 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     return Step(u, out, res, solves)
 
 
-def _free_mode(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray, null: list,
-               sigma: float) -> np.ndarray | None:
-    """A rigid motion the active rows ``A`` leave free (besides ``null``), or None: two inverse
-    iterations with ``H_A`` from a fixed start, judged by their Rayleigh quotient as
-    :func:`solve_active` judges its first correction (below SINGULAR_QUOTIENT)."""
-    WA = np.where(A, W, 0.0)
+def _softest(pb: ReducedQP, fac: SpringFactor, w: np.ndarray, null: list = ()) -> tuple[np.ndarray, float]:
+    """The softest mode of ``K + Bᵀ diag(w) B`` (besides ``null``), as two inverse iterations with
+    ``fac`` (a factor of that matrix plus ``σD``) from a fixed start find it, and its Rayleigh
+    quotient ``vᵀ(K + Bᵀ diag(w) B)v / vᵀDv`` (a rigid motion left free: about 0; a held plate:
+    ``λ_min ≫ σ``)."""
     v = np.cos(np.arange(pb.K.shape[0], dtype=float))
     for _ in range(2):
         v = _project(null, pb.Kd, fac.solve(pb.Kd * v))
     Dv = float(v @ (pb.Kd * v))
     Bv = pb.B @ v
-    energy = float(v @ (pb.K @ v)) + float(Bv @ (WA * Bv))
-    if Dv > 0 and energy < SINGULAR_QUOTIENT * sigma * Dv:
-        return v / np.abs(v).max()
-    return None
+    energy = float(v @ (pb.K @ v)) + float(Bv @ (w * Bv))
+    return v, (energy / Dv if Dv > 0 else np.inf)
+
+
+def _free_mode(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray, null: list,
+               sigma: float) -> np.ndarray | None:
+    """A rigid motion the active rows ``A`` leave free (besides ``null``), or None: the softest
+    mode of ``H_A`` (:func:`_softest`), judged by its Rayleigh quotient as :func:`solve_active`
+    judges its first correction (below SINGULAR_QUOTIENT·σ)."""
+    v, quotient = _softest(pb, fac, np.where(A, W, 0.0), null)
+    return v / np.abs(v).max() if quotient < SINGULAR_QUOTIENT * sigma else None
 
 
 def _free_motion(pb: ReducedQP, fac: SpringFactor, null: list, d: np.ndarray) -> np.ndarray:
@@ -217,35 +223,28 @@ def _dual_energy(pb: ReducedQP, uf: np.ndarray, lam: np.ndarray, u: np.ndarray) 
     return float(-0.5 * (pb.B.T @ lam) @ (uf + u) + 0.5 * lam @ (pb.rho * lam) + pb.g @ lam)
 
 
+def _held_by(pb: ReducedQP, kfac: SpringFactor, w: np.ndarray, sigma: float) -> np.ndarray | None:
+    """``K_w⁻¹ f`` with ``kfac`` set to ``K_w = K + Bᵀ diag(w) B``, or None where ``K_w`` is
+    (nearly) singular: its softest mode's Rayleigh quotient (:func:`_softest`) below
+    DUAL_DEFINITE·σ."""
+    kfac.set(w)
+    uf = kfac.solve(pb.f)
+    return None if _softest(pb, kfac, w)[1] < DUAL_DEFINITE * sigma else uf
+
+
 def held_plate(pb: ReducedQP, kfac: SpringFactor, sigma: float) -> np.ndarray | None:
     """``u_f = K⁻¹ f`` with ``kfac`` set to ``K`` alone, or None where ``K`` is (nearly)
-    singular: a floating plate, recognised by two inverse iterations (its softest mode's
-    Rayleigh quotient below DUAL_DEFINITE·σ). The stiff rows' first phases need a held plate."""
-    kfac.set(np.zeros(pb.m))
-    uf = kfac.solve(pb.f)
-    v = kfac.solve(pb.Kd * np.cos(np.arange(uf.size)))  # two inverse iterations: the softest mode of K
-    v = kfac.solve(pb.Kd * v)
-    if float(v @ (pb.K @ v)) < DUAL_DEFINITE * sigma * float(v @ (pb.Kd * v)):
-        return None
-    return uf
+    singular: a floating plate (:func:`_held_by`). The stiff rows' first phases need a held plate."""
+    return _held_by(pb, kfac, np.zeros(pb.m), sigma)
 
 
 def anchored_plate(pb: ReducedQP, kfac: SpringFactor, sigma: float) -> np.ndarray | None:
     """For a floating plate: ``u_a = K_a⁻¹ f`` with ``kfac`` set to ``K_a = K + Bᵀ diag(w) B``,
     each row held by a spring ``w_i = ANCHOR·k_i`` (a soft anchor: the anchored plate's contact
     set is the plate's but for rows within about ANCHOR of a change; the exact steps decide),
-    or None where ``K_a`` is (nearly) singular too (two inverse iterations, as
-    :func:`held_plate`): the rows, held, do not hold the plate, or too few of them to lift its
-    rigid motions above DUAL_DEFINITE·σ."""
-    w = ANCHOR * pb.k
-    kfac.set(w)
-    uf = kfac.solve(pb.f)
-    v = kfac.solve(pb.Kd * np.cos(np.arange(uf.size)))
-    v = kfac.solve(pb.Kd * v)
-    Bv = pb.B @ v
-    if float(v @ (pb.K @ v)) + float(Bv @ (w * Bv)) < DUAL_DEFINITE * sigma * float(v @ (pb.Kd * v)):
-        return None
-    return uf
+    or None where ``K_a`` is (nearly) singular too (:func:`_held_by`): the rows, held, do not
+    hold the plate, or too few of them to lift its rigid motions above DUAL_DEFINITE·σ."""
+    return _held_by(pb, kfac, ANCHOR * pb.k, sigma)
 
 
 class _Columns:
@@ -257,12 +256,14 @@ class _Columns:
 
     None (and ``why`` says which) once the method has taken ``budget`` seconds since this was
     made (its own steps included: on small plates they cost more than the solves); when,
-    asked for its LH_PROBE + 1-th row, more than LH_PRESSED of all rows are still pressed (a
-    broad contact, as on a stiff bed: most rows will end in contact, and one row a step is the
-    wrong tool); or when the rows of M held (m doubles each: first_set's, in a buffer that
+    asked for its ``probe[0] + 1``-th row, more than ``probe[1]`` of all rows are still pressed
+    (LH_PROBE and LH_PRESSED; LH_ANCHORED_PROBE for an anchored plate, which starts sunk: a broad
+    contact, as on a stiff bed: most rows will end in contact, and one row a step is the wrong
+    tool); or when the rows of M held (m doubles each: first_set's, in a buffer that
     doubles, and those computed ahead) would pass LH_MEMORY bytes per dof of the plate."""
 
-    def __init__(self, pb: ReducedQP, kfac: SpringFactor, budget: float, probe: bool = True) -> None:
+    def __init__(self, pb: ReducedQP, kfac: SpringFactor, budget: float,
+                 probe: tuple[int, float] = (LH_PROBE, LH_PRESSED)) -> None:
         self.pb, self.kfac, self.budget, self.probe = pb, kfac, budget, probe
         self.BT = pb.B.T.tocsc()
         self.kept: dict[int, np.ndarray] = {}
@@ -283,11 +284,7 @@ class _Columns:
             return None
         pressed = np.flatnonzero(force < 0)
         broad = pressed.size > LH_PRESSED * force.size
-        if self.probe and self.asked == LH_PROBE + 1 and broad:
-            self.why = "pressed"
-            return None
-        if not self.probe and self.asked == LH_ANCHORED_PROBE[0] + 1 and \
-                pressed.size > LH_ANCHORED_PROBE[1] * force.size:  # an anchored plate: see LH_ANCHORED
+        if self.asked == self.probe[0] + 1 and pressed.size > self.probe[1] * force.size:
             self.why = "pressed"
             return None
         row = self.kept.pop(j, None)
@@ -308,19 +305,22 @@ class _Columns:
 
 
 def lawson_hanson(pb: ReducedQP, kfac: SpringFactor, uf: np.ndarray, feas_tol: float, steps,
-                  info: dict, budget: float | None = None) -> tuple:
+                  info: dict, anchored: bool = False) -> tuple:
     """Phase 1 of the sparse method for stiff rows on a held plate: Lawson–Hanson's first set
     (:func:`.dense.first_set`) with the rows of the flexibility ``M`` computed as the method
     frees them (:class:`_Columns`), never all of ``M``: where few of many rows end in contact
     (a post at every node: 209 of 16 129 at 128²) that is about as many solves as contacts.
-    Its time is held to LH_TIME factorisations of ``K`` (``budget`` of them if given: an
-    anchored plate, whose probe for a broad contact is LH_ANCHORED_PROBE; measured as it goes),
-    and it stops early where most rows stay pressed (:class:`_Columns`). Returns ``(u, λ, A, steps)``, or
+    Its time is held to LH_TIME factorisations of ``K`` (LH_ANCHORED on an ``anchored`` plate,
+    :func:`anchored_plate`, whose probe for a broad contact is LH_ANCHORED_PROBE; measured as it
+    goes), and it stops early where most rows stay pressed (:class:`_Columns`). Returns ``(u, λ, A, steps)``, or
     where it gave up ``(None, λ, None, steps)``, ``λ`` the reactions of the set it reached (the
     projected Newton phase starts from them). ``info`` receives ``lh_sets``, ``lh_columns`` (rows of ``M``
     computed), ``lh_s`` (their solves' time) and, where it gave up, ``lh_gave_up`` ("time",
     "pressed" or "memory")."""
-    cols = _Columns(pb, kfac, (LH_TIME if budget is None else budget) * kfac.t_factor, probe=budget is None)
+    if anchored:
+        cols = _Columns(pb, kfac, LH_ANCHORED * kfac.t_factor, LH_ANCHORED_PROBE)
+    else:
+        cols = _Columns(pb, kfac, LH_TIME * kfac.t_factor)
     d = pb.g - pb.B @ uf
     out: dict = {}
     A, n = first_set(cols, d, pb.c, feas_tol, 1e-12 * np.abs(pb.f).sum(), np.inf, out)
@@ -454,7 +454,7 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         first = lam0 = None
         spent = 0  # the sets Lawson–Hanson solved before it gave up (iterations count them)
         if uf is not None and lh:
-            first = lawson_hanson(pb, kfac, uf, feas_tol, steps, info, LH_ANCHORED if anchored else None)
+            first = lawson_hanson(pb, kfac, uf, feas_tol, steps, info, anchored)
             phase = "anchored lawson-hanson" if anchored else "lawson-hanson"
             if first[0] is None:  # gave up: its reactions start the projected Newton phase
                 first, lam0, spent = None, first[1], first[3]
