@@ -270,3 +270,38 @@ def test_auto_solves_a_floating_plate_by_pdas_to_a_tight_tolerance():
     assert res.status == pq.Status.OPTIMAL and res.kkt.worst <= 1e-10
     assert res.extras["first_phase"] == "anchored"
     np.testing.assert_allclose(res.reactions.sum(), TOTAL, rtol=1e-9)
+
+
+def test_the_hold_check_finds_a_free_motion_on_a_woodbury_corrected_factor(monkeypatch):
+    """The final set's hold check (``_free_mode``) runs on the factor in hand, also where that is
+    a Woodbury correction of another set's factor. Four elastic posts (soft: a stiff row leaving
+    is refactorised, its downdate would lose too many digits), three in a line and one off it,
+    hold a free slab; the factor of that set corrected by one row (the off-line post leaves) is
+    the factor of three collinear posts, which leave the slab free to turn about their line.
+    The check must find that motion (statics: w vanishes on the line, K d = 0, B_A d = 0) and
+    find none where the four posts hold."""
+    from plateqp.backends.pdas import factor as pdas_factor
+    from plateqp.backends.pdas.reduced import ReducedQP
+    from plateqp.backends.pdas.sparse import _free_mode
+
+    base = F.floating(16, 9)
+    xy = np.array([[2.0, 4.0], [4.0, 4.0], [6.0, 4.0], [4.0, 6.0]])
+    sc = pq.Scene(name="three-in-a-row-and-one", plate=base.plate, mesh=base.mesh, loads=base.loads,
+                  supports=[pq.Support(x, y, gap=0.0) for x, y in xy])
+    pb = ReducedQP(Primal(Scaled.from_model(build_model(sc))).qp, 10**6)
+    sigma = 1e-12
+    W = 1e-2 * pb.k  # springs a hundred times softer than the plate under them
+    monkeypatch.setattr(pdas_factor, "LOWRANK_COST", 1e9)  # a small plate's solve costs as much as its factor
+    fac = pdas_factor.SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, "auto")
+    four = np.ones(4, dtype=bool)
+    fac.set(np.where(four, W, 0.0))
+    assert _free_mode(pb, fac, W, four, [], sigma) is None
+    three = np.array([True, True, True, False])
+    fac.set(np.where(three, W, 0.0))
+    assert fac.stats["factorisations"] == 1 and fac.stats["lowrank"] == 1 and not fac.clean
+    d = _free_mode(pb, fac, W, three, [], sigma)
+    assert d is not None
+    scale = np.abs(d).max()
+    assert np.abs(pb.B[:3] @ d).max() <= 1e-6 * scale  # w = 0 at the three posts on the line
+    assert abs(pb.B[3] @ d) >= 0.1 * scale  # the fourth post's point moves
+    assert np.abs(pb.K @ d).max() <= 1e-6 * np.abs(pb.K).max() * scale  # a rigid motion

@@ -545,10 +545,10 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
             if exact and not held:
                 # a floating plate: do the active rows hold it? A rigid motion the load barely
                 # works along can escape the first correction's test (the elastic part of that
-                # correction outweighs it): two inverse iterations with H_A find it
+                # correction outweighs it): two inverse iterations with H_A find it, on the
+                # factor in hand (a Woodbury correction or a downdate loses at most
+                # DOWNDATE_LOSS: a free motion still outgrows every held mode by λ/σ)
                 held = True
-                if not fac.clean:
-                    fac.refactor(np.where(A, W, 0.0))
                 pending = _free_mode(pb, fac, W, A, null, sigma)
                 if pending is not None:
                     continue
