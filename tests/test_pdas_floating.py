@@ -79,6 +79,25 @@ def test_anchored_first_set_then_exact_steps_agree_with_lemke(solved):
 
 
 @needs_cholmod
+def test_exact_steps_on_the_anchored_factorisation_or_their_own(solved):
+    """The floating slab's 81 posts cost little as a dense block: its exact steps run on the
+    anchored factorisation, trailing block replaced (one sparse factorisation in all); the
+    one-edge slab's 144 posts at 16² do not (TRAILING_SHARE): a sparse factorisation of their
+    own. Both answers are Lemke's (above); here, each route is taken where it should be, and
+    the floating slab's exact steps on a factorisation of their own give the same reactions."""
+    name, sc, res, _, ref = solved
+    trailing = name == "floating"
+    assert (res.extras["factor"] == "trailing") is trailing
+    assert res.extras["factorisations"] == (1 if trailing else 2)
+    if trailing:  # a sparse factorisation of their own, forced by naming the binding
+        binding = {"sksparse": "cholmod", "cvxopt": "cvxopt"}[bindings()[0]]
+        other = solve(sc, options={"factor": binding})
+        assert other.status == pq.Status.OPTIMAL and other.extras["factor"] == binding
+        scale = np.abs(ref.reactions).max()
+        np.testing.assert_allclose(other.reactions, res.reactions, rtol=0, atol=1e-9 * scale)
+
+
+@needs_cholmod
 def test_anchored_answer_carries_the_load_by_statics(solved):
     name, _, res, _, _ = solved
     xy = res.model.contacts.xy
@@ -305,3 +324,56 @@ def test_the_hold_check_finds_a_free_motion_on_a_woodbury_corrected_factor(monke
     assert np.abs(pb.B[:3] @ d).max() <= 1e-6 * scale  # w = 0 at the three posts on the line
     assert abs(pb.B[3] @ d) >= 0.1 * scale  # the fourth post's point moves
     assert np.abs(pb.K @ d).max() <= 1e-6 * np.abs(pb.K).max() * scale  # a rigid motion
+
+
+@needs_cholmod
+def test_trailing_factor_solves_the_active_set_matrix_of_a_floating_plate():
+    """The exact steps' factor on the anchored contacts-last factorisation of ``K + σ diag(K)``
+    (its trailing block replaced by a dense Cholesky of ``S + B_cᵀ diag(w) B_c``) solves
+    ``H(w) = K + σ diag(K) + Bᵀ diag(w) B``, the sparse method's matrix: checked against SciPy's sparse LU
+    of that matrix, built from K and B directly, for a set that holds the plate and for one
+    that leaves it free to turn (then H(w) is definite by σ alone, and both agree still)."""
+    from plateqp.backends.pdas.factor import TrailingFactor
+    from plateqp.backends.pdas.reduced import ReducedQP
+
+    pb = ReducedQP(Primal(Scaled.from_model(build_model(F.floating(16, 5)))).qp, 10**6)
+    c = np.unique(pb.B.indices)
+    sigma = 1e-12
+    schur = SchurFactor(pb.K, c, shift=pdas_options.ANCHOR, method=bindings()[0], diagonal=pb.Kd, prox=sigma)
+    fac = TrailingFactor(schur, pb.B)
+    rng = np.random.default_rng(3)
+    b = rng.standard_normal(pb.K.shape[0])
+    sig = sigma * pb.Kd
+    free = np.zeros(pb.m, dtype=bool)
+    free[[0, 1, 2, 3, 4]] = True  # one row of five posts: the plate turns about their line
+    for name, A, tol in (("held", rng.random(pb.m) < 0.5, 1e-10), ("free", free, 1e-6)):
+        A[0] = A[pb.m - 1] = A[4] = True if name == "held" else A[0]  # three corners: held
+        w = np.where(A, 1e8 * pb.k, 0.0)
+        fac.set(w)
+        H = sp.csc_matrix(pb.K + pb.B.T @ sp.diags(w) @ pb.B + sp.diags(sig))
+        ref = spla.spsolve(H, b)
+        x = fac.solve(b)
+        assert np.abs(x - ref).max() <= tol * np.abs(ref).max(), name
+        assert np.abs(H @ x - b).max() <= 1e-13 * abs(H).max() * np.abs(x).max(), name  # backward stable
+    assert fac.stats["trailing_factorisations"] == 2 and fac.stats["factorisations"] == 0
+
+
+@pytest.mark.parametrize("d", [0.0, 1e-10])
+def test_a_load_on_the_line_of_two_posts_does_no_work_along_the_turn_about_it(d):
+    """A point load on the line of two of four posts (64²): the anchored set (those two) leaves
+    the slab free to turn about their line. On the line the load does no work along that turn:
+    an equilibrium, the lever rule's reactions (5 kN on each of the two). 1e-10 of the slab
+    outside it, the load works along it: no equilibrium (unbounded, with a ray). The free
+    motion's own rounding makes Σ|f_j d_j| as large as |fᵀd| for a point load on the axis;
+    before FREE_FLOOR the first case said unbounded at 64² (4e-12 of Σ|f_j| max|d_j| there)."""
+    sc = pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(64, 64),
+                  loads=[pq.PointLoad(10.0, 0.75 + d, 0.5)],
+                  supports=[pq.Support(x, y) for x, y in [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]])
+    raw = pdas(_primal_qp(sc, True), accuracy="default", trace=True)
+    assert "singular" in [s["solve"] for s in raw.extras["trace"]]  # the turn was found and judged
+    if d > 0:
+        assert raw.status == pq.Status.UNBOUNDED and "ray" in raw.extras
+    else:
+        res = solve(sc, accuracy="default")
+        assert res.status == pq.Status.OPTIMAL
+        np.testing.assert_allclose(res.reactions, [0.0, 5.0, 5.0, 0.0], rtol=0, atol=1e-6 * 10.0)

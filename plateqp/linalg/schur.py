@@ -76,6 +76,10 @@ class SchurFactor:
     method : "auto" (the first CHOLMOD binding in use, else "blocks"), "sksparse",
         "cvxopt", or "blocks" (``S`` by solves with a :class:`Factor` of ``K_oo``).
     diagonal : ``diag(K)``, where the caller has it (it equilibrates ``K``).
+    prox : float
+        ``prox·diag(K)`` added on every unknown (``prox·I`` equilibrated) before the shift: the
+        factor, :meth:`schur` and :meth:`flexibility` are then those of ``K + prox·diag(K)``
+        (a proximal term a caller wants in every solve; CHOLMOD methods only).
 
     Raises
     ------
@@ -85,7 +89,7 @@ class SchurFactor:
     """
 
     def __init__(self, K, last, shift: float = 0.0, pivot_tol: float = 0.0, method: str = "auto",
-                 diagonal: np.ndarray | None = None) -> None:
+                 diagonal: np.ndarray | None = None, prox: float = 0.0) -> None:
         if method not in SCHUR_METHODS:
             raise ValueError(f"unknown method {method!r}; choose one of {SCHUR_METHODS}")
         self.K = sp.csc_matrix(K)
@@ -96,13 +100,15 @@ class SchurFactor:
         if mask.sum() != self.last.size:
             raise ValueError("the unknowns ordered last must be distinct")
         self.n, self.nl, self.no = n, self.last.size, n - self.last.size
-        self.shift = float(shift)
+        self.shift, self.prox = float(shift), float(prox)
         if method == "auto":
             from . import bindings  # read at every call: a test may switch one off
 
             libs = bindings()
             method = libs[0] if libs else "blocks"
         self.method = method
+        if self.prox and method == "blocks":
+            raise ValueError("prox needs a CHOLMOD method")
         self.s = equilibration(self.K, diagonal)
         self.stats = {"analyse_s": 0.0, "factor_s": 0.0, "extract_s": 0.0, "factorisations": 1, "solves": 0,
                       "solve_s": 0.0, "last": int(self.nl), "method": method}
@@ -131,8 +137,8 @@ class SchurFactor:
         A = lower(self.K, self.s, upper=chol.upper)  # one pass over K; the order is given to CHOLMOD
         order = chol.order(A)
         self.perm = np.concatenate([order[~self._mask[order]], self.last])
-        if self.shift:
-            A = A + sp.diags(np.where(self._mask, self.shift, 0.0), format="csc")
+        if self.shift or self.prox:
+            A = A + sp.diags(np.where(self._mask, self.shift, 0.0) + self.prox, format="csc")
             A.sort_indices()
         chol.analyse(A, order=self.perm)
         t1 = time.perf_counter()
@@ -299,7 +305,7 @@ class SchurFactor:
     def can_split(self) -> bool:
         """The factor solves in halves (:meth:`forward`, :meth:`backward`): CHOLMOD, unshifted,
         not spent."""
-        return self.chol is not None and not self.chol.spent and not self.shift
+        return self.chol is not None and not self.chol.spent and not self.shift and not self.prox
 
     def _usable(self) -> None:
         if not self.can_split:
@@ -309,8 +315,8 @@ class SchurFactor:
         """``K⁻¹ b`` (``b`` of shape (n,) or (n, k)), with ``refine`` refinement steps. With the
         factor itself while it solves; else (a cvxopt factor spent by reading it, or the
         blocks method) from a second factorisation of ``K``, made once."""
-        if self.shift:
-            raise ValueError("solve needs an unshifted factor (K definite)")
+        if self.shift or self.prox:
+            raise ValueError("solve needs an unshifted factor of K itself (K definite)")
         if self._solver is None:
             if self.chol is not None and not self.chol.spent:
                 self._solver = _Solver(self.K, self._raw_full)

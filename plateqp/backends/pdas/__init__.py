@@ -84,7 +84,12 @@ the rows act on held by a spring of ``ANCHOR·K_jj`` (``10⁻⁸``: the contacts
 that shift on its trailing diagonal, definite where the rows, held, hold the plate), found
 by the dense steps on its LCP without exact steps (:func:`.dense.anchored_set`); the sparse
 method's exact steps then solve the plate itself from that set (``extras["first_phase"] ==
-"anchored"``, option ``anchor_start``). Measured on a 128² slab with 30 × 30 posts (CPU, one
+"anchored"``, option ``anchor_start``), on the anchored factorisation itself where the rows'
+dofs are few enough (its trailing block replaced by the dense Cholesky of ``S + B_cᵀ W_A B_c``,
+:class:`.factor.TrailingFactor`; ``extras["factor"] == "trailing"``, its dense factorisations in
+``trailing_factorisations``; no second sparse factorisation: a floating 128² slab on 9 posts
+0.69 s → 0.43 s, on 900 posts 0.84 s → 0.70 s, held on one edge on 900 posts 1.14 s → 0.79 s,
+CPU, one run each), else on a sparse factorisation of their own. Measured on a 128² slab with 30 × 30 posts (CPU, one
 run): held on one edge only, 7.5 s (29 sets, one factorisation each) → 0.9 s (2
 factorisations); floating on the posts alone, 2.9 s → 0.9 s. With stiff rows (median ``ρ_i k_i < 1``: rigid posts) and no
 given set, the first set is found by Lawson–Hanson's method on the dual QP
@@ -196,8 +201,8 @@ does work along ``d`` (``fᵀd > 0``), then ``K d = 0``, ``G d ≤ 0``, ``qᵀd 
 that the QP is unbounded below, the plate cannot be held (``Status.UNBOUNDED``,
 ``extras["ray"]``; the contact driver turns it into :class:`~plateqp.errors.NoEquilibriumError`
 after its own statics check). Before it is judged, ``d`` is sharpened by inverse iteration with
-``H_A``. If the load does no work along it (``|fᵀd| ≤ FREE_WORK Σ|f_j d_j|``: a load balanced
-about a line of supports, or on a corner support), every ``u + t d`` solves the step equally
+``H_A``. If the load does no work along it (``|fᵀd| ≤ FREE_WORK Σ|f_j d_j| + FREE_FLOOR Σ|f_j| max|d_j|``:
+a load balanced about a line of supports, or on a corner support), every ``u + t d`` solves the step equally
 well: the corrections leave ``d`` out (projected off in the ``diag(K)`` metric, at most three
 such motions) and the method goes on; the reactions are unique, the deflection is not, and
 :func:`plateqp.contact.statics.settle` picks the canonical one (``deflection_unique = False``).

@@ -53,9 +53,11 @@ class DenseDual:
 
     ``anchor > 0``: the LCP of the plate with each of the rows' dofs held by a spring of
     ``anchor·K_jj`` (``K + anchor·diag(K)`` on those dofs: definite for a floating plate whose
-    rows, held, hold it), for :func:`anchored_set`; no exact steps (:meth:`exact` refuses)."""
+    rows, held, hold it), for :func:`anchored_set`; no exact steps (:meth:`exact` refuses);
+    ``prox``: with ``prox·diag(K)`` on every dof too (the sparse method's ``σ``), so that its
+    factor serves the exact steps after (:class:`.factor.TrailingFactor`)."""
 
-    def __init__(self, pb: ReducedQP, max_dense: int, anchor: float = 0.0) -> None:
+    def __init__(self, pb: ReducedQP, max_dense: int, anchor: float = 0.0, prox: float = 0.0) -> None:
         libs = bindings()
         if not libs:
             raise NotApplicable("no CHOLMOD binding (scikit-sparse or cvxopt) is in use here")
@@ -64,7 +66,8 @@ class DenseDual:
         if c.size > max_dense:
             raise NotApplicable(f"the rows touch {c.size} dofs (max_dense = {max_dense})")
         try:
-            self.fac = SchurFactor(pb.K, c, shift=anchor, pivot_tol=PIVOT_TOL, method=libs[0], diagonal=pb.Kd)
+            self.fac = SchurFactor(pb.K, c, shift=anchor, pivot_tol=PIVOT_TOL, method=libs[0], diagonal=pb.Kd,
+                                   prox=prox if anchor > 0 else 0.0)
         except SingularMatrixError as exn:
             raise NotApplicable(f"K is singular ({exn})", singular=True) from exn
         t0 = time.perf_counter()

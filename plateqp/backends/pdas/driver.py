@@ -11,7 +11,16 @@ import numpy as np
 from ...errors import ProblemError, SolverError
 from ..base import QP, RawSolution, Status, preset
 from .dense import DenseDual, NotApplicable, anchored_set, run_dense
-from .options import ACCURACY, ANCHOR, MAX_DENSE_AUTO, OPTIONS, SETTINGS
+from .factor import TrailingFactor
+from .options import (
+    ACCURACY,
+    ANCHOR,
+    MAX_DENSE_AUTO,
+    OPTIONS,
+    SETTINGS,
+    TRAILING_MAX,
+    TRAILING_SHARE,
+)
 from .reduced import ReducedQP, force_scale, natural_residuals
 from .sparse import SpringFactor, run_sparse
 
@@ -35,18 +44,29 @@ def auto_max_dense(n: int) -> int:
     return max(lo, min(hi, int(per_root * np.sqrt(n))))
 
 
-def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: int, steps):
-    """``(A, sets, seconds, how its first set was found)``: the anchored plate's contact set
+def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: int, steps, sigma: float):
+    """``(A, sets, seconds, how its first set was found, its SchurFactor)``: the anchored plate's contact set
     (:func:`.dense.anchored_set`), a first set for a floating plate; None where the anchored
     plate is singular too (the rows, held, do not hold it) or the condensed method does not
     apply to it."""
     t0 = time.perf_counter()
     try:
-        cond = DenseDual(pb, max_dense, anchor=ANCHOR)
+        cond = DenseDual(pb, max_dense, anchor=ANCHOR, prox=sigma)  # σ: its factor serves the exact steps
     except NotApplicable:
         return None
     A, sets = anchored_set(pb, cond, feas_tol, max_iter, p, steps)
-    return A, sets, time.perf_counter() - t0, cond.first.get("first_set")
+    return A, sets, time.perf_counter() - t0, cond.first.get("first_set"), cond.fac
+
+
+def _trailing_pays(schur) -> bool:
+    """The exact steps on the anchored factorisation, its trailing block replaced
+    (:class:`.factor.TrailingFactor`), cost less than on a sparse factorisation of their own
+    (:data:`.options.TRAILING_SHARE`)."""
+    if schur.chol is None or schur.chol.spent:
+        return False
+    flops = schur.chol.flops()
+    dense = schur.nl**3 / 3
+    return dense <= TRAILING_SHARE * flops if flops else schur.nl <= TRAILING_MAX
 
 
 def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> RawSolution:
@@ -137,7 +157,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             singular = singular or why.singular
             if (why.singular and method == "auto" and A is None and settings["anchor_start"]
                     and np.median(pb.rho * pb.k) < 1.0):
-                anchored = _anchored(pb, max_dense, tol["feas_tol"], max_iter, p, steps)
+                anchored = _anchored(pb, max_dense, tol["feas_tol"], max_iter, p, steps, sigma)
                 if anchored is not None:
                     A = anchored[0]
         else:
@@ -145,7 +165,15 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             extras.update(method="condensed", **cond.stats)
     if out is None:
         W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k))
-        fac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
+        schur = anchored[4] if anchored is not None else None
+        if anchored is not None:
+            anchored = anchored[:4]  # the anchored factorisation is not kept beside a sparse one
+        if schur is not None and settings["factor"] == "auto" and _trailing_pays(schur):
+            # the exact steps on the anchored factorisation, its trailing block replaced
+            fac = TrailingFactor(schur, pb.B)
+        else:
+            schur = None
+            fac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
         kfac = None
         lh, dual = bool(settings["lh_start"]), bool(settings["dual_start"])
         if (lh or dual) and A is None and not np.all(pb.rho * pb.k >= 1.0):

@@ -15,7 +15,7 @@ from ...errors import ProblemError, SingularMatrixError, SolverError
 from ...linalg import Cholesky, Factor, bindings
 from .options import DOWNDATE_LOSS, LOWRANK_COND, LOWRANK_COST, LOWRANK_MAX
 
-__all__ = ["SpringFactor"]
+__all__ = ["SpringFactor", "TrailingFactor"]
 
 
 class SpringFactor:
@@ -314,4 +314,90 @@ class SpringFactor:
         self.stats["solve_s"] += dt
         if self.lr is None:
             self.t_solve = dt
+        return x
+
+
+class TrailingFactor:
+    """Factor of ``H(w) = K + σ diag(K) + Bᵀ diag(w) B`` (:class:`SpringFactor`'s matrix) from the
+    anchored plate's contacts-last factorisation, for the sparse method's exact steps on a
+    floating plate.
+
+    ``schur`` (:class:`plateqp.linalg.SchurFactor`, made with ``prox=σ``) factorises
+    ``K̂ = K + σ diag(K)`` with the dofs ``c`` the rows act on ordered last and ``shift·I`` added
+    on their (equilibrated) diagonal: with ``P K̂ Pᵀ = L Lᵀ``, ``L_oo L_ooᵀ = K̂_oo`` is the plate
+    with those dofs held, and ``L_cc L_ccᵀ = S + shift·I`` (``S`` the Schur complement of ``K̂``
+    on ``c``). ``H(w)`` differs from ``K̂`` on ``c`` only, so its factor is ``L`` with the
+    trailing block replaced by the Cholesky factor of ``S_w = S + B_cᵀ diag(w) B_c`` (dense,
+    ``|c|³/3`` flops a set; no sparse analysis or factorisation at all): a solve is ``L``'s
+    forward half, ``z_c = L_cc y_c``, ``x_c = S_w⁻¹ z_c``, ``y_c = L_ccᵀ x_c``, ``L``'s backward
+    half. Where the active rows leave a rigid motion ``v`` free, ``H(w) v = σ diag(K) v``
+    exactly, as with :class:`SpringFactor` (the first correction, the hold check and the
+    free motion's sharpening rest on that). The same interface as :class:`SpringFactor`
+    (``set``, ``solve``, ``refactor``, ``clean``, ``stats``) for :func:`.sparse.run_sparse`;
+    exact, so ``clean``.
+    """
+
+    method = "trailing"
+
+    def __init__(self, schur, B: sp.csr_matrix) -> None:
+        if schur.chol is None or schur.chol.spent:
+            raise ValueError("TrailingFactor needs the SchurFactor's own CHOLMOD factor, not spent")
+        if not schur.prox > 0:
+            raise ValueError("TrailingFactor needs a SchurFactor made with prox = σ > 0")
+        self.schur = schur
+        L = schur.Lll
+        S = sla.blas.dsyrk(1.0, L, lower=1) if L.size else np.zeros((0, 0))
+        S = np.tril(S) + np.tril(S, -1).T
+        S[np.diag_indices_from(S)] -= schur.shift  # the Schur complement of K + σ diag(K), equilibrated
+        self.S = S
+        sc = schur.s[schur.last]
+        col = np.full(schur.n, -1, dtype=np.int64)
+        col[schur.last] = np.arange(schur.nl)
+        B = sp.csr_matrix(B)
+        if np.any(col[B.indices] < 0):
+            raise ValueError("the rows act on dofs that are not ordered last")
+        # the rows on the trailing dofs, equilibrated, columns in the order of `last`
+        self.Bc = sp.csr_matrix((B.data * sc[col[B.indices]], col[B.indices], B.indptr), shape=(B.shape[0], schur.nl))
+        self.w = self.target = None
+        self.t_factor = None
+        self._cho = None
+        # no sparse factorisation of its own: its dense ones are counted apart
+        self.stats = {"analyse_s": 0.0, "factorisations": 0, "factor_s": 0.0, "trailing_factorisations": 0,
+                      "trailing_s": 0.0, "solves": 0, "solve_s": 0.0}
+
+    clean = True  # the factor is always H(w)'s own
+
+    def refactor(self, w: np.ndarray) -> None:
+        t0 = time.perf_counter()
+        rows = np.flatnonzero(w)
+        Sw = self.S.copy()
+        if rows.size:
+            Br = self.Bc[rows]
+            Sw += (Br.T @ sp.diags(w[rows]) @ Br).toarray()
+        try:
+            self._cho = sla.cho_factor(Sw, lower=True, overwrite_a=True, check_finite=False)
+        except np.linalg.LinAlgError as exn:
+            raise SolverError(f"pdas: the active-set matrix is not positive definite ({exn})") from exn
+        dt = time.perf_counter() - t0
+        self.t_factor = dt
+        self.stats["trailing_factorisations"] += 1
+        self.stats["trailing_s"] += dt
+        self.w = self.target = w.copy()
+
+    def set(self, w: np.ndarray) -> None:
+        """Make the factor that of ``H(w)``."""
+        if self.w is None or not np.array_equal(w, self.w):
+            self.refactor(w)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        t0 = time.perf_counter()
+        sf = self.schur
+        s = sf.s if b.ndim == 1 else sf.s[:, None]
+        y = sf.chol.forward(s * b)
+        L, no = sf.Lll, sf.no
+        z = L @ y[no:]  # = (P D b)_c − L_co y_o
+        y[no:] = L.T @ sla.cho_solve(self._cho, z, check_finite=False)
+        x = s * sf.chol.backward(y)
+        self.stats["solves"] += 1
+        self.stats["solve_s"] += time.perf_counter() - t0
         return x

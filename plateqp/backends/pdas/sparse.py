@@ -22,6 +22,7 @@ from .options import (
     DUAL_RISES,
     DUAL_ROUNDING,
     DUAL_STEPS,
+    FREE_FLOOR,
     FREE_MOTIONS,
     FREE_SHARPEN,
     FREE_WORK,
@@ -517,11 +518,15 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
                 return Outcome(Status.ERROR, "the active rows leave a null direction of K that is not a "
                                "rigid motion of the plate: cannot go on", A, it=newton + it)
             work = float(pb.f @ d)
-            if work > FREE_WORK * float(np.abs(pb.f) @ np.abs(d)) and np.all(Bd <= 1e-9 * scale):
+            # rounding: the sum's own (FREE_WORK Σ|f_j d_j|), and d's, which for a load on the axis
+            # of d is all of Σ|f_j d_j| (FREE_FLOOR of the whole load moved by d's largest motion)
+            no_work = (FREE_WORK * float(np.abs(pb.f) @ np.abs(d))
+                       + FREE_FLOOR * float(np.abs(pb.f).sum()) * float(np.abs(d).max()))
+            if work > no_work and np.all(Bd <= 1e-9 * scale):
                 ray = np.zeros(pb.n)
                 ray[pb.keep] = d  # (d, 0): P (d, 0) = 0, G (d, 0) = B d ≤ 0, qᵀ(d, 0) = −fᵀd < 0
                 return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
-            if work < -FREE_WORK * float(np.abs(pb.f) @ np.abs(d)):  # the load pushes along −d
+            if work < -no_work:  # the load pushes along −d
                 hit = ~A & (Bd < -1e-9 * scale)
                 if hit.any():
                     A = A | hit
