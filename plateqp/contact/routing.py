@@ -30,9 +30,11 @@ from .scaling import Scaled
 #   too while m ≤ AUTO_LCP_MAX, while PDAS had no first phase for a singular K; since issue
 #   11's seventh session (the anchored first set) it goes to PDAS like any other: measured
 #   on families.floating(n, k), 9–81 posts, CPU medians of 3, accuracy 1e-10, PDAS took
-#   1.05–1.4× BPP's time (0.04–0.05 s at 32², 0.13–0.15 s at 64², 0.76–1.0 s at 128²), but at
-#   128² BPP's answers were INACCURATE (KKT 1–2e-10: the condensation of a singular K, shifted
-#   and unshifted, costs digits) where PDAS's were at 1–2e-11.
+#   1.05–1.4× BPP's time then (0.04–0.05 s at 32², 0.13–0.15 s at 64², 0.76–1.0 s at 128²),
+#   but at 128² BPP's answers were INACCURATE (KKT 1–2e-10: the condensation of a singular K,
+#   shifted and unshifted, costs digits) where PDAS's were at 1–2e-11. Since the eighth session
+#   PDAS's exact steps run on the anchored factorisation itself (pdas.factor.TrailingFactor):
+#   0.67–0.96× BPP's time (benchmarks/bench_floating.py, interleaved, results/floating-s26.csv).
 # * which backend, read from the declared capabilities (plateqp.backends.base.Backend): an
 #   exact one that takes the formulation (answers exact to rounding at any tolerance), the
 #   warm-startable ones first (sweeps re-use their final active set; of the exact LCP solvers

@@ -167,12 +167,12 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k))
         schur = anchored[4] if anchored is not None else None
         if anchored is not None:
-            anchored = anchored[:4]  # the anchored factorisation is not kept beside a sparse one
+            anchored = anchored[:4]
         if schur is not None and settings["factor"] == "auto" and _trailing_pays(schur):
             # the exact steps on the anchored factorisation, its trailing block replaced
             fac = TrailingFactor(schur, pb.B)
         else:
-            schur = None
+            schur = None  # released: the anchored factorisation is not kept beside a sparse one
             fac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
         kfac = None
         lh, dual = bool(settings["lh_start"]), bool(settings["dual_start"])
