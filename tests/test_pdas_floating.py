@@ -377,3 +377,18 @@ def test_a_load_on_the_line_of_two_posts_does_no_work_along_the_turn_about_it(d)
         res = solve(sc, accuracy="default")
         assert res.status == pq.Status.OPTIMAL
         np.testing.assert_allclose(res.reactions, [0.0, 5.0, 5.0, 0.0], rtol=0, atol=1e-6 * 10.0)
+
+
+def test_a_load_just_inside_two_posts_line_does_not_cycle():
+    """A point load 1e-10 of the slab inside the line of two of four posts, at 128²: the four
+    posts' exact step calls the far two infeasible (their reactions, 1e-9 kN by statics, are
+    at the exact step's rounding there), the two left leave the slab free to turn, and the
+    load's push along that turn (1e-10 of its work) brought the four back: before, a cycle
+    {4} → {3} → {2} → {4} to MAX_ITER. A set left on its exact step is not re-entered by a
+    push: the turn is kept out as a free motion, and the answer is the lever rule's."""
+    sc = pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(128, 128),
+                  loads=[pq.PointLoad(10.0, 0.75 - 1e-10, 0.5)],
+                  supports=[pq.Support(x, y) for x, y in [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]])
+    res = solve(sc, accuracy="default")
+    assert res.status == pq.Status.OPTIMAL and res.kkt.ok
+    np.testing.assert_allclose(res.reactions, [0.0, 5.0, 5.0, 0.0], rtol=0, atol=1e-8 * 10.0)

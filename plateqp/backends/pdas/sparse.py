@@ -436,6 +436,7 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
     info = {} if info is None else info
     info.update(first_phase="none", first_phase_steps=0)
     ex = Exchange(p)
+    left_exact: set = set()  # sets left on their exact step's verdict
     u = np.zeros(pb.K.shape[0])
     lam = np.zeros(pb.m)
     exact = False
@@ -485,6 +486,10 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         fac.set(np.where(A, W, 0.0))
         if prev is None or not np.array_equal(prev, A):
             null, held = [], not floating
+            # a set met again is classified on its exact step: a loose step's reactions can call a
+            # row that carries almost nothing infeasible every time (a load 1e-10 inside the hull
+            # of four posts at 128²: {4} → {3} → {2}, which leaves the turn that brings {4} back)
+            exact = exact or A.tobytes() in ex.seen
         prev = A.copy()
         entered = False
         while True:
@@ -528,15 +533,20 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
                 return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
             if work < -no_work:  # the load pushes along −d
                 hit = ~A & (Bd < -1e-9 * scale)
-                if hit.any():
+                if not hit.any():
+                    ray = np.zeros(pb.n)
+                    ray[pb.keep] = -d
+                    return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
+                if (A | hit).tobytes() not in left_exact:
                     A = A | hit
                     exact = False
                     entered = True
                     break
-                ray = np.zeros(pb.n)
-                ray[pb.keep] = -d
-                return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
-            # the load does no work along d: every u + t d is as good; keep d out of the steps
+                # those rows, in, made a set already solved and left on its exact step: the
+                # push is at rounding (a load 1e-10 inside the hull of four posts at 128²
+                # cycled {4} → {3} → {2} → {4}); d is kept out as a free motion, and the
+                # answer's stationarity residual shows the work left along it
+            # the load does no work along d (to rounding): every u + t d is as good; keep d out of the steps
             null.append(d)
         if entered:
             continue
@@ -561,6 +571,8 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
                 return Outcome(Status.OPTIMAL, "no infeasible row", A, u, lam, newton + it)
             exact = True  # the set looks right: solve it to rounding and look again
             continue
+        if exact:
+            left_exact.add(A.tobytes())
         exact = exact and int(bad.sum()) <= NEWTON_SETTLED  # a few rows at the end: stay exact
         A, mode = ex.next(A, bad)
         if steps is not None:
