@@ -207,7 +207,11 @@ well: the corrections leave ``d`` out (projected off in the ``diag(K)`` metric, 
 such motions) and the method goes on; the reactions are unique, the deflection is not, and
 :func:`plateqp.contact.statics.settle` picks the canonical one (``deflection_unique = False``).
 The answer's residuals are checked as always: the work left along ``d`` stays in the
-stationarity residual that decides ``OPTIMAL`` against ``INACCURATE``. The condensed method needs a definite ``K`` and leaves
+stationarity residual that decides ``OPTIMAL`` against ``INACCURATE``. Where the load pushes
+along ``−d`` and the rows it presses would make a set already left on its exact step, the push
+is taken as rounding and ``d`` kept out the same way (else a load 1e-10 inside the line of
+two posts cycled between the sets with and without the far posts), and a set met again is
+solved exactly before it is judged. The condensed method needs a definite ``K`` and leaves
 floating plates to the sparse one.
 
 Warm start and output

@@ -73,8 +73,10 @@ SINGULAR_QUOTIENT = 1.0
 #: (sparse) A rigid motion d the active rows leave free is one the load does no work along when
 #: |fᵀd| ≤ FREE_WORK Σ|f_j d_j| + FREE_FLOOR Σ|f_j| max|d_j| (rounding: the sum's own, and d's,
 #: which for a load on d's axis is all of Σ|f_j d_j|: measured 7e-13 of the second term for a
-#: point load on the line of two posts, 1.0e-10 for one 1e-10 of the plate's size off it, so a
-#: load within about FREE_FLOOR of the plate's size of the axis is on it); the steps then leave d out (any solution along it is
+#: point load on the line of two posts at 8², 3.5e-12 at 64², 2.7e-11 at 128², and 1.0e-10 for
+#: one 1e-10 of the plate's size off it, so a load within about FREE_FLOOR of the plate's size
+#: of the axis is on it; at 128² d's rounding is above that: a load on the line is called
+#: unbounded there); the steps then leave d out (any solution along it is
 #: one; contact.statics.settle picks the canonical deflection). At most FREE_MOTIONS of them (a
 #: plate has three rigid motions); each sharpened by FREE_SHARPEN inverse iterations.
 FREE_WORK, FREE_FLOOR, FREE_MOTIONS, FREE_SHARPEN = 1e-9, 1e-11, 3, 2
