@@ -194,15 +194,26 @@ class SchurFactor:
             v /= norm
         return float(np.linalg.norm(L.T @ v) ** 2)
 
-    def schur(self) -> np.ndarray:
-        """``S = K_ll − K_lo K_oo⁻¹ K_ol`` (dense, rows and columns in the order of ``last``)."""
+    def schur(self, equilibrated: bool = False) -> np.ndarray:
+        """``S = K_ll − K_lo K_oo⁻¹ K_ol`` (dense, rows and columns in the order of ``last``);
+        ``equilibrated``: in the factor's units (``D S D``, ``D = diag(s)`` on ``last``)."""
         L = self.Lll
         S = sla.blas.dsyrk(1.0, L, lower=1) if L.size else np.zeros((0, 0))
         S = np.tril(S) + np.tril(S, -1).T
         if self.shift:
             S[np.diag_indices_from(S)] -= self.shift
+        if equilibrated:
+            return S
         sl = 1.0 / self.s[self.last]
         return S * np.outer(sl, sl)
+
+    def rows_on_last(self, B) -> sp.csr_matrix:
+        """Rows ``B`` (m × n, acting on ``last`` only) as rows on ``last``, equilibrated:
+        ``B_l D_l`` (m × len(last), columns in the order of ``last``)."""
+        B = sp.csr_matrix(B)
+        if np.any(B.data[~self._mask[B.indices]] != 0):
+            raise ValueError("the rows act on unknowns that are not ordered last")
+        return sp.csr_matrix(B[:, self.last] @ sp.diags(self.s[self.last]))
 
     def flexibility(self, B, refine: int = 0, shifted: bool = False) -> np.ndarray:
         """``B K⁻¹ Bᵀ`` (dense m × m) for rows ``B`` (m × n, sparse) acting on ``last`` only.
@@ -223,8 +234,7 @@ class SchurFactor:
         if self.shift and not (shifted and refine == 0):
             raise ValueError("flexibility needs an unshifted factor (K definite)")
         B = sp.csr_matrix(B)
-        if np.any(B.data[~self._mask[B.indices]] != 0):
-            raise ValueError("the rows act on unknowns that are not ordered last")
+        Bl = self.rows_on_last(B)
         if refine > 0:
             m = B.shape[0]
             BT = B.T.tocsc()
@@ -233,7 +243,6 @@ class SchurFactor:
                 cols = slice(j0, min(m, j0 + BLOCK))
                 G[:, cols] = B @ self.solve(BT[:, cols].toarray(), refine=refine)
             return 0.5 * (G + G.T)
-        Bl = sp.csr_matrix(B[:, self.last] @ sp.diags(self.s[self.last]))
         m = Bl.shape[0]
         if m == 0:
             return np.zeros((0, 0))

@@ -345,19 +345,8 @@ class TrailingFactor:
         if not schur.prox > 0:
             raise ValueError("TrailingFactor needs a SchurFactor made with prox = σ > 0")
         self.schur = schur
-        L = schur.Lll
-        S = sla.blas.dsyrk(1.0, L, lower=1) if L.size else np.zeros((0, 0))
-        S = np.tril(S) + np.tril(S, -1).T
-        S[np.diag_indices_from(S)] -= schur.shift  # the Schur complement of K + σ diag(K), equilibrated
-        self.S = S
-        sc = schur.s[schur.last]
-        col = np.full(schur.n, -1, dtype=np.int64)
-        col[schur.last] = np.arange(schur.nl)
-        B = sp.csr_matrix(B)
-        if np.any(col[B.indices] < 0):
-            raise ValueError("the rows act on dofs that are not ordered last")
-        # the rows on the trailing dofs, equilibrated, columns in the order of `last`
-        self.Bc = sp.csr_matrix((B.data * sc[col[B.indices]], col[B.indices], B.indptr), shape=(B.shape[0], schur.nl))
+        self.S = schur.schur(equilibrated=True)  # the Schur complement of K + σ diag(K)
+        self.Bc = schur.rows_on_last(B)  # the rows on the trailing dofs, equilibrated
         self.w = self.target = None
         self.t_factor = None
         self._cho = None
