@@ -26,13 +26,16 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # b
     os.environ.setdefault(_var, "1")
 
 import argparse
-import csv
 import statistics
+import sys
 import time
 import warnings
 from pathlib import Path
 
 HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+from bench_fast import write_csv  # noqa: E402
+
 ROUTES = {"pdas": ("pdas", "primal"), "bpp": ("bpp", "condensed"), "auto": ("auto", None)}
 FIELDS = ("mesh", "k", "route", "cpu_s", "runs", "status", "kkt_max", "factor", "pdas_over_bpp")
 
@@ -95,11 +98,7 @@ def main() -> None:
                 print(f"| {n}² | {k} × {k} | {route} | {med[route]:.3f} | {row['status']} | {row['kkt_max']:.1e} "
                       f"| {row['factor']} | {ratio} |", flush=True)
     out = HERE / "results" / f"floating{'-' + args.tag if args.tag else ''}.csv"
-    out.parent.mkdir(exist_ok=True)
-    with out.open("w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=FIELDS)
-        w.writeheader()
-        w.writerows(rows)
+    write_csv(rows, out)  # every row has FIELDS, in that order
     print(f"wrote {out}")
 
 
