@@ -408,6 +408,25 @@ def test_the_primal_spring_block_and_its_leading_view_keep_k_as_stored():
     np.testing.assert_array_equal(_leading_block(C, np.arange(40)).toarray(), C.toarray()[:40, :40])
 
 
+def test_primal_with_springs_keeps_one_copy_of_k():
+    """With elastic supports the primal P is block_diag(K, I): the formulation's K is then read
+    back as a view of P's leading block (one copy of K alive, not two: 16 MB at 128² on the
+    bed), equal entry for entry to the scaled K it was built from."""
+    from plateqp.assembly import build_model
+    from plateqp.contact.formulations import formulate
+    from plateqp.contact.scaling import Scaled
+    from plateqp.families import bed
+
+    data = Scaled.from_model(build_model(bed(8)))
+    K0 = data.K.copy()
+    form = formulate(data, "primal")
+    P = form.qp.P
+    assert P.shape[0] > K0.shape[0]  # the spring block is there
+    assert np.shares_memory(data.K.data, P.data) and np.shares_memory(data.K.indices, P.indices)
+    assert data.K.nnz == K0.nnz and abs(data.K - K0).max() == 0
+    np.testing.assert_array_equal(data.K.indices, K0.indices)  # stored pattern and order kept
+
+
 def test_refinement_stops_at_rounding_and_not_before():
     """The stop test of the exact steps (Oettli–Prager's backward error): a step solved by
     SciPy's sparse LU (and refined) passes it; the same step moved by 1e-11 relative does not. And |K||u| by

@@ -59,6 +59,17 @@ def congruence(T: sp.spmatrix, K: sp.spmatrix, like: sp.spmatrix | None = None) 
     return add(out, sp.coo_matrix((np.zeros(Z.nnz), (Z.row, Z.col)), shape=Z.shape)).tocsr()
 
 
+def leading(P: sp.csc_matrix, k: int) -> sp.csc_matrix | None:
+    """``P[:k, :k]`` as a view of the CSC matrix P's arrays (no copy; stored entries and their
+    order kept), or None where P's first k columns hold a row past k (then it is no block)."""
+    end = P.indptr[k]
+    if end and P.indices[:end].max() >= k:
+        return None
+    K = sp.csc_matrix((P.data[:end], P.indices[:end], P.indptr[:k + 1]), shape=(k, k), copy=False)
+    K.has_sorted_indices = P.has_sorted_indices
+    return K
+
+
 def abs_matvec(K: sp.csc_matrix, x: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
     """``|K| x`` for symmetric ``K`` (CSC or CSR), a block of rows at a time: K's arrays read as
     CSR are K itself, so each block is ``chunk`` entries of |K| and gives its own rows (no

@@ -9,7 +9,7 @@ import scipy.sparse as sp
 
 from ...errors import SolverError
 from ...linalg import row_stiffness
-from ...linalg.pattern import abs_matvec
+from ...linalg.pattern import abs_matvec, leading
 from ..base import QP
 
 __all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "infeasible", "natural_residuals"]
@@ -25,10 +25,8 @@ def _leading_block(P: sp.csc_matrix, keep: np.ndarray) -> sp.csc_matrix:
     copy of K (65 MB and 0.1 s at 256²)."""
     k = keep.size
     if k and keep[-1] == k - 1:  # keep is sorted and distinct: 0 … k−1
-        end = P.indptr[k]
-        if end == 0 or P.indices[:end].max() < k:
-            K = sp.csc_matrix((P.data[:end], P.indices[:end], P.indptr[:k + 1]), shape=(k, k), copy=False)
-            K.has_sorted_indices = P.has_sorted_indices
+        K = leading(P, k)
+        if K is not None:
             return K
     return P[keep][:, keep].tocsc()
 
