@@ -115,9 +115,10 @@ def test_anchored_answer_carries_the_load_by_statics(solved):
     assert R.min() >= -1e-10 * R.max()
 
 
-def _primal_qp(scene, singular):
+def _primal_qp(scene, singular, null=False):
+    """The primal QP of ``scene`` with the hint ``singular``, and its rigid motions if ``null``."""
     qp = Primal(Scaled.from_model(build_model(scene))).qp
-    return QP(P=qp.P, q=qp.q, G=qp.G, h=qp.h, singular=singular)
+    return QP(P=qp.P, q=qp.q, G=qp.G, h=qp.h, singular=singular, null=qp.null if null else None)
 
 
 @needs_cholmod
@@ -358,21 +359,28 @@ def test_trailing_factor_solves_the_active_set_matrix_of_a_floating_plate():
     assert fac.stats["trailing_factorisations"] == 2 and fac.stats["factorisations"] == 0
 
 
-@pytest.mark.parametrize("d", [0.0, 1e-10])
-def test_a_load_on_the_line_of_two_posts_does_no_work_along_the_turn_about_it(d):
-    """A point load on the line of two of four posts (64²): the anchored set (those two) leaves
-    the slab free to turn about their line. On the line the load does no work along that turn:
-    an equilibrium, the lever rule's reactions (5 kN on each of the two). 1e-10 of the slab
-    outside it, the load works along it: no equilibrium (unbounded, with a ray). The free
-    motion's own rounding makes Σ|f_j d_j| as large as |fᵀd| for a point load on the axis;
-    before FREE_FLOOR the first case said unbounded at 64² (4e-12 of Σ|f_j| max|d_j| there)."""
-    sc = pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(64, 64),
+@pytest.mark.parametrize("n, d", [(64, 0.0), (64, 1e-10), (128, 0.0), (128, 1e-10)])
+def test_a_load_on_the_line_of_two_posts_does_no_work_along_the_turn_about_it(n, d):
+    """A point load on the line of two of four posts: the anchored set (those two) leaves the
+    slab free to turn about their line. On the line the load does no work along that turn: an
+    equilibrium, the lever rule's reactions (5 kN on each of the two). 1e-10 of the slab
+    outside it, the load works along it: no equilibrium (unbounded, with a ray: an exact rigid
+    motion, P d = 0 to rounding). The turn as the inverse iterations find it carries the
+    plate's softest elastic modes at their rounding, which for a point load on its axis is
+    all of fᵀd: before FREE_FLOOR the line said unbounded at 64² (4e-12 of Σ|f_j| max|d_j|
+    there), and at 128² (2.7e-11) until the QP named the plate's rigid motions (QP.null) and
+    the turn was taken as the exact one nearest it."""
+    sc = pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(n, n),
                   loads=[pq.PointLoad(10.0, 0.75 + d, 0.5)],
                   supports=[pq.Support(x, y) for x, y in [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]])
-    raw = pdas(_primal_qp(sc, True), accuracy="default", trace=True)
+    qp = _primal_qp(sc, True, null=True)
+    raw = pdas(qp, accuracy="default", trace=True)
     assert "singular" in [s["solve"] for s in raw.extras["trace"]]  # the turn was found and judged
     if d > 0:
         assert raw.status == pq.Status.UNBOUNDED and "ray" in raw.extras
+        ray = raw.extras["ray"]
+        assert np.abs(qp.P @ ray).max() <= 1e-12 * abs(qp.P).max() * np.abs(ray).max()  # exact: K d = 0
+        assert qp.q @ ray < 0 and np.all(qp.G @ ray <= 1e-12 * np.abs(qp.G @ ray).max())
     else:
         res = solve(sc, accuracy="default")
         assert res.status == pq.Status.OPTIMAL
@@ -392,3 +400,55 @@ def test_a_load_just_inside_two_posts_line_does_not_cycle():
     res = solve(sc, accuracy="default")
     assert res.status == pq.Status.OPTIMAL and res.kkt.ok
     np.testing.assert_allclose(res.reactions, [0.0, 5.0, 5.0, 0.0], rtol=0, atol=1e-8 * 10.0)
+
+
+def test_a_wrong_null_space_hint_is_refused():
+    """QP.null is a hint: pdas takes it only where K annihilates it to rounding and it is zero
+    on the separable (spring) variables; a wrong one (a random vector; a rigid motion with an
+    elastic support's variable set) is refused, and the answer is the one without the hint.
+    A hint of the wrong shape is a ProblemError."""
+    from plateqp.backends.pdas.reduced import ReducedQP
+    from plateqp.errors import ProblemError
+
+    sc = F.floating(8, 3)
+    qp = Primal(Scaled.from_model(build_model(sc))).qp
+    assert qp.null is not None and qp.null.shape[1] == 3
+    assert ReducedQP(qp, 10**6).rigid() is not None  # the formulation's own: taken
+    wrong = QP(P=qp.P, q=qp.q, G=qp.G, h=qp.h, singular=True,
+               null=np.random.default_rng(0).standard_normal(qp.null.shape))
+    assert ReducedQP(wrong, 10**6).rigid() is None
+    ref = pdas(_primal_qp(sc, True), accuracy=1e-10)
+    out = pdas(wrong, accuracy=1e-10)
+    assert out.status == ref.status == pq.Status.OPTIMAL
+    np.testing.assert_allclose(out.x, ref.x, rtol=0, atol=1e-9 * np.abs(ref.x).max())
+    el = pq.Scene(name="elastic", plate=sc.plate, mesh=sc.mesh, loads=sc.loads,
+                  supports=[pq.Support(s.x, s.y, gap=s.gap, stiffness=1e6) for s in sc.supports])
+    qe = Primal(Scaled.from_model(build_model(el))).qp
+    assert qe.null.shape[0] == qe.P.shape[0]  # P carries the springs' variables too: zero there
+    assert np.all(qe.null[-len(sc.supports):] == 0)
+    bad = qe.null.copy()
+    bad[-1, 0] = 1.0  # a spring's variable moved by a "rigid motion"
+    assert ReducedQP(QP(P=qe.P, q=qe.q, G=qe.G, h=qe.h, null=bad), 10**6).rigid() is None
+    assert ReducedQP(qe, 10**6).rigid() is not None
+    with pytest.raises(ProblemError, match="null"):
+        QP(P=qp.P, q=qp.q, G=qp.G, h=qp.h, null=qp.null[:-1])
+
+
+@pytest.mark.parametrize("n", [32, 64])
+def test_the_free_turns_work_is_taken_off_before_the_solve(n):
+    """Two posts on the line x = c of a floating slab carry a point load on that line (on an
+    element edge), two more posts on one side of it carry nothing: the slab may turn about the
+    line, and the exact steps keep that turn out. Statics: the lever rule along the line, the
+    far posts idle. Each correction solves with ``K + σD + B_Aᵀ W B_A``, nearly singular along
+    the turn; the residual's work along it (rounding of K u, 4e-12) came back from the solve
+    multiplied by 1/σ and, projected off after it, left the rest polluted: the residual grew
+    tenfold a correction and the answer ended 1.5e-7 off (INACCURATE at 1e-10). With that work
+    taken off the right-hand side first the corrections converge."""
+    c, y1, y2, y0, P = 41 / 64, 3 / 64, 51 / 64, 0.08083139542683387, 42.0
+    sc = pq.Scene(name="line", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n),
+                  loads=[pq.PointLoad(P, c, y0)],
+                  supports=[pq.Support(c, y1), pq.Support(c, y2), pq.Support(51 / 64, 0.143), pq.Support(51 / 64, 0.407)])
+    res = solve(sc, backend="pdas", accuracy=1e-10)
+    assert res.status == pq.Status.OPTIMAL and res.kkt.ok
+    lever = [P * (y2 - y0) / (y2 - y1), P * (y0 - y1) / (y2 - y1), 0.0, 0.0]
+    np.testing.assert_allclose(res.reactions, lever, rtol=0, atol=1e-9 * P)

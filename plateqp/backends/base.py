@@ -86,10 +86,18 @@ class QP:
     #: motions), False where it knows P definite, None (the default) where it does not say. A
     #: hint only: pdas skips a factorisation that would fail; no backend trusts it for an answer.
     singular: bool | None = None
+    #: (n, k) a basis of P's null space where the caller knows it exactly (a floating plate's
+    #: rigid motions, zero on every other variable), or None. A hint only: pdas checks that P
+    #: annihilates it before it judges the load's work along a free motion on it.
+    null: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.q = np.asarray(self.q, dtype=float).reshape(-1)
         n = self.q.shape[0]
+        if self.null is not None:
+            self.null = np.asarray(self.null, dtype=float)
+            if self.null.ndim != 2 or self.null.shape[0] != n or not np.all(np.isfinite(self.null)):
+                raise ProblemError(f"null must be a finite (n, k) array with n={n}, got shape {self.null.shape}")
         if self.P.shape != (n, n):
             raise ProblemError(f"P has shape {self.P.shape}, expected ({n}, {n})")
         for M, v, name in ((self.G, self.h, "G"), (self.A, self.b, "A")):

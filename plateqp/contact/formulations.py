@@ -132,7 +132,9 @@ class Primal(Formulation):
         q = np.concatenate([-data.f, np.zeros(ne)])
         T = sp.csr_matrix((-np.sqrt(data.rho[el]), (el, np.arange(ne))), shape=(m, ne))
         G = sp.hstack([data.B, T], format="csc")
-        super().__init__("primal", data, qp=QP(P=P, q=q, G=G, h=data.g0.copy(), singular=data.floating))
+        null = np.vstack([data.modes, np.zeros((ne, data.modes.shape[1]))]) if data.floating else None
+        super().__init__("primal", data, qp=QP(P=P, q=q, G=G, h=data.g0.copy(), singular=data.floating,
+                                                null=null))
         self._el = el
 
     def recover(self, raw: RawSolution) -> ContactSolution:

@@ -201,7 +201,12 @@ does work along ``d`` (``fᵀd > 0``), then ``K d = 0``, ``G d ≤ 0``, ``qᵀd 
 that the QP is unbounded below, the plate cannot be held (``Status.UNBOUNDED``,
 ``extras["ray"]``; the contact driver turns it into :class:`~plateqp.errors.NoEquilibriumError`
 after its own statics check). Before it is judged, ``d`` is sharpened by inverse iteration with
-``H_A``. If the load does no work along it (``|fᵀd| ≤ FREE_WORK Σ|f_j d_j| + FREE_FLOOR Σ|f_j| max|d_j|``:
+``H_A`` and, where the QP names the plate's rigid motions ``N`` (``QP.null``, which the primal
+formulation sets for a floating plate; checked to be ``P``'s null space to rounding before it
+is used), replaced by the exact one nearest it: its ``diag(K)``-projection onto the rigid motions
+that move no active row (``N`` times the null space of ``B_A N``; FREE_RIGID, RIGID_RANK), so
+that its work is the load's statics along an exact motion, free of ``d``'s own rounding (the
+plate's softest elastic modes, which grow with the mesh). If the load does no work along it (``|fᵀd| ≤ FREE_WORK Σ|f_j d_j| + FREE_FLOOR Σ|f_j| max|d_j|``:
 a load balanced about a line of supports, or on a corner support), every ``u + t d`` solves the step equally
 well: the corrections leave ``d`` out (projected off in the ``diag(K)`` metric, at most three
 such motions) and the method goes on; the reactions are unique, the deflection is not, and

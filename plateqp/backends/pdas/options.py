@@ -80,6 +80,11 @@ SINGULAR_QUOTIENT = 1.0
 #: one; contact.statics.settle picks the canonical deflection). At most FREE_MOTIONS of them (a
 #: plate has three rigid motions); each sharpened by FREE_SHARPEN inverse iterations.
 FREE_WORK, FREE_FLOOR, FREE_MOTIONS, FREE_SHARPEN = 1e-9, 1e-11, 3, 2
+#: Where the QP names the plate's rigid motions (:attr:`plateqp.backends.base.QP.null`), a free
+#: motion found by the inverse iterations is replaced by the exact rigid motion nearest it (its
+#: D-projection onto those that move no active row: the null space of ``B_A N``, singular values
+#: above RIGID_RANK of the largest), where it is within FREE_RIGID of it (D-norm, relative).
+FREE_RIGID, RIGID_RANK = 1e-6, 1e-9
 #: Refinement: at most this many solves per active set while it changes, and for the final set.
 INNER_LOOSE, INNER_EXACT = 2, 12
 #: (sparse) While the active set changes, refinement stops at this relative residual.

@@ -12,6 +12,10 @@ from ...linalg import row_stiffness
 from ...linalg.pattern import abs_matvec, leading
 from ..base import QP
 
+#: The QP's null-space hint is taken where K annihilates it to this fraction of |K||N| (a plate's
+#: rigid motions from its coordinates: about 1e-15 at 128²).
+NULL_ROUNDING = 1e-10
+
 __all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "infeasible", "natural_residuals"]
 
 #: A step is exact when its residuals are within this many ε of the terms that make them
@@ -98,6 +102,26 @@ class ReducedQP:
         self.k = row_stiffness(sp.diags(Kd), self.B, "diagonal")
         self.c = self.k / (1.0 + self.rho * self.k)  # in series with the row's spring
         self.P, self.q = P, qp.q
+        self._null, self._null_checked = qp.null, False
+
+    def rigid(self) -> np.ndarray | None:
+        """The QP's hint ``null`` (:attr:`QP.null`) on the coupled variables, once checked (on
+        first use): zero on the separable ones, and ``K`` annihilates it to rounding
+        (``|K N| ≤ NULL_ROUNDING · |K||N|`` column by column); None where there is none or it
+        fails (then nothing trusts it)."""
+        if not self._null_checked:
+            self._null_checked = True
+            N = self._null
+            if N is not None:
+                Nk = N[self.keep]
+                scale = np.abs(Nk).max(initial=0.0)
+                ok = scale > 0 and np.abs(N[self.sep]).max(initial=0.0) <= NULL_ROUNDING * scale
+                for j in range(Nk.shape[1] if ok else 0):
+                    bound = abs_matvec(self.K, np.abs(Nk[:, j])).max()
+                    ok = ok and np.abs(self.K @ Nk[:, j]).max() <= NULL_ROUNDING * bound
+                N = Nk if ok else None
+            self._null = N
+        return self._null
 
     def x(self, u: np.ndarray, lam: np.ndarray) -> np.ndarray:
         x = np.empty(self.n)
