@@ -302,7 +302,7 @@ def test_the_hold_check_finds_a_free_motion_on_a_woodbury_corrected_factor(monke
     find none where the four posts hold."""
     from plateqp.backends.pdas import factor as pdas_factor
     from plateqp.backends.pdas.reduced import ReducedQP
-    from plateqp.backends.pdas.sparse import _free_mode
+    from plateqp.backends.pdas.motions import free_mode as _free_mode
 
     base = F.floating(16, 9)
     xy = np.array([[2.0, 4.0], [4.0, 4.0], [6.0, 4.0], [4.0, 6.0]])

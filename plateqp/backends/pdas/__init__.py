@@ -246,7 +246,7 @@ Layout
 ------
 :mod:`.reduced` (the QP read back as a contact problem, :class:`~.reduced.ReducedQP`; the
 exchange rule), :mod:`.dense` (``method="condensed"``), :mod:`.sparse` (``method="sparse"``),
-:mod:`.driver` (the :func:`pdas` function), :mod:`.options` (presets and settings); this file
+:mod:`.motions` (its free rigid motions), :mod:`.factor` (its factors), :mod:`.driver` (the :func:`pdas` function), :mod:`.options` (presets and settings); this file
 holds the backend, :class:`PDAS`.
 """
 

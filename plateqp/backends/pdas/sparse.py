@@ -12,6 +12,7 @@ import numpy as np
 from ..base import Status
 from .dense import first_set
 from .factor import SpringFactor
+from .motions import deflate, exact_motion, free_mode, free_motion, project, softest
 from .options import (
     ALPHA_MAX,
     ALPHA_MIN,
@@ -24,8 +25,6 @@ from .options import (
     DUAL_STEPS,
     FREE_FLOOR,
     FREE_MOTIONS,
-    FREE_RIGID,
-    FREE_SHARPEN,
     FREE_WORK,
     INNER_EXACT,
     INNER_LOOSE,
@@ -44,7 +43,6 @@ from .options import (
     PCG_MAX,
     PCG_TOL,
     RAY_MESSAGE,
-    RIGID_RANK,
     SINGULAR_QUOTIENT,
 )
 from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
@@ -57,20 +55,6 @@ class Step:
 
     def __init__(self, u, lam, residual, solves, ray=None):
         self.u, self.lam, self.residual, self.solves, self.ray = u, lam, residual, solves, ray
-
-
-def _project(null: list, D: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``v`` without its components along the (``D``-orthonormal) free rigid motions ``null``."""
-    for n in null:
-        v = v - n * float(n @ (D * v))
-    return v
-
-
-def _deflate(null: list, D: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """``r`` without its work along the free rigid motions ``null`` (``nᵀr = 0`` after)."""
-    for n in null:
-        r = r - (D * n) * float(n @ r)
-    return r
 
 
 def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray, u: np.ndarray,
@@ -103,7 +87,7 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
         if exact and k >= 1 and at_rounding(pb, u, idx, BA, lamA, r_u, r_A):
             break  # another correction would not change the answer
         best = min(best, res)
-        du = _project(null, pb.Kd, fac.solve(_deflate(null, pb.Kd, r_u - BA.T @ (WA * r_A))))
+        du = project(null, pb.Kd, fac.solve(deflate(null, pb.Kd, r_u - BA.T @ (WA * r_A))))
         solves += 1
         if k == 0:
             Bdu = BA @ du
@@ -116,70 +100,6 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     out = np.zeros_like(lam)
     out[idx] = lamA
     return Step(u, out, res, solves)
-
-
-def _softest(pb: ReducedQP, fac: SpringFactor, w: np.ndarray, null: list = ()) -> tuple[np.ndarray, float]:
-    """The softest mode of ``K + Bᵀ diag(w) B`` (besides ``null``), as two inverse iterations with
-    ``fac`` (a factor of that matrix plus ``σD``) from a fixed start find it, and its Rayleigh
-    quotient ``vᵀ(K + Bᵀ diag(w) B)v / vᵀDv`` (a rigid motion left free: about 0; a held plate:
-    ``λ_min ≫ σ``)."""
-    v = np.cos(np.arange(pb.K.shape[0], dtype=float))
-    for _ in range(2):
-        v = _project(null, pb.Kd, fac.solve(pb.Kd * v))
-    Dv = float(v @ (pb.Kd * v))
-    Bv = pb.B @ v
-    energy = float(v @ (pb.K @ v)) + float(Bv @ (w * Bv))
-    return v, (energy / Dv if Dv > 0 else np.inf)
-
-
-def _free_mode(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray, null: list,
-               sigma: float) -> np.ndarray | None:
-    """A rigid motion the active rows ``A`` leave free (besides ``null``), or None: the softest
-    mode of ``H_A`` (:func:`_softest`), judged by its Rayleigh quotient as :func:`solve_active`
-    judges its first correction (below SINGULAR_QUOTIENT·σ)."""
-    v, quotient = _softest(pb, fac, np.where(A, W, 0.0), null)
-    return v / np.abs(v).max() if quotient < SINGULAR_QUOTIENT * sigma else None
-
-
-def _free_motion(pb: ReducedQP, fac: SpringFactor, null: list, d: np.ndarray) -> np.ndarray:
-    """The rigid motion ``d`` sharpened by inverse iteration with ``H_A`` (its error in the held
-    modes falls by ``σ/λ`` each time) and ``D``-normalised against ``null``."""
-    for _ in range(FREE_SHARPEN):
-        d = _project(null, pb.Kd, fac.solve(pb.Kd * d))
-        d /= np.sqrt(float(d @ (pb.Kd * d)))
-    return d
-
-
-def _exact_motion(pb: ReducedQP, A: np.ndarray, null: list, d: np.ndarray) -> np.ndarray | None:
-    """The free rigid motion ``d`` (from :func:`_free_motion`) replaced by the exact one nearest
-    it, where the QP names the plate's rigid motions ``N`` (:meth:`ReducedQP.rigid`): its
-    ``D``-projection onto ``N Z``, ``Z`` spanning the null space of ``B_A N`` (the rigid
-    motions that move no active row), projected off ``null`` and ``D``-normalised as ``d`` is.
-    None where there is no hint or ``d`` is not such a motion to FREE_RIGID. The load's work
-    along it is then its work along an exact rigid motion, rounding of the sum only: ``d``'s
-    own rounding (the plate's softest elastic modes, left in by the inverse iterations) grows
-    with the mesh, and for a point load on ``d``'s axis it was all of ``fᵀd`` (2.7e-11 of
-    ``Σ|f_j| max|d_j|`` at 128²: above FREE_FLOOR)."""
-    N = pb.rigid()
-    if N is None:
-        return None
-    BN = pb.B[A] @ N if A.any() else np.zeros((0, N.shape[1]))
-    if BN.shape[0]:
-        _, sv, Vt = np.linalg.svd(BN)
-        rank = int(np.sum(sv > RIGID_RANK * sv.max(initial=0.0))) if sv.max(initial=0.0) > 0 else 0
-        F = N @ Vt[rank:].T
-    else:
-        F = N
-    if F.shape[1] == 0:
-        return None
-    DF = pb.Kd[:, None] * F
-    df = F @ np.linalg.solve(F.T @ DF, DF.T @ d)
-    df = _project(null, pb.Kd, df)
-    e = d - df
-    size = float(df @ (pb.Kd * df))
-    if size == 0.0 or float(e @ (pb.Kd * e)) > FREE_RIGID**2 * float(d @ (pb.Kd * d)):
-        return None
-    return df / np.sqrt(size)
 
 
 def line_search(pb: ReducedQP, W: np.ndarray, u: np.ndarray, du: np.ndarray) -> float:
@@ -267,11 +187,11 @@ def _dual_energy(pb: ReducedQP, uf: np.ndarray, lam: np.ndarray, u: np.ndarray) 
 
 def _held_by(pb: ReducedQP, kfac: SpringFactor, w: np.ndarray, sigma: float) -> np.ndarray | None:
     """``K_w⁻¹ f`` with ``kfac`` set to ``K_w = K + Bᵀ diag(w) B``, or None where ``K_w`` is
-    (nearly) singular: its softest mode's Rayleigh quotient (:func:`_softest`) below
+    (nearly) singular: its softest mode's Rayleigh quotient (:func:`softest`) below
     DUAL_DEFINITE·σ."""
     kfac.set(w)
     uf = kfac.solve(pb.f)
-    return None if _softest(pb, kfac, w)[1] < DUAL_DEFINITE * sigma else uf
+    return None if softest(pb, kfac, w)[1] < DUAL_DEFINITE * sigma else uf
 
 
 def held_plate(pb: ReducedQP, kfac: SpringFactor, sigma: float) -> np.ndarray | None:
@@ -469,7 +389,7 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
     (a dict) receives ``first_phase`` ("newton", "lawson-hanson", "dual" or "none"),
     ``first_phase_steps`` and, where Lawson–Hanson ran, ``lh_sets``, ``lh_columns`` and ``lh_s``.
     ``floating``: ``K`` is known to be singular (as where :func:`held_plate` finds it so): the
-    final set is checked to hold the plate (:func:`_free_mode`) before it is called optimal.
+    final set is checked to hold the plate (:func:`free_mode`) before it is called optimal.
     ``anchor``: on such a plate, Lawson–Hanson (if ``lh``) runs on the anchored plate's
     flexibility (:func:`anchored_plate`); where it gives up, the exact steps start from the
     rows it holds and those still pressed at its reactions (the projected Newton phase needs
@@ -535,7 +455,7 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
         entered = False
         while True:
             if pending is not None:
-                d, pending, solves = pending, None, 2  # _free_mode's two solves
+                d, pending, solves = pending, None, 2  # free_mode's two solves
             else:
                 step = solve_active(pb, fac, W, A, u, lam, sigma, exact, null)
                 if step.ray is not None and not fac.clean:  # judge a free rigid motion on a clean factor
@@ -556,8 +476,8 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
                 exact = False
                 entered = True
                 break
-            d = _free_motion(pb, fac, null, d)  # sharpened: its work and K d judged on rounding
-            exact_d = _exact_motion(pb, A, null, d)  # the exact rigid motion, where the QP names them
+            d = free_motion(pb, fac, null, d)  # sharpened: its work and K d judged on rounding
+            exact_d = exact_motion(pb, A, null, d)  # the exact rigid motion, where the QP names them
             d = d if exact_d is None else exact_d
             Bd = pb.B @ d
             scale = np.abs(Bd).max(initial=0.0)
@@ -607,7 +527,7 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
                 # factor in hand (a Woodbury correction or a downdate loses at most
                 # DOWNDATE_LOSS: a free motion still outgrows every held mode by λ/σ)
                 held = True
-                pending = _free_mode(pb, fac, W, A, null, sigma)
+                pending = free_mode(pb, fac, W, A, null, sigma)
                 if pending is not None:
                     continue
             if exact:

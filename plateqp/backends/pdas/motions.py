@@ -1,0 +1,90 @@
+r"""Free rigid motions of a floating plate's active set: found (the softest mode of ``H_A`` by
+inverse iteration), sharpened, replaced by the exact rigid motion nearest them where the QP
+names the plate's rigid motions, and kept out of the exact steps' corrections (see the package
+docstring: "Singular steps and no equilibrium")."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .factor import SpringFactor
+from .options import FREE_RIGID, FREE_SHARPEN, RIGID_RANK, SINGULAR_QUOTIENT
+from .reduced import ReducedQP
+
+
+def project(null: list, D: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``v`` without its components along the (``D``-orthonormal) free rigid motions ``null``."""
+    for n in null:
+        v = v - n * float(n @ (D * v))
+    return v
+
+
+def deflate(null: list, D: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """``r`` without its work along the free rigid motions ``null`` (``nᵀr = 0`` after)."""
+    for n in null:
+        r = r - (D * n) * float(n @ r)
+    return r
+
+
+def softest(pb: ReducedQP, fac: SpringFactor, w: np.ndarray, null: list = ()) -> tuple[np.ndarray, float]:
+    """The softest mode of ``K + Bᵀ diag(w) B`` (besides ``null``), as two inverse iterations with
+    ``fac`` (a factor of that matrix plus ``σD``) from a fixed start find it, and its Rayleigh
+    quotient ``vᵀ(K + Bᵀ diag(w) B)v / vᵀDv`` (a rigid motion left free: about 0; a held plate:
+    ``λ_min ≫ σ``)."""
+    v = np.cos(np.arange(pb.K.shape[0], dtype=float))
+    for _ in range(2):
+        v = project(null, pb.Kd, fac.solve(pb.Kd * v))
+    Dv = float(v @ (pb.Kd * v))
+    Bv = pb.B @ v
+    energy = float(v @ (pb.K @ v)) + float(Bv @ (w * Bv))
+    return v, (energy / Dv if Dv > 0 else np.inf)
+
+
+def free_mode(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray, null: list,
+               sigma: float) -> np.ndarray | None:
+    """A rigid motion the active rows ``A`` leave free (besides ``null``), or None: the softest
+    mode of ``H_A`` (:func:`softest`), judged by its Rayleigh quotient as :func:`solve_active`
+    judges its first correction (below SINGULAR_QUOTIENT·σ)."""
+    v, quotient = softest(pb, fac, np.where(A, W, 0.0), null)
+    return v / np.abs(v).max() if quotient < SINGULAR_QUOTIENT * sigma else None
+
+
+def free_motion(pb: ReducedQP, fac: SpringFactor, null: list, d: np.ndarray) -> np.ndarray:
+    """The rigid motion ``d`` sharpened by inverse iteration with ``H_A`` (its error in the held
+    modes falls by ``σ/λ`` each time) and ``D``-normalised against ``null``."""
+    for _ in range(FREE_SHARPEN):
+        d = project(null, pb.Kd, fac.solve(pb.Kd * d))
+        d /= np.sqrt(float(d @ (pb.Kd * d)))
+    return d
+
+
+def exact_motion(pb: ReducedQP, A: np.ndarray, null: list, d: np.ndarray) -> np.ndarray | None:
+    """The free rigid motion ``d`` (from :func:`free_motion`) replaced by the exact one nearest
+    it, where the QP names the plate's rigid motions ``N`` (:meth:`ReducedQP.rigid`): its
+    ``D``-projection onto ``N Z``, ``Z`` spanning the null space of ``B_A N`` (the rigid
+    motions that move no active row), projected off ``null`` and ``D``-normalised as ``d`` is.
+    None where there is no hint or ``d`` is not such a motion to FREE_RIGID. The load's work
+    along it is then its work along an exact rigid motion, rounding of the sum only: ``d``'s
+    own rounding (the plate's softest elastic modes, left in by the inverse iterations) grows
+    with the mesh, and for a point load on ``d``'s axis it was all of ``fᵀd`` (2.7e-11 of
+    ``Σ|f_j| max|d_j|`` at 128²: above FREE_FLOOR)."""
+    N = pb.rigid()
+    if N is None:
+        return None
+    BN = pb.B[A] @ N if A.any() else np.zeros((0, N.shape[1]))
+    if BN.shape[0]:
+        _, sv, Vt = np.linalg.svd(BN)
+        rank = int(np.sum(sv > RIGID_RANK * sv.max(initial=0.0))) if sv.max(initial=0.0) > 0 else 0
+        F = N @ Vt[rank:].T
+    else:
+        F = N
+    if F.shape[1] == 0:
+        return None
+    DF = pb.Kd[:, None] * F
+    df = F @ np.linalg.solve(F.T @ DF, DF.T @ d)
+    df = project(null, pb.Kd, df)
+    e = d - df
+    size = float(df @ (pb.Kd * df))
+    if size == 0.0 or float(e @ (pb.Kd * e)) > FREE_RIGID**2 * float(d @ (pb.Kd * d)):
+        return None
+    return df / np.sqrt(size)
