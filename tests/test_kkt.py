@@ -159,3 +159,35 @@ def test_an_accuracy_below_the_rounding_floor_is_said_to_be_so():
     c = form.recover(raw)
     moved = kkt_report(d, ContactSolution(c.u * (1 + 1e-8), c.R, c.s), 1e-14)
     assert exact.status == pq.Status.OPTIMAL and not moved.at_floor and moved.stationarity > 10 * moved.floor
+
+
+@pytest.mark.parametrize("n, held", [(16, False), (64, True)])
+def test_a_load_on_a_post_is_not_inaccurate_and_a_pressed_post_still_fails(n, held):
+    """A point load exactly on one of four posts: by statics that post carries all of it and the
+    plate does not bend (its deflection is rounding: 1e-18 to 1e-25 m). The gap residuals were
+    judged against that deflection, and pdas's exact answer (reactions (P, 0, 0, 0) to the
+    digit) came back INACCURATE at 1e-6 (primal residual 2e-4 to 0.34: a gap error of 1e-22 m).
+    A gap error below what the stationarity's rounding floor can move the plate by (floor ×
+    the load's deflection scale), divided by the accuracy asked, is not resolvable: the
+    deflection scale is at least that. Now OPTIMAL at 1e-6 and 1e-10, and the same answer with
+    the plate pressed 1e-12 of the load's deflection scale into the idle posts still fails."""
+    import plateqp as pq
+
+    P = 10.0
+    sc = pq.Scene(name="on a post", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n),
+                  loads=[pq.PointLoad(P, 0.5, 0.5)], edges={"left": pq.Edge("simple")} if held else {},
+                  supports=[pq.Support(0.5, 0.5), pq.Support(0.25, 0.25), pq.Support(0.75, 0.25),
+                            pq.Support(0.5, 0.8)])
+    for accuracy in ("default", 1e-10):
+        res = pq.solve(sc, backend="pdas", accuracy=accuracy)
+        assert res.status == pq.Status.OPTIMAL and res.kkt.ok, res.kkt
+        np.testing.assert_allclose(res.reactions, [P, 0, 0, 0], rtol=0, atol=1e-9 * P)
+    d = Scaled.from_model(build_model(sc))
+    form = formulate(d, "primal")
+    c = form.recover(get_backend("pdas").solve(form.problem(frozenset({"qp"})), accuracy=1e-10))
+    assert kkt_report(d, c, 1e-10).ok
+    worst = 0.0
+    for sign in (1.0, -1.0):  # the plate moved by 1e-12 w_load at every node, one way: into the idle posts
+        u = c.u + sign * 1e-12 * d.w_load * d.is_w
+        worst = max(worst, kkt_report(d, ContactSolution(u, c.R, c.s), 1e-6).primal)
+    assert worst > 1e-6

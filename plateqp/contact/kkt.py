@@ -22,7 +22,10 @@ residuals alone cannot see reaction errors where supports are close together: me
 64² plate on a 30×30 support grid, Clarabel ended with gap-unit residuals of 3e-12 and
 reactions 1e-7 off; the natural residual sees that.
 
-with the deflection scale δ = max(‖B u‖∞, ‖g0‖∞, max |w| of the plate) and the force scale
+with the deflection scale δ = max(‖B u‖∞, ‖g0‖∞, max |w| of the plate, min(floor / tol, 1) w_load)
+(the last: a gap error below what the stationarity's rounding floor moves the plate by, floor ×
+the load's deflection scale ``Scaled.w_load``, cannot be resolved; it counts where the plate
+does not bend, as under a load exactly on a support) and the force scale
 ρ_R = max(‖R‖∞, 10⁻¹² ‖f‖₁), or ‖f‖₁ where every reaction is at most tol · ‖f‖₁ (the supports
 carry nothing to the accuracy asked: :func:`reaction_scale`).
 
@@ -83,6 +86,10 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     # 3e-4 of the load's scale). The part of st above its rounding floor is scaled so.
     floor = np.finfo(float).eps * np.linalg.norm(
         abs_matvec(data.K, np.abs(u)) + np.abs(data.f) + abs(data.B).T @ np.abs(R)) / force
+    # a gap error below what that floor moves the plate by (floor · w_load) is not resolvable:
+    # where the plate does not bend (a load on a post: δ 1e-18 m and less) the gap residuals of
+    # an exact answer were a large part of δ. δ is at least that motion ÷ tol (at most w_load)
+    delta = max(delta, min(floor / tol, 1.0) * data.w_load)
     st = max(st, (st - 10.0 * floor) * data.w_load / delta)
     gap = data.g0 + s - w
     rscale = reaction_scale(R, data.f, tol)
