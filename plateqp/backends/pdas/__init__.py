@@ -206,10 +206,12 @@ formulation sets for a floating plate; checked to be ``P``'s null space to round
 is used), replaced by the exact one nearest it: its ``diag(K)``-projection onto the rigid motions
 that move no active row (``N`` times the null space of ``B_A N``; FREE_RIGID, RIGID_RANK), so
 that its work is the load's statics along an exact motion, free of ``d``'s own rounding (the
-plate's softest elastic modes, which grow with the mesh). If the load does no work along it (``|fᵀd| ≤ FREE_WORK Σ|f_j d_j| + FREE_FLOOR Σ|f_j| max|d_j|``:
-a load balanced about a line of supports, or on a corner support), every ``u + t d`` solves the step equally
-well: the corrections leave ``d`` out (projected off in the ``diag(K)`` metric, at most three
-such motions) and the method goes on; the reactions are unique, the deflection is not, and
+plate's softest elastic modes, which grow with the mesh). If the load does no work along it
+(``|fᵀd| ≤ FREE_WORK Σ|f_j d_j| + FREE_FLOOR Σ|f_j| max|d_j|``: a load balanced about a line of
+supports, or on a corner support), every ``u + t d`` solves the step equally well: the
+corrections leave ``d`` out (projected off in the ``diag(K)`` metric, at most three such
+motions; and the residual's work along it taken off before each solve, which would return it
+multiplied by 1/σ) and the method goes on; the reactions are unique, the deflection is not, and
 :func:`plateqp.contact.statics.settle` picks the canonical one (``deflection_unique = False``).
 The answer's residuals are checked as always: the work left along ``d`` stays in the
 stationarity residual that decides ``OPTIMAL`` against ``INACCURATE``. Where the load pushes
@@ -246,8 +248,9 @@ Layout
 ------
 :mod:`.reduced` (the QP read back as a contact problem, :class:`~.reduced.ReducedQP`; the
 exchange rule), :mod:`.dense` (``method="condensed"``), :mod:`.sparse` (``method="sparse"``),
-:mod:`.motions` (its free rigid motions), :mod:`.factor` (its factors), :mod:`.driver` (the :func:`pdas` function), :mod:`.options` (presets and settings); this file
-holds the backend, :class:`PDAS`.
+:mod:`.motions` (its free rigid motions), :mod:`.factor` (its factors), :mod:`.driver` (the
+:func:`pdas` function), :mod:`.options` (presets and settings); this file holds the backend,
+:class:`PDAS`.
 """
 
 from __future__ import annotations
