@@ -115,6 +115,14 @@ def test_anchored_answer_carries_the_load_by_statics(solved):
     assert R.min() >= -1e-10 * R.max()
 
 
+def _four_posts(n, x):
+    """A 1 m slab (n × n) on four corner posts of [0.25, 0.75]², a 10 kN point load at (x, 0.5):
+    x = 0.75 puts it on the line of the two posts there."""
+    return pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(n, n),
+                    loads=[pq.PointLoad(10.0, x, 0.5)],
+                    supports=[pq.Support(x0, y0) for x0, y0 in [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]])
+
+
 def _primal_qp(scene, singular, null=False):
     """The primal QP of ``scene`` with the hint ``singular``, and its rigid motions if ``null``."""
     qp = Primal(Scaled.from_model(build_model(scene))).qp
@@ -194,9 +202,7 @@ def test_the_final_set_must_hold_a_floating_plate():
     show it. The final set's check (two inverse iterations with H_A) finds it: unbounded, with
     a ray, as Lemke and BPP say (tests/test_statics.py: exit code 3). Without that check the
     anchored route answered OPTIMAL."""
-    sc = pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(8, 8),
-                  loads=[pq.PointLoad(10.0, 0.75 + 1e-10, 0.5)],
-                  supports=[pq.Support(x, y) for x, y in [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]])
+    sc = _four_posts(8, 0.75 + 1e-10)
     raw = pdas(_primal_qp(sc, True), accuracy="default", trace=True)
     steps = [s["solve"] for s in raw.extras["trace"]]
     assert raw.status == pq.Status.UNBOUNDED and "ray" in raw.extras
@@ -370,9 +376,7 @@ def test_a_load_on_the_line_of_two_posts_does_no_work_along_the_turn_about_it(n,
     all of fᵀd: before FREE_FLOOR the line said unbounded at 64² (4e-12 of Σ|f_j| max|d_j|
     there), and at 128² (2.7e-11) until the QP named the plate's rigid motions (QP.null) and
     the turn was taken as the exact one nearest it."""
-    sc = pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(n, n),
-                  loads=[pq.PointLoad(10.0, 0.75 + d, 0.5)],
-                  supports=[pq.Support(x, y) for x, y in [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]])
+    sc = _four_posts(n, 0.75 + d)
     qp = _primal_qp(sc, True, null=True)
     raw = pdas(qp, accuracy="default", trace=True)
     assert "singular" in [s["solve"] for s in raw.extras["trace"]]  # the turn was found and judged
@@ -394,9 +398,7 @@ def test_a_load_just_inside_two_posts_line_does_not_cycle():
     load's push along that turn (1e-10 of its work) brought the four back: before, a cycle
     {4} → {3} → {2} → {4} to MAX_ITER. A set left on its exact step is not re-entered by a
     push: the turn is kept out as a free motion, and the answer is the lever rule's."""
-    sc = pq.Scene(name="posts", plate=pq.Plate(a=1.0, b=1.0, h=0.02, E=1e7, nu=0.3), mesh=pq.MeshSpec(128, 128),
-                  loads=[pq.PointLoad(10.0, 0.75 - 1e-10, 0.5)],
-                  supports=[pq.Support(x, y) for x, y in [(0.25, 0.25), (0.75, 0.25), (0.75, 0.75), (0.25, 0.75)]])
+    sc = _four_posts(128, 0.75 - 1e-10)
     res = solve(sc, accuracy="default")
     assert res.status == pq.Status.OPTIMAL and res.kkt.ok
     np.testing.assert_allclose(res.reactions, [0.0, 5.0, 5.0, 0.0], rtol=0, atol=1e-8 * 10.0)

@@ -45,17 +45,17 @@ def auto_max_dense(n: int) -> int:
 
 
 def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: int, steps, sigma: float):
-    """``(A, sets, seconds, how its first set was found, its SchurFactor)``: the anchored plate's contact set
-    (:func:`.dense.anchored_set`), a first set for a floating plate; None where the anchored
-    plate is singular too (the rows, held, do not hold it) or the condensed method does not
-    apply to it."""
+    """``((A, sets, seconds, how its first set was found), its SchurFactor)``: the anchored
+    plate's contact set (:func:`.dense.anchored_set`), a first set for a floating plate, and
+    the factorisation it was found on; None where the anchored plate is singular too (the rows,
+    held, do not hold it) or the condensed method does not apply to it."""
     t0 = time.perf_counter()
     try:
         cond = DenseDual(pb, max_dense, anchor=ANCHOR, prox=sigma)  # σ: its factor serves the exact steps
     except NotApplicable:
         return None
     A, sets = anchored_set(pb, cond, feas_tol, max_iter, p, steps)
-    return A, sets, time.perf_counter() - t0, cond.first.get("first_set"), cond.fac
+    return (A, sets, time.perf_counter() - t0, cond.first.get("first_set")), cond.fac
 
 
 def _trailing_pays(schur) -> bool:
@@ -142,7 +142,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             raise ProblemError(f"option active must be a bool array with one entry per row of G ({m})")
     steps: list[dict] | None = [] if trace else None
 
-    out = anchored = None
+    out = anchored = schur = None
     singular = qp.singular is True  # K known singular: the caller's hint, or a failed factorisation
     extras: dict = {"max_dense": max_dense}
     if method in ("auto", "condensed"):
@@ -157,17 +157,15 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             singular = singular or why.singular
             if (why.singular and method == "auto" and A is None and settings["anchor_start"]
                     and np.median(pb.rho * pb.k) < 1.0):
-                anchored = _anchored(pb, max_dense, tol["feas_tol"], max_iter, p, steps, sigma)
-                if anchored is not None:
+                got = _anchored(pb, max_dense, tol["feas_tol"], max_iter, p, steps, sigma)
+                if got is not None:
+                    anchored, schur = got
                     A = anchored[0]
         else:
             out = run_dense(pb, cond, A, tol["feas_tol"], max_iter, p, steps)
             extras.update(method="condensed", **cond.stats)
     if out is None:
         W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k))
-        schur = anchored[4] if anchored is not None else None
-        if anchored is not None:
-            anchored = anchored[:4]
         if schur is not None and settings["factor"] == "auto" and _trailing_pays(schur):
             # the exact steps on the anchored factorisation, its trailing block replaced
             fac = TrailingFactor(schur, pb.B)

@@ -71,13 +71,10 @@ def exact_motion(pb: ReducedQP, A: np.ndarray, null: list, d: np.ndarray) -> np.
     N = pb.rigid()
     if N is None:
         return None
-    BN = pb.B[A] @ N if A.any() else np.zeros((0, N.shape[1]))
-    if BN.shape[0]:
-        _, sv, Vt = np.linalg.svd(BN)
-        rank = int(np.sum(sv > RIGID_RANK * sv.max(initial=0.0))) if sv.max(initial=0.0) > 0 else 0
-        F = N @ Vt[rank:].T
-    else:
-        F = N
+    F = N
+    if A.any():  # the rigid motions that move no active row: N times the null space of B_A N
+        _, sv, Vt = np.linalg.svd(pb.B[A] @ N)
+        F = N @ Vt[int(np.sum(sv > RIGID_RANK * sv.max())):].T
     if F.shape[1] == 0:
         return None
     DF = pb.Kd[:, None] * F
