@@ -9,12 +9,16 @@ do so (a declared failure that stops failing fails the test, so the list stays t
 
 from __future__ import annotations
 
+import importlib.util
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 import plateqp as pq
-from plateqp.backends import get_backend, registry
+from plateqp.backends import get_backend, in_house, registry
 from plateqp.backends.base import LCP, QP, Backend, Status
 from plateqp.contact.formulations import FORMULATIONS
 from plateqp.errors import ProblemError
@@ -92,6 +96,7 @@ def test_a_module_giving_something_else_is_refused(monkeypatch):
 
     monkeypatch.setattr(pdas, "backends", lambda: [pdas])
     monkeypatch.setattr(B, "_registry", None)
+    monkeypatch.setattr(B, "_loaded", {})
     with pytest.raises(TypeError, match="Backend instances"):
         B.registry()
     monkeypatch.undo()
@@ -101,3 +106,54 @@ def test_a_module_giving_something_else_is_refused(monkeypatch):
 def test_unknown_backend_names_the_installed_ones():
     with pytest.raises(pq.SolverError, match="unknown backend 'nope'.*lemke"):
         get_backend("nope")
+
+
+def test_every_exact_backend_is_plateqps_own():
+    """``backend="auto"`` chooses among the exact backends from plateqp's own modules alone
+    (plateqp.backends.IN_HOUSE): that is right only while no other module declares one."""
+    reg, own = registry(), in_house()
+    assert {"lemke", "bpp", "pdas"} <= set(own)
+    assert all(reg[n] is b for n, b in own.items())
+    assert [n for n, b in reg.items() if b.exact and n not in own] == []
+    assert list(own) == [n for n in reg if n in own]  # the registry's order
+
+
+THIRD_PARTY = ("cvxpy", "qpsolvers", "osqp", "clarabel")
+
+
+@pytest.mark.skipif(not any(importlib.util.find_spec(m) for m in THIRD_PARTY),
+                    reason="no third-party solver installed: nothing that could be imported")
+def test_a_solve_with_plateqps_own_backends_imports_no_third_party_solver():
+    """A fresh process's first solve with ``auto`` or an in-house backend imported every
+    backend module, cvxpy among them (0.5 s of a 0.8 s first solve at 128²): now only what it uses."""
+    code = ("import sys, plateqp as pq\n"
+            "from plateqp.families import grid_rigid\n"
+            "s = grid_rigid(8, 3)\n"
+            "for b in ('auto', 'pdas', 'bpp', 'lemke'):\n"
+            "    assert pq.solve(s, backend=b).status.name == 'OPTIMAL'\n"
+            f"print(sorted(m for m in {THIRD_PARTY!r} if m in sys.modules))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_a_backend_of_another_family_is_found_by_its_name_alone():
+    """``get_backend`` imports the module a name's family points to (``cvxpy:SCS`` → cvxpy's)
+    before it would import every module: one installed backend of each family is found that
+    way, in a fresh process, and is the registry's."""
+    first = {}  # one installed backend of each other family
+    for n in INSTALLED:
+        if n not in in_house():
+            first.setdefault(n.split(":")[0], n)
+    others = list(first.values())
+    if not others:
+        pytest.skip("no third-party backend installed")
+    code = ("import sys\n"
+            "from plateqp.backends import _loaded, get_backend, registry\n"
+            "found = {n: get_backend(n) for n in sys.argv[1:]}\n"
+            "print(len(_loaded))\n"
+            "assert all(registry()[n] is b for n, b in found.items())\n")
+    for name in others:
+        out = subprocess.run([sys.executable, "-c", code, name], capture_output=True, text=True, timeout=300)
+        assert out.returncode == 0, (name, out.stderr)
+        assert int(out.stdout.split()[0]) < 9, name  # not every module: the in-house ones and its family's

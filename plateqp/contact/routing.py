@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import contextlib
 
-from ..backends import get_backend, registry
+from ..backends import get_backend, in_house, registry
 from ..errors import ProblemError, SolverError
 from .formulations import FORMULATIONS
 from .scaling import Scaled
@@ -92,8 +92,9 @@ def _first_installed(names: tuple[str, ...]) -> str | None:
 def exact_backends(formulation: str, data: Scaled | None = None) -> list[str]:
     """The installed backends declared ``exact`` that take ``formulation``, the warm-startable
     first (then in registry order); with ``data``, an exact QP backend only while the contact
-    rows are at most the dofs."""
-    found = [b for b in registry().values() if getattr(b, "exact", False) and b.available()
+    rows are at most the dofs. Every exact backend is plateqp's own (:data:`plateqp.backends.
+    IN_HOUSE`): no third-party solver module is imported to find them."""
+    found = [b for b in in_house().values() if getattr(b, "exact", False) and b.available()
              and formulation in formulations_for(b)
              and (data is None or "lcp" in b.accepts or data.m <= data.n)]
     return [b.name for b in sorted(found, key=lambda b: not getattr(b, "warm_start", False))]
