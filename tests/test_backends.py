@@ -95,8 +95,8 @@ def test_a_module_giving_something_else_is_refused(monkeypatch):
     from plateqp.backends import pdas
 
     monkeypatch.setattr(pdas, "backends", lambda: [pdas])
-    monkeypatch.setattr(B, "_registry", None)
-    monkeypatch.setattr(B, "_loaded", {})
+    for name, fresh in (("_known", {}), ("_names", {}), ("_complete", False)):  # nothing imported yet
+        monkeypatch.setattr(B, name, fresh)
     with pytest.raises(TypeError, match="Backend instances"):
         B.registry()
     monkeypatch.undo()
@@ -149,9 +149,9 @@ def test_a_backend_of_another_family_is_found_by_its_name_alone():
     if not others:
         pytest.skip("no third-party backend installed")
     code = ("import sys\n"
-            "from plateqp.backends import _loaded, get_backend, registry\n"
+            "from plateqp.backends import _names, get_backend, registry\n"
             "found = {n: get_backend(n) for n in sys.argv[1:]}\n"
-            "print(len(_loaded))\n"
+            "print(len(_names))\n"
             "assert all(registry()[n] is b for n, b in found.items())\n")
     for name in others:
         out = subprocess.run([sys.executable, "-c", code, name], capture_output=True, text=True, timeout=300)

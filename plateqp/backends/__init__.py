@@ -23,49 +23,60 @@ IN_HOUSE = ("lemke", "bpp", "pgs", "pdas", "toggle")
 # the other modules by the family a backend's name starts with ("cvxpy:SCS" -> cvxpy_)
 _FAMILY = {"osqp": "osqp_", "clarabel": "clarabel_", "cvxpy": "cvxpy_", "qpsolvers": "qpsolvers_"}
 
-_loaded: dict[str, list[Backend]] = {}  # module name -> its backends, once imported
-_registry: dict[str, Backend] | None = None
+_known: dict[str, Backend] = {}  # the backends of every module imported so far, by name
+_names: dict[str, list[str]] = {}  # module name -> the names of its backends, once imported
+_complete = False  # every module imported (registry() was called)
 
 
-def _backends_of(mod_name: str) -> list[Backend]:
-    if mod_name not in _loaded:
+def _load(modules) -> None:
+    """Import ``modules`` (those not imported yet, in the order of ``_MODULES``) and register
+    their backends."""
+    for mod_name in _MODULES:
+        if mod_name not in modules or mod_name in _names:
+            continue
         try:
             mod = importlib.import_module(f"{__name__}.{mod_name}")
         except ImportError:  # the module itself is missing: nothing to register
-            found: list[Backend] = []
+            found: list = []
         else:
             found = list(mod.backends())
             for b in found:
                 if not isinstance(b, Backend):
                     raise TypeError(f"plateqp.backends.{mod_name}.backends() must give Backend instances, "
                                     f"got {type(b).__name__}")
-        _loaded[mod_name] = found
-    return _loaded[mod_name]
-
-
-def _by_name(modules) -> dict[str, Backend]:
-    """The backends of ``modules`` by name, in the order of ``_MODULES`` (importing them)."""
-    return {b.name: b for m in _MODULES if m in modules for b in _backends_of(m)}
+        _names[mod_name] = [b.name for b in found]
+        for b in found:
+            _known.setdefault(b.name, b)
 
 
 def registry() -> dict[str, Backend]:
-    """All known backends by name (installed or not), built once: imports every backend module."""
-    global _registry
-    if _registry is None:
-        _registry = _by_name(_MODULES)
-    return _registry
+    """All known backends by name (installed or not), in the order of ``_MODULES``: imports every
+    backend module the first time. The same dict every call (an entry set in it is what
+    :func:`get_backend` finds)."""
+    global _complete
+    if not _complete:
+        _load(_MODULES)
+        order = [n for m in _MODULES for n in _names[m]]
+        items = [(n, _known[n]) for n in order if n in _known]
+        items += [(n, b) for n, b in _known.items() if n not in set(order)]
+        _known.clear()
+        _known.update(items)
+        _complete = True
+    return _known
 
 
 def in_house() -> dict[str, Backend]:
     """plateqp's own backends by name (:data:`IN_HOUSE`; no third-party solver imported)."""
-    return _by_name(IN_HOUSE)
+    _load(IN_HOUSE)
+    return {n: _known[n] for m in IN_HOUSE for n in _names[m] if n in _known}
 
 
 def get_backend(name: str) -> Backend:
     """The backend called ``name``; a clear error listing what is installed otherwise. Imports
     only the module that provides it (and plateqp's own), not every backend's."""
     family = _FAMILY.get(name.split(":")[0])
-    b = _by_name(IN_HOUSE + ((family,) if family else ())).get(name)
+    _load(IN_HOUSE + ((family,) if family else ()))
+    b = _known.get(name)
     if b is None:
         reg = registry()
         if name not in reg:
