@@ -31,7 +31,9 @@ Parts (``--parts``, comma-separated):
 * ``auto``: ``backend="auto"`` on a single cold solve (a new model each time, nothing cached)
   of ``grid_rigid(n, k)`` for ``--auto-meshes`` × ``--auto-ks``, against every exact route
   (pdas on the primal, bpp and lemke on the condensed, bpp on the dual) at accuracy 1e-10,
-  CPU time, medians of ``--auto-repeat`` interleaved; and a sweep of ``--sweep-values`` gaps
+  CPU time, medians of ``--auto-repeat`` interleaved, each solve in a child forked from the
+  benchmark's process (the same heap and imports for every route; run in one process, a
+  route's time depended on which route ran before it); and a sweep of ``--sweep-values`` gaps
   of one support (``plateqp.sweep``) through auto and through pdas.
 * ``mesh``: the grid scene's ``pq.solve`` ÷ raw for ``--scale-meshes`` (32,64,128,256,512;
   one run at 512²).
@@ -142,6 +144,41 @@ def cpu(fn):
     t0 = time.process_time()
     out = fn()
     return time.process_time() - t0, out
+
+
+def _in_child(conn, fn) -> None:
+    try:
+        conn.send(fn())
+    except BaseException as exn:  # sent back and raised in the parent, not lost
+        conn.send(RuntimeError(f"{type(exn).__name__}: {exn}"))
+    finally:
+        conn.close()
+
+
+def forked(fn):
+    """``fn()`` (returning something small to pickle) in a child forked from this process, where
+    fork exists (Linux): every route then starts from the same heap and the same imports, so
+    the order the routes run in does not move their times. Run one after another in one
+    process, the same route (auto's choice and pdas/primal) took 1.0-1.8 s at 256² with 9
+    posts depending on which route freed its memory before it (the primal formulation's
+    copies of K paid their pages again). Elsewhere ``fn()`` runs here."""
+    import multiprocessing
+
+    if "fork" not in multiprocessing.get_all_start_methods():
+        return fn()
+    ctx = multiprocessing.get_context("fork")
+    parent, child = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_in_child, args=(child, fn))
+    proc.start()
+    child.close()
+    try:
+        out = parent.recv()
+    except EOFError:
+        out = RuntimeError(f"the child ended without an answer (exit code {proc.exitcode})")
+    proc.join()
+    if isinstance(out, BaseException):
+        raise out
+    return out
 
 
 def goal_row(kind: str, n: int, repeat: int) -> dict:
@@ -283,8 +320,17 @@ def flops_row(n: int, repeat: int) -> dict:
 ROUTES = (("auto", "auto"), ("pdas", "primal"), ("bpp", "condensed"), ("lemke", "condensed"), ("bpp", "dual"))
 
 
+def _route(scene, b: str, f: str) -> tuple:
+    """One solve by route ``b/f``: (CPU s, solved, the route taken, worst KKT residual)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        dt, res = cpu(lambda: pq.solve(scene, backend=b, formulation=f, accuracy=ACCURACY))
+    return dt, bool(res.status.solved), f"{res.backend}/{res.formulation}", kkt_worst(res)
+
+
 def auto_row(n: int, k: int, repeat: int, routes=ROUTES) -> dict:
-    """Single cold solves of grid_rigid(n, k): auto and each exact route (CPU s, medians)."""
+    """Single cold solves of grid_rigid(n, k): auto and each exact route (CPU s, medians), each
+    in a child forked from this process (:func:`forked`: the same heap for every route)."""
     scene = grid_rigid(n, k)
     ROUTES = routes  # noqa: N806
     times: dict[str, list[float]] = {f"{b}/{f}": [] for b, f in ROUTES}
@@ -292,18 +338,16 @@ def auto_row(n: int, k: int, repeat: int, routes=ROUTES) -> dict:
     for r in range(repeat):
         for i in range(len(ROUTES)):
             b, f = ROUTES[(i + r) % len(ROUTES)]
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                try:
-                    dt, res = cpu(lambda: pq.solve(scene, backend=b, formulation=f, accuracy=ACCURACY))
-                except Exception:  # a route that does not apply here (recorded as missing)
-                    continue
-            if not res.status.solved:
+            try:
+                dt, solved, route, worst = forked(lambda: _route(scene, b, f))
+            except Exception:  # a route that does not apply here (recorded as missing)
+                continue
+            if not solved:
                 continue
             times[f"{b}/{f}"].append(dt)
-            kkt[f"{b}/{f}"] = kkt_worst(res)
+            kkt[f"{b}/{f}"] = worst
             if b == "auto":
-                chosen = f"{res.backend}/{res.formulation}"
+                chosen = route
     med = {key: statistics.median(v) for key, v in times.items() if v}
     exact = {key: v for key, v in med.items() if key != "auto/auto"}
     best = min(exact, key=exact.get)

@@ -7,7 +7,8 @@ Routes, each ``pq.solve(scene, …, accuracy=1e-10)``: ``pdas`` (primal formulat
 first set, then exact steps), ``bpp`` (condensed formulation: a contacts-last factorisation of
 the shifted K, the dense LCP) and ``auto``. They run interleaved in one process (route after
 route, ``--repeat`` rounds, after one warm-up solve of each), CPU time (``time.process_time``)
-of the whole call, medians. Reported: time, status, the answer's largest KKT residual
+of the whole call, medians, each solve in a child forked from the benchmark's process (the
+same heap for every route). Reported: time, status, the answer's largest KKT residual
 (:mod:`plateqp.contact.kkt`), the factor pdas's exact steps ran on (``extras["factor"]``:
 ``"trailing"`` for the anchored factorisation with its trailing block replaced) and the ratio
 pdas ÷ BPP.
@@ -34,7 +35,7 @@ from pathlib import Path
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
-from bench_fast import write_csv  # noqa: E402
+from bench_fast import forked, write_csv  # noqa: E402
 
 ROUTES = {"pdas": ("pdas", "primal"), "bpp": ("bpp", "condensed"), "auto": ("auto", None)}
 FIELDS = ("mesh", "k", "route", "cpu_s", "runs", "status", "kkt_max", "factor", "pdas_over_bpp")
@@ -48,6 +49,15 @@ def solve(scene, route: str):
     t0 = time.process_time()
     res = pq.solve(scene, backend=backend, accuracy=1e-10, **kw)
     return time.process_time() - t0, res
+
+
+def timed(scene, route: str) -> tuple:
+    """:func:`solve` in a child forked from this process (bench_fast.forked: the same heap for
+    every route): (CPU s, status, worst KKT residual, the factor pdas ran on)."""
+    def run():
+        dt, res = solve(scene, route)
+        return dt, res.status.value, res.kkt.worst, res.extras.get("factor", "")
+    return forked(run)
 
 
 def main() -> None:
@@ -83,15 +93,13 @@ def main() -> None:
             last = {}
             for _ in range(args.repeat):
                 for route in ROUTES:
-                    dt, res = solve(scene, route)
+                    dt, *last[route] = timed(scene, route)
                     times[route].append(dt)
-                    last[route] = res
             med = {r: statistics.median(t) for r, t in times.items()}
             for route in ROUTES:
-                res = last[route]
+                status, worst, factor = last[route]
                 row = {"mesh": n, "k": k, "route": route, "cpu_s": med[route], "runs": args.repeat,
-                       "status": res.status.value, "kkt_max": res.kkt.worst,
-                       "factor": res.extras.get("factor", ""),
+                       "status": status, "kkt_max": worst, "factor": factor,
                        "pdas_over_bpp": med["pdas"] / med["bpp"] if route == "pdas" else ""}
                 rows.append(row)
                 ratio = f"{row['pdas_over_bpp']:.2f}" if route == "pdas" else ""
