@@ -125,7 +125,7 @@ THIRD_PARTY = ("cvxpy", "qpsolvers", "osqp", "clarabel")
                     reason="no third-party solver installed: nothing that could be imported")
 def test_a_solve_with_plateqps_own_backends_imports_no_third_party_solver():
     """A fresh process's first solve with ``auto`` or an in-house backend imported every
-    backend module, cvxpy among them (0.5 s of a 0.8 s first solve at 128²): now only what it uses."""
+    backend module, cvxpy among them (0.3 s of a 0.8 s first solve at 128²): now only what it uses."""
     code = ("import sys, plateqp as pq\n"
             "from plateqp.families import grid_rigid\n"
             "s = grid_rigid(8, 3)\n"
