@@ -20,6 +20,7 @@ from ..linalg import solve_saddle
 from ..results import Result
 from .formulations import ContactSolution, Formulation, formulate
 from .kkt import defect_residual, kkt_report, reaction_scale
+from .predict import check_predict, predicted_set, wanted
 from .routing import choose, formulations_for
 from .scaling import Scaled
 from .statics import NO_EQUILIBRIUM, settle, supports_reach
@@ -38,6 +39,9 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     supports' reach statics cannot tell, and the backend's verdict stands either way.
     """
     acc = Accuracy.parse(accuracy)  # ProblemError for a bad one, before any work
+    options = dict(options or {})
+    predict = options.pop("predict", "auto")  # the pipeline's own option, never the backend's
+    check_predict(predict)
     t0 = time.perf_counter()
     data = Scaled.from_model(model)
     reach = supports_reach(data, band=acc.tol)
@@ -65,7 +69,15 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         form = formulate(data, formulation)
     problem = form.problem(b.accepts)
     t1 = time.perf_counter()
-    raw = b.solve(problem, accuracy=acc, options=options or {})
+    first = options
+    predicted = {"why": wanted(model, data, backend, formulation, options, predict)}
+    if predicted["why"] is None:  # the coarse mesh's contact set starts the solve
+        A0, predicted = predicted_set(model, solve_contact)
+        if A0 is not None:
+            first = dict(options, active=A0)
+    t_predict = time.perf_counter() - t1
+    t1 = time.perf_counter()
+    raw = b.solve(problem, accuracy=acc, options=first)
     t2 = time.perf_counter()
     if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED):  # the backend's certificate, in QP/LCP terms
         verdict = f"{backend} on the {formulation} problem ended {raw.status.value} ({raw.solver_status})"
@@ -90,7 +102,7 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         if not np.isfinite(size) or size <= 0.1 * acc.tol or 4.0 * size < res.kkt.worst:
             break
         nxt = form.corrected(e)
-        opts = dict(options or {})
+        opts = dict(options)
         if getattr(b, "warm_start", False) and "active" in raw.extras and "active" not in opts:
             opts["active"] = raw.extras["active"]
         t3 = time.perf_counter()
@@ -121,12 +133,13 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
                       f"(worst KKT residual {res.kkt.worst:.2e}, asked {res.kkt.tol:.0e}){why}", PlateQPWarning,
                       stacklevel=3)
     res.iterations = iterations
-    res.extras = {"solver_status": raw.solver_status, **raw.extras}
+    res.extras = {"solver_status": raw.solver_status, **raw.extras, "predicted": predicted}
     if form.max_corrections:
         res.extras["corrections"] = corrections
         if failed is not None:
             res.extras["correction_failed"] = failed
-    res.times.update(formulate=t1 - t0, solve=solve_s, recover=time.perf_counter() - t1 - solve_s)
+    res.times.update(formulate=t1 - t0 - t_predict, predict=t_predict, solve=solve_s,
+                     recover=time.perf_counter() - t1 - solve_s)
     return res
 
 

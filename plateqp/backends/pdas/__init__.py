@@ -143,15 +143,20 @@ exchange (two rows) is such a correction: two factorisations instead of three.
 A bed's first steps change thousands of rows each (plain PDAS from the two-sided start:
 16 641 → 11 501 → 9 352 → 8 727 → 8 658 rows in contact on a 128 × 128 bed, a
 refactorisation each). So when every row is a soft spring (``ρ_i k_i ≥ 1``: no stiffer than
-the plate under it) and there is no warm start, a first phase finds the contact without
-refactorising: semismooth Newton on the energy ``½uᵀKu − fᵀu + Σ ½ W_i max(0, B_i u − g_i)²``
-(the tensionless bed's own energy), each Newton system solved roughly (PCG to
-``PCG_TOL``) with the factor of the two-sided matrix as preconditioner, then an exact line
-search (the energy is piecewise quadratic along a line). Removing soft springs changes
-``H`` only in its few smooth, spring-dominated modes, so PCG needs a handful of iterations.
-When a Newton step changes few rows (``NEWTON_SETTLED``), the factor is rebuilt once for that
-active set and exact steps finish as above. On the 128 × 128 bed: three Newton steps, 13 PCG
-iterations, then one exact step and two rows exchanged (a Woodbury correction).
+the plate under it), a first phase finds the contact without refactorising: semismooth
+Newton on the energy ``½uᵀKu − fᵀu + Σ ½ W_i max(0, B_i u − g_i)²`` (the tensionless bed's
+own energy), each Newton system solved roughly (PCG to ``PCG_TOL``) with one factor as
+preconditioner, then an exact line search (the energy is piecewise quadratic along a line).
+Removing soft springs changes ``H`` only in its few smooth, spring-dominated modes, so PCG
+needs a handful of iterations. When a Newton step changes few rows (``NEWTON_SETTLED``), the
+factor is rebuilt once for that active set and exact steps finish as above. On a cold start
+the factor is that of the two-sided matrix: on the 128 × 128 bed three Newton steps, 13 PCG
+iterations, then one exact step and two rows exchanged (a Woodbury correction): two
+factorisations. With a warm start the factor is that of its set, so a good one (a sweep's
+previous answer; :mod:`plateqp.contact.predict`'s coarse mesh, 8 of 16 641 rows wrong on that
+bed) costs one factorisation (no Newton step where the set's own minimiser keeps it; its few
+wrong rows a Woodbury correction), and a bad one costs PCG iterations, not refactorisations
+(every row of the bed's set flipped at random in 10 %: three Newton steps, two factorisations).
 
 Stiff rows (rigid posts) on a held plate, cold start: plain PDAS from the two-sided start cycles
 and falls back to Murty's one row per step (a 64 × 64 slab with 45 × 45 posts: 407 steps, each a
@@ -227,7 +232,8 @@ Option ``active`` (bool array over the rows of ``G``) gives the first active set
 for the condensed method, Lawson–Hanson's set (stiff rows, within its budget) or else the
 rows the unsupported plate would press into, ``d < 0``, as ``extras["first_set"]`` says; for
 the sparse one, the set its first phase finds, or every row, the two-sided problem, where no
-first phase applies); ``extras["active"]`` holds the final set,
+first phase applies; on soft rows a warm start is the first phase's factor, above);
+``extras["active"]`` holds the final set,
 so a sweep can warm start each solve from the previous one. ``x`` (``u`` with the eliminated
 variables restored), ``z = λ ≥ 0`` (one per row of ``G``, the qpsolvers sign convention),
 ``iterations`` (active sets solved, the steps of the first phase and Lawson–Hanson's

@@ -127,19 +127,29 @@ def line_search(pb: ReducedQP, W: np.ndarray, u: np.ndarray, du: np.ndarray) -> 
     return 0.5 * (lo + hi)
 
 
-def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, steps) -> tuple:
+def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, steps,
+               start: np.ndarray | None = None) -> tuple:
     """Phase 1 of the sparse method, for soft rows (springs no stiffer than the plate under them).
 
     Semismooth Newton on the energy ``½uᵀKu − fᵀu + Σ ½ W_i max(0, B_i u − g_i)²`` (the exact
     energy of a tensionless bed), each Newton system ``(K + σD + B_Aᵀ W_A B_A) δu = −∇`` solved
-    only roughly (PCG to ``PCG_TOL``) with the factor of the two-sided matrix (every row
-    active) as preconditioner, then an exact line search: no refactorisation until the active
-    set settles. Returns ``(u, A, solves)``.
+    only roughly (PCG to ``PCG_TOL``) with one factor as preconditioner, then an exact line
+    search: no refactorisation until the active set settles. The factor is that of the set
+    ``start`` (a warm start: a good one is the answer's set, and the first step finds nothing
+    to change; a bad one costs PCG iterations, each wrong row one more at most, never a
+    factorisation), or of the two-sided matrix (every row active) on a cold start. Returns
+    ``(u, A, steps)``; 0 steps where the warm start's own minimiser keeps its set.
     """
     B, K, f, g, D = pb.B, pb.K, pb.f, pb.g, pb.Kd
-    fac.set(W.copy())
-    u = fac.solve(f + B.T @ (W * g))  # the two-sided problem
+    first = W.copy() if start is None else np.where(start, W, 0.0)
+    fac.set(first)
+    u = fac.solve(f + B.T @ (first * g))  # the minimiser with the rows of the first set held
     A = B @ u - g > 0
+    if start is not None and np.array_equal(A, start):  # u is that set's step, and the set keeps
+        if steps is not None:
+            steps.append({"step": "newton 0", "active": int(A.sum()), "infeasible": 0, "solve": "warm start"})
+        return u, A, 0
+    k = -1
     for k in range(NEWTON_STEPS):
         WA = np.where(A, W, 0.0)
         grad = K @ u - f + B.T @ (WA * (B @ u - g))
@@ -402,8 +412,8 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
     lam = np.zeros(pb.m)
     exact = False
     newton = 0
-    if A is None and np.all(pb.rho * pb.k >= 1.0):  # soft rows only, cold start: phase 1
-        u, A, newton = newton_pcg(pb, fac, W, sigma, steps)
+    if np.all(pb.rho * pb.k >= 1.0):  # soft rows only: phase 1, from the warm start's set if any
+        u, A, newton = newton_pcg(pb, fac, W, sigma, steps, A)
         lam = np.where(A, W * (pb.B @ u - pb.g), 0.0)
         exact = True
         info.update(first_phase="newton", first_phase_steps=newton)
