@@ -62,7 +62,10 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
         meshes (:func:`plateqp.estimate.auto_tolerance`; ``extras["discretisation_error"]``),
         then checked against this mesh's answer (:func:`plateqp.estimate.confirm`: a
         PlateQPWarning and ``"trusted": false`` there when the meshes disagree)
-    options : passed to the backend untouched
+    options : passed to the backend untouched, but for ``predict`` ("auto", True or False):
+        start pdas on the primal problem from the contact set of the scene's mesh coarsened
+        four times ("auto": where every contact row is soft and there are at least 4000 of
+        them; :mod:`plateqp.contact.predict`; ``extras["predicted"]`` says what was done or why not)
     model : a model built before from the same scene (skips the assembly)
     check_statics : check first, by statics alone, that the one-sided supports can carry the
         load (else NoEquilibriumError before any solve); set False to let the backend find out

@@ -378,6 +378,27 @@ def test_max_dense_auto_grows_with_the_mesh():
         solve(sc, {"max_dense": "big"})
 
 
+def test_max_dense_auto_on_soft_rows_is_8_root_n():
+    """Every row soft (springs no stiffer than the plate under them): 8·√n, no floor, so a slab
+    on a bed (961 rows at 32²) takes the sparse method's Newton phase, and 15 × 15 piles the
+    condensed method; either way the answer is the other method's."""
+    from plateqp import families as F
+    from plateqp.backends.pdas.driver import auto_max_dense
+
+    assert auto_max_dense(3007, soft=True) == int(8 * np.sqrt(3007)) == 438
+    assert auto_max_dense(10**7, soft=True) == 4000
+    bed = F.bed(32)
+    bed.edges, bed.loads = dict(F.WALLS), F._loads()
+    bed.validate()
+    piles = F.grid_elastic(32, 15)
+    for sc, method, other in ((bed, "sparse", "condensed"), (piles, "condensed", "sparse")):
+        res = solve(sc)
+        assert res.status == pq.Status.OPTIMAL and res.extras["method"] == method
+        assert res.extras["max_dense"] == int(8 * np.sqrt(res.model.n_free))
+        ref = solve(sc, {"method": other, "max_dense": 4000})
+        assert np.abs(res.reactions - ref.reactions).max() <= 1e-9 * np.abs(ref.reactions).max()
+
+
 def test_registered():
     b = pq.get_backend("pdas")
     assert b.accepts == frozenset({"qp"}) and b.available()

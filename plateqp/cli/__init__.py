@@ -84,7 +84,7 @@ def main(argv=None) -> int:
                         "of max |w| and of the reactions is at most REL, solved at a tolerance of REL/10")
     s.add_argument("--max-mesh", type=int, default=256, metavar="N", help="--target: most cells a side")
     s.add_argument("--probe", type=_probe, action="append", default=[], metavar="X,Y")
-    s.add_argument("--options", help="backend options as a JSON object, passed through untouched")
+    s.add_argument("--options", help="backend options as a JSON object, passed through untouched (but for \"predict\": see plateqp.solve)")
     s.add_argument("--json", action="store_true")
     s.add_argument("--sensitivity", action="store_true",
                    help="add the exact gap sensitivities dR_i/dg0_j of the solution (with --json: a 'sensitivity' object)")
@@ -103,7 +103,7 @@ def main(argv=None) -> int:
     w.add_argument("--formulation", default="auto", choices=["auto", "primal", "condensed", "dual"])
     w.add_argument("--accuracy", default="default", type=_accuracy,
                    help="low, default, high, a tolerance such as 1e-7, or auto")
-    w.add_argument("--options", help="backend options as a JSON object, passed through untouched")
+    w.add_argument("--options", help="backend options as a JSON object, passed through untouched (but for \"predict\": see plateqp.solve)")
     w.add_argument("--rtol", type=float, default=1e-3, help="relative width of each breakpoint's bracket")
     w.add_argument("--no-refine", action="store_true", help="report changes between values without bisection")
     w.add_argument("--exact", action="store_true",

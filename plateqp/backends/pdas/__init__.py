@@ -51,7 +51,9 @@ Two ways to solve a step
 ------------------------
 ``method="condensed"`` (:mod:`.dense`; the default where CHOLMOD is at hand, through
 scikit-sparse or the copy in cvxopt's wheels, ``K`` is definite and the rows touch at most
-``max_dense`` dofs ("auto": 2000 to 4000 as the mesh grows, :data:`.options.MAX_DENSE_AUTO`):
+``max_dense`` dofs ("auto": 2000 to 4000 as the mesh grows, :data:`.options.MAX_DENSE_AUTO`;
+where every row is soft, 8 √n for n dofs, :data:`.options.MAX_DENSE_SOFT`, as the sparse
+method's Newton phase is cheaper there):
 discrete supports on a held plate). The dofs the rows act on go *last* in
 the elimination order (AMD order on the rest); one sparse Cholesky ``K = L Lᵀ``
 (:class:`plateqp.linalg.SchurFactor`) then holds, in its trailing dense block ``L_cc``, the

@@ -16,6 +16,7 @@ from .options import (
     ACCURACY,
     ANCHOR,
     MAX_DENSE_AUTO,
+    MAX_DENSE_SOFT,
     OPTIONS,
     SETTINGS,
     TRAILING_MAX,
@@ -38,9 +39,12 @@ def _is_int(v, lo):
     return not isinstance(v, bool) and isinstance(v, (int, np.integer)) and v >= lo
 
 
-def auto_max_dense(n: int) -> int:
-    """``max_dense="auto"`` for ``n`` coupled dofs (:data:`.options.MAX_DENSE_AUTO`)."""
+def auto_max_dense(n: int, soft: bool = False) -> int:
+    """``max_dense="auto"`` for ``n`` coupled dofs (:data:`.options.MAX_DENSE_AUTO`), or where
+    every row is ``soft`` (:data:`.options.MAX_DENSE_SOFT`)."""
     lo, hi, per_root = MAX_DENSE_AUTO
+    if soft:
+        return min(hi, int(MAX_DENSE_SOFT * np.sqrt(n)))
     return max(lo, min(hi, int(per_root * np.sqrt(n))))
 
 
@@ -131,7 +135,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     pb = ReducedQP(qp, max_rows)
     m = pb.m
     if max_dense == "auto":
-        max_dense = auto_max_dense(pb.K.shape[0])
+        max_dense = auto_max_dense(pb.K.shape[0], soft=bool(np.all(pb.rho * pb.k >= 1.0)))
     max_iter = settings["max_iter"] if settings["max_iter"] is not None else 50 + 2 * m
     if not _is_int(max_iter, 1):
         raise ProblemError(f"option max_iter must be a positive integer, got {max_iter!r}")

@@ -63,6 +63,15 @@ SETTINGS: dict = {"method": "auto", "max_dense": "auto", "penalty": 1e8, "prox":
 #: 29.9. ``lo`` keeps the earlier fixed limit (2000) on small meshes; ``hi`` bounds the dense
 #: blocks' memory (m² doubles each: 128 MB at 4000).
 MAX_DENSE_AUTO = (2000, 4000, 16.0)
+#: ... where every row is soft (``ρ_i k_i ≥ 1``): ``MAX_DENSE_SOFT · √n``, no floor. The sparse
+#: method there is a Newton phase on one factor (2–8 factorisations in all, not 20–30), so the
+#: crossover is lower: measured (CPU s, condensed / sparse, medians of 3, on scenes built
+#: from families.py): a walled slab on a bed, 32² (n = 3007), m = 961: 0.091 / 0.014; grid_elastic
+#: 40 × 40 at 48² (m = 1600): 0.385 / 0.112, at 64²: 0.429 / 0.183, at 96² (n = 27 455): 0.486 /
+#: 0.519; 30 × 30 piles over a bed at 32² (m = 1861): 0.402 / 0.144; grid_elastic 30 × 30 at
+#: 64² (n = 16 895, m = 900): 0.140 / 0.145, at 128²: 0.311 / 0.728; 15 × 15 at 64²: 0.043 /
+#: 0.081. The even split lies near m = 8 √n.
+MAX_DENSE_SOFT = 8.0
 
 #: Keys accepted in the ``options`` dict of :func:`solve`.
 OPTIONS = ("active", "trace") + tuple(SETTINGS) + tuple(ACCURACY["default"])
