@@ -507,7 +507,8 @@ def test_a_plate_free_to_turn_about_its_one_held_edge_goes_to_the_sparse_method(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pq.PlateQPWarning)
         with pytest.raises(SolverError, match="K is singular"):
-            pq.solve(sc, backend="pdas", accuracy=1e-10, options={"method": "condensed"})
+            # (max_dense: its 210 soft rows are past "auto"'s 8·√n, which would refuse them first)
+            pq.solve(sc, backend="pdas", accuracy=1e-10, options={"method": "condensed", "max_dense": 4000})
         res = pq.solve(sc, backend="pdas", accuracy=1e-10)
         ref = pq.solve(sc, backend="lemke", formulation="condensed", accuracy="high")
     assert res.extras["method"] == "sparse"

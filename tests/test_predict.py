@@ -197,3 +197,21 @@ def test_the_option_is_checked_and_says_why_it_did_not_apply(bed_64):
     assert rigid.extras["predicted"]["why"].startswith("900 contact rows")
     cond = solve(F.bed(16), backend="bpp", formulation="condensed", options={"predict": True})
     assert "only pdas on the primal" in cond.extras["predicted"]["why"]
+
+
+def test_a_triangle_meshed_bed_with_a_coarse_start():
+    """DKT on a gmsh mesh (element size 1/32: 1297 springs), its coarse mesh of size 1/8: the
+    same answer as a cold start, and the bed carries the point load (Σ R = P, Σ R x = P x_P)."""
+    pytest.importorskip("gmsh")
+    sq = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    sc = pq.Scene(plate=pq.Plate(shape={"polygon": sq}, h=0.01, E=1e7, nu=0.3),
+                  mesh=pq.MeshSpec(element="dkt", size=1 / 32), loads=[pq.PointLoad(1.0, 0.3, 0.6)],
+                  foundation=pq.Foundation(k=1e4, gap={"profile": "linear", "g0": 0.0, "gx": 1e-4, "gy": 5e-5}))
+    res = solve(sc, backend="pdas", options={"predict": True})
+    cold = solve(sc, backend="pdas", options={"predict": False})
+    assert res.extras["predicted"]["mesh"] == [8, 8]
+    assert res.status == pq.Status.OPTIMAL and res.kkt.ok and 0.05 < res.active.mean() < 0.95
+    same_answer(res, cold)
+    xy = res.model.contacts.xy
+    np.testing.assert_allclose([res.reactions.sum(), res.reactions @ xy[:, 0], res.reactions @ xy[:, 1]],
+                               [1.0, 0.3, 0.6], rtol=1e-9)
