@@ -140,6 +140,23 @@ def test_a_bad_warm_start_on_soft_rows_costs_pcg_not_factorisations():
     same_answer(exact, ref, rtol=1e-7)
 
 
+def test_a_warm_start_a_few_rows_off_goes_to_the_exact_steps():
+    """Three springs of the answer's set flipped: the warm start's own minimiser moves them back,
+    and the exact steps take them at once, no Newton step; the answer is bpp's on the condensed
+    LCP. (Whether they do it by a low-rank correction or a refactorisation is the factor's
+    choice by measured times, which on a 32² plate differ from run to run.)"""
+    sc = F.bed(32)
+    ref = solve(sc, backend="bpp", formulation="condensed", accuracy=1e-8)
+    A = ref.active.copy()
+    on, off = np.flatnonzero(A), np.flatnonzero(~A)
+    A[[on[0], on[len(on) // 2], off[len(off) // 2]]] ^= True
+    res = solve(sc, backend="pdas", options={"active": A, "trace": True})
+    assert res.extras["first_phase"] == "newton" and res.extras["first_phase_steps"] == 0
+    assert res.extras["trace"][0]["infeasible"] >= 1  # the warm start was not the answer's set
+    assert np.array_equal(res.active, ref.active)
+    same_answer(res, ref, rtol=1e-7)
+
+
 def test_elastic_posts_on_a_bed_with_a_coarse_start():
     """Soft elastic posts (F.grid_elastic) over a bed settled 1 mm: the same answer as a cold start."""
     sc = F.grid_elastic(32, 9)

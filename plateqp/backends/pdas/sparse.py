@@ -138,17 +138,26 @@ def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, st
     ``start`` (a warm start: a good one is the answer's set, and the first step finds nothing
     to change; a bad one costs PCG iterations, each wrong row one more at most, never a
     factorisation), or of the two-sided matrix (every row active) on a cold start. Returns
-    ``(u, A, steps)``; 0 steps where the warm start's own minimiser keeps its set.
+    ``(u, A, steps)``; 0 steps where the warm start's own minimiser keeps its set or moves at
+    most ``max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION · m)`` rows of it (the exact steps
+    take those on the warm start's factor).
     """
     B, K, f, g, D = pb.B, pb.K, pb.f, pb.g, pb.Kd
     first = W.copy() if start is None else np.where(start, W, 0.0)
     fac.set(first)
     u = fac.solve(f + B.T @ (first * g))  # the minimiser with the rows of the first set held
     A = B @ u - g > 0
-    if start is not None and np.array_equal(A, start):  # u is that set's step, and the set keeps
-        if steps is not None:
-            steps.append({"step": "newton 0", "active": int(A.sum()), "infeasible": 0, "solve": "warm start"})
-        return u, A, 0
+    if start is not None:
+        changes = int((A ^ start).sum())
+        if changes <= max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION * pb.m):
+            # u is that set's step and it keeps, or moves a few rows: the exact steps take them
+            # on this factor (a low-rank correction), as they would after a Newton step that
+            # settled, and that step's gradient and PCG solves are saved (2 of 7 on the
+            # benchmark bed at 128² from its coarse mesh's set, 8 rows moved)
+            if steps is not None:
+                steps.append({"step": "newton 0", "active": int(A.sum()), "infeasible": changes,
+                              "solve": "warm start"})
+            return u, A, 0
     k = -1
     for k in range(NEWTON_STEPS):
         WA = np.where(A, W, 0.0)
