@@ -333,6 +333,40 @@ def test_the_hold_check_finds_a_free_motion_on_a_woodbury_corrected_factor(monke
     assert np.abs(pb.K @ d).max() <= 1e-6 * np.abs(pb.K).max() * scale  # a rigid motion
 
 
+def test_the_rigid_motions_hold_check_agrees_with_the_inverse_iterations():
+    """Where the QP names the plate's rigid motions, the final set's hold check is the rank of
+    ``B_A N`` (``rows_hold``, no solve): four posts, three in a line and one off it, hold a free
+    slab (and the inverse iterations find no free motion); the three in a line do not (rank 2:
+    it gives no verdict, and the inverse iterations find the turn about their line); nor do
+    four posts on springs so soft that the least held rigid motion is below the inverse
+    iterations' own threshold (they find it free too)."""
+    from plateqp.backends.pdas import factor as pdas_factor
+    from plateqp.backends.pdas.motions import free_mode, rows_hold
+    from plateqp.backends.pdas.reduced import ReducedQP
+
+    base = F.floating(16, 9)
+    xy = np.array([[2.0, 4.0], [4.0, 4.0], [6.0, 4.0], [4.0, 6.0]])
+    sc = pq.Scene(name="three-in-a-row-and-one", plate=base.plate, mesh=base.mesh, loads=base.loads,
+                  supports=[pq.Support(x, y, gap=0.0) for x, y in xy])
+    pb = ReducedQP(Primal(Scaled.from_model(build_model(sc))).qp, 10**6)
+    assert pb.rigid() is not None and pb.rigid().shape[1] == 3
+    sigma = 1e-12
+    four, three = np.ones(4, dtype=bool), np.array([True, True, True, False])
+    for W, holds in ((1e-2 * pb.k, True), (1e-20 * pb.k, False)):
+        fac = pdas_factor.SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, "auto")
+        fac.set(np.where(four, W, 0.0))
+        assert rows_hold(pb, W, four, sigma) is holds
+        assert (free_mode(pb, fac, W, four, [], sigma) is None) is holds
+    W = 1e-2 * pb.k
+    assert rows_hold(pb, W, three, sigma) is False
+    fac = pdas_factor.SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, "auto")
+    fac.set(np.where(three, W, 0.0))
+    assert free_mode(pb, fac, W, three, [], sigma) is not None
+    # a plate whose rigid motions the QP does not name: no verdict
+    pb._null, pb._null_checked = None, True
+    assert rows_hold(pb, W, four, sigma) is False
+
+
 @needs_cholmod
 def test_trailing_factor_solves_the_active_set_matrix_of_a_floating_plate():
     """The exact steps' factor on the anchored contacts-last factorisation of ``K + σ diag(K)``

@@ -91,6 +91,7 @@ def test_a_coarse_start_agrees_with_the_condensed_problem():
     ref = solve(sc, backend="bpp", formulation="condensed", accuracy=1e-8)
     assert res.extras["predicted"]["mesh"] == [8, 8]
     assert res.status == ref.status == pq.Status.OPTIMAL
+    assert res.extras["hold_check"] == "rigid motions"  # the free slab held, judged without a solve
     same_answer(res, ref, rtol=1e-7)
     assert_bed_statics(res)
 

@@ -156,8 +156,9 @@ the factor is that of the two-sided matrix: on the 128 × 128 bed three Newton s
 iterations, then one exact step and two rows exchanged (a Woodbury correction): two
 factorisations. With a warm start the factor is that of its set, so a good one (a sweep's
 previous answer; :mod:`plateqp.contact.predict`'s coarse mesh, 8 of 16 641 rows wrong on that
-bed) costs one factorisation (no Newton step where the set's own minimiser keeps it; its few
-wrong rows a Woodbury correction), and a bad one costs PCG iterations, not refactorisations
+bed) costs one factorisation (no Newton step where the set's own minimiser keeps it or moves
+at most the settled count of rows; those a Woodbury correction), and a bad one costs PCG
+iterations, not refactorisations
 (every row of the bed's set flipped at random in 10 %: three Newton steps, two factorisations).
 
 Stiff rows (rigid posts) on a held plate, cold start: plain PDAS from the two-sided start cycles
@@ -225,8 +226,13 @@ stationarity residual that decides ``OPTIMAL`` against ``INACCURATE``. Where the
 along ``−d`` and the rows it presses would make a set already left on its exact step, the push
 is taken as rounding and ``d`` kept out the same way (else a load 1e-10 inside the line of
 two posts cycled between the sets with and without the far posts), and a set met again is
-solved exactly before it is judged. The condensed method needs a definite ``K`` and leaves
-floating plates to the sparse one.
+solved exactly before it is judged. Before a floating plate's final set is called optimal,
+its hold on the plate is checked: where the QP names the rigid motions, by the rank of
+``B_A N`` and the stiffness of the least held one (:func:`.motions.rows_hold`, no solve;
+``extras["hold_check"] = "rigid motions"``), else by two inverse iterations with ``H_A``
+(:func:`.motions.free_mode`, two solves; ``"inverse iteration"``), whose free motion is judged
+as above. The condensed method needs a definite ``K`` and leaves floating plates to the
+sparse one.
 
 Warm start and output
 ---------------------

@@ -6,9 +6,10 @@ docstring: "Singular steps and no equilibrium")."""
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg as sla
 
 from .factor import SpringFactor
-from .options import FREE_RIGID, FREE_SHARPEN, RIGID_RANK, SINGULAR_QUOTIENT
+from .options import FREE_RIGID, FREE_SHARPEN, HOLD_MARGIN, RIGID_RANK, SINGULAR_QUOTIENT
 from .reduced import ReducedQP
 
 
@@ -47,6 +48,28 @@ def free_mode(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray, nu
     judges its first correction (below SINGULAR_QUOTIENT·σ)."""
     v, quotient = softest(pb, fac, np.where(A, W, 0.0), null)
     return v / np.abs(v).max() if quotient < SINGULAR_QUOTIENT * sigma else None
+
+
+def rows_hold(pb: ReducedQP, W: np.ndarray, A: np.ndarray, sigma: float) -> bool:
+    """True where the QP names the plate's rigid motions ``N`` (:meth:`ReducedQP.rigid`) and the
+    active rows ``A`` hold every one of them: ``B_A N`` of full column rank (its singular
+    values above RIGID_RANK of the largest, :func:`exact_motion`'s test) and the least held,
+    ``N a``, stiffer than HOLD_MARGIN times :func:`free_mode`'s threshold (its Rayleigh quotient
+    ``Σ_A W_i (B_i N a)² / (N a)ᵀD(N a)``, ``K N = 0``: the smallest eigenvalue of
+    ``(NᵀB_AᵀW_A B_A N, NᵀDN)``). A free motion of ``H_A`` is a rigid motion the rows do not
+    hold (``N`` spans ``K``'s null space, piece by piece), so :func:`free_mode`'s two solves are
+    not needed; False gives no verdict (:func:`free_mode` decides)."""
+    N = pb.rigid()
+    if N is None or N.shape[1] == 0 or not A.any():
+        return False
+    BN = pb.B[A] @ N
+    sv = np.linalg.svd(BN, compute_uv=False)
+    if sv.size < N.shape[1] or not sv[-1] > RIGID_RANK * sv[0]:
+        return False
+    G = BN.T @ (W[A][:, None] * BN)
+    DN = N.T @ (pb.Kd[:, None] * N)
+    mu = sla.eigh(G, DN, eigvals_only=True)[0]
+    return bool(mu > HOLD_MARGIN * SINGULAR_QUOTIENT * sigma)
 
 
 def free_motion(pb: ReducedQP, fac: SpringFactor, null: list, d: np.ndarray) -> np.ndarray:

@@ -94,6 +94,12 @@ FREE_WORK, FREE_FLOOR, FREE_MOTIONS, FREE_SHARPEN = 1e-9, 1e-11, 3, 2
 #: D-projection onto those that move no active row: the null space of ``B_A N``, singular values
 #: above RIGID_RANK of the largest), where it is within FREE_RIGID of it (D-norm, relative).
 FREE_RIGID, RIGID_RANK = 1e-6, 1e-9
+#: ... and the final set's hold check is the rank of ``B_A N`` there (:func:`.motions.rows_hold`,
+#: no solve) where the least held rigid motion is also this many times stiffer than the inverse
+#: iterations' threshold SINGULAR_QUOTIENT·σ; else the inverse iterations decide (two solves:
+#: 0.024 s of 0.35 s on the benchmark bed at 128²). The quotient falls as h⁴ (D grows as
+#: h⁻⁴): on the benchmark bed 1.4e-5 at 32², 5.7e-8 at 128² (σ = 1e-12).
+HOLD_MARGIN = 100.0
 #: Refinement: at most this many solves per active set while it changes, and for the final set.
 INNER_LOOSE, INNER_EXACT = 2, 12
 #: (sparse) While the active set changes, refinement stops at this relative residual.

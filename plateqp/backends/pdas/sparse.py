@@ -12,7 +12,7 @@ import numpy as np
 from ..base import Status
 from .dense import first_set
 from .factor import SpringFactor
-from .motions import deflate, exact_motion, free_mode, free_motion, project, softest
+from .motions import deflate, exact_motion, free_mode, free_motion, project, rows_hold, softest
 from .options import (
     ALPHA_MAX,
     ALPHA_MIN,
@@ -546,7 +546,11 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
                 # factor in hand (a Woodbury correction or a downdate loses at most
                 # DOWNDATE_LOSS: a free motion still outgrows every held mode by λ/σ)
                 held = True
-                pending = free_mode(pb, fac, W, A, null, sigma)
+                if not null and rows_hold(pb, W, A, sigma):  # the plate's rigid motions, held: no solve
+                    info["hold_check"] = "rigid motions"
+                else:
+                    info["hold_check"] = "inverse iteration"
+                    pending = free_mode(pb, fac, W, A, null, sigma)
                 if pending is not None:
                     continue
             if exact:
