@@ -465,9 +465,11 @@ def test_refinement_stops_at_rounding_and_not_before():
     pb = ReducedQP(formulate(data, "primal").problem(frozenset({"qp"})), max_rows=10**6)
     x = np.abs(np.random.default_rng(2).standard_normal(pb.K.shape[0]))
     ref = abs(pb.K) @ x
+    X = np.abs(np.random.default_rng(3).standard_normal((pb.K.shape[0], 3)))  # several columns at once
     for chunk in (7, 1000, 1 << 20):
         np.testing.assert_allclose(abs_matvec(pb.K, x, chunk), ref, rtol=1e-14)
         np.testing.assert_allclose(abs_matvec(pb.K.tocsr(), x, chunk), ref, rtol=1e-14)
+        np.testing.assert_allclose(abs_matvec(pb.K, X, chunk), abs(pb.K) @ X, rtol=1e-14)
     idx = np.arange(pb.m)  # every post held at its gap: the saddle-point system, solved by LU
     BA = pb.B[idx]
     n = pb.K.shape[0]

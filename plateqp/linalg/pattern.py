@@ -71,11 +71,12 @@ def leading(P: sp.csc_matrix, k: int) -> sp.csc_matrix | None:
 
 
 def abs_matvec(K: sp.csc_matrix, x: np.ndarray, chunk: int = 1 << 16) -> np.ndarray:
-    """``|K| x`` for symmetric ``K`` (CSC or CSR), a block of rows at a time: K's arrays read as
-    CSR are K itself, so each block is ``chunk`` entries of |K| and gives its own rows (no
-    copy of K's data: ``abs(K) @ x`` copied all of it, 43 MB at 256²)."""
+    """``|K| x`` for symmetric ``K`` (CSC or CSR) and ``x`` of shape (n,) or (n, k), a block of
+    rows at a time: K's arrays read as CSR are K itself, so each block is ``chunk`` entries of
+    |K| and gives its own rows (no copy of K's data: ``abs(K) @ x`` copied all of it, 43 MB at
+    256²)."""
     n = K.shape[0]
-    out = np.empty(n)
+    out = np.empty((n,) + np.shape(x)[1:])
     j0 = 0
     while j0 < n:
         j1 = int(np.searchsorted(K.indptr, K.indptr[j0] + chunk, side="right")) - 1

@@ -116,9 +116,9 @@ class ReducedQP:
                 Nk = N[self.keep]
                 scale = np.abs(Nk).max(initial=0.0)
                 ok = scale > 0 and np.abs(N[self.sep]).max(initial=0.0) <= NULL_ROUNDING * scale
-                for j in range(Nk.shape[1] if ok else 0):
-                    bound = abs_matvec(self.K, np.abs(Nk[:, j])).max()
-                    ok = ok and np.abs(self.K @ Nk[:, j]).max() <= NULL_ROUNDING * bound
+                if ok and Nk.shape[1]:  # every column in one pass over K (and one over |K|)
+                    bound = abs_matvec(self.K, np.abs(Nk)).max(axis=0)
+                    ok = bool(np.all(np.abs(self.K @ Nk).max(axis=0) <= NULL_ROUNDING * bound))
                 N = Nk if ok else None
             self._null = N
         return self._null
