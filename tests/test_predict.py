@@ -233,3 +233,26 @@ def test_a_triangle_meshed_bed_with_a_coarse_start():
     xy = res.model.contacts.xy
     np.testing.assert_allclose([res.reactions.sum(), res.reactions @ xy[:, 0], res.reactions @ xy[:, 1]],
                                [1.0, 0.3, 0.6], rtol=1e-9)
+
+
+@pytest.mark.parametrize("n, predict", [(64, True), (128, "auto")])
+def test_a_coarse_mesh_without_equilibrium_leaves_the_fine_solve_to_start_cold(n, predict):
+    """A free plate on a bed strip x ∈ [0.27, 0.515] under a point load at x = 0.51: the fine
+    mesh's bed reaches x = 0.5156 and carries it, the coarse mesh's cells end at x = 0.5 and its
+    plate would tip off them (NoEquilibriumError there). The prediction is then given up, never
+    the solve: the answer is the cold start's, and statics holds (Σ R = P, Σ R x = P x_P). At
+    128² the strip has 4128 springs, so ``predict="auto"`` (the default) takes this route."""
+    P, xP = 20.0, 0.51
+    sc = pq.Scene(name="strip", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
+                  edges={}, loads=[pq.PointLoad(P, xP, 0.5)],
+                  foundation=pq.Foundation(2.0e4, region=[0.27, 0.515, 0.0, 1.0]))
+    sc.validate()
+    res = solve(sc, options={"predict": predict})
+    cold = solve(sc, options={"predict": False})
+    why = res.extras["predicted"]["why"]
+    assert why.startswith("the coarse mesh failed: NoEquilibriumError"), why
+    assert res.model.contacts.xy[:, 0].max() > xP
+    R, xy = res.reactions, res.model.contacts.xy
+    np.testing.assert_allclose(R.sum(), P, rtol=1e-6)  # the answer is at its rounding floor here
+    np.testing.assert_allclose(R @ xy[:, 0], P * xP, rtol=1e-6)
+    same_answer(res, cold)

@@ -23,7 +23,7 @@ import scipy.sparse as sp
 
 from ..accuracy import Status
 from ..assembly import Model, build_model
-from ..errors import PlateQPWarning, ProblemError
+from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError
 from ..estimate import COARSE_FAILURES, with_mesh
 from ..geometry import mesh_cells
 from ..linalg import row_stiffness
@@ -91,7 +91,10 @@ def predicted_set(model: Model, solve) -> tuple[np.ndarray | None, dict]:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", PlateQPWarning)
             coarse = solve(build_model(coarse_scene), backend="pdas", formulation="primal", accuracy="default")
-    except COARSE_FAILURES as exn:
+    except (*COARSE_FAILURES, NoEquilibriumError) as exn:
+        # the coarse answer is only a start: whatever stops it (a bed region whose coarse cells
+        # end short of the load, so that the coarse plate tips off them) leaves the fine solve
+        # to start cold, never fails it
         return None, {"mesh": [cx, cy], "why": f"the coarse mesh failed: {type(exn).__name__}: {exn}"}
     if coarse.status != Status.OPTIMAL:
         return None, {"mesh": [cx, cy], "why": f"the coarse solve ended {coarse.status.value}"}
