@@ -61,15 +61,20 @@ def bed_64():
     return sc, solve(sc, options={"predict": False})
 
 
-def test_a_large_bed_starts_from_the_coarse_mesh_and_factorises_once(bed_64):
+def test_a_large_bed_starts_from_the_coarse_mesh_and_factorises_once(bed_64, monkeypatch):
     """F.bed(64): 4225 soft springs (≥ ROWS_MIN), so ``predict="auto"`` solves the 16² mesh first;
-    its set is (nearly) the answer's, so pdas factorises once (a cold start: twice, the two-sided
-    matrix and then the set it settles on). Same answer, and statics holds."""
+    its set is (nearly) the answer's, so pdas factorises once (a cold start: at least twice, the
+    two-sided matrix and then the set it settles on). Same answer, and statics holds. (Whether the few
+    rows left are a low-rank correction or a refactorisation is the factor's choice by measured
+    times; on a 64² plate that choice is made certain here, as the cost rule is not under test.)"""
+    from plateqp.backends.pdas import factor as pdas_factor
+
+    monkeypatch.setattr(pdas_factor, "LOWRANK_COST", 1e9)
     sc, cold = bed_64
     res = solve(sc)
     assert res.status == pq.Status.OPTIMAL and res.kkt.ok
     assert res.extras["predicted"]["mesh"] == [16, 16]
-    assert res.extras["factorisations"] == 1 and cold.extras["factorisations"] == 2
+    assert res.extras["factorisations"] == 1 and cold.extras["factorisations"] >= 2
     assert res.times["predict"] > 0
     assert_bed_statics(res)
     assert_contact(res)
@@ -241,11 +246,14 @@ def test_a_coarse_mesh_without_equilibrium_leaves_the_fine_solve_to_start_cold(n
     mesh's bed reaches x = 0.5156 and carries it, the coarse mesh's cells end at x = 0.5 and its
     plate would tip off them (NoEquilibriumError there). The prediction is then given up, never
     the solve: the answer is the cold start's, and statics holds (Σ R = P, Σ R x = P x_P). At
-    128² the strip has 4128 springs, so ``predict="auto"`` (the default) takes this route."""
+    128² the strip has 4128 springs, so ``predict="auto"`` (the default) takes this route. (A
+    stiff bed: on a soft one, k = 2e4, the plate's tilt dwarfs its bending, the stationarity's
+    rounding floor is 2.8e-8 at 128² and two cold solves differed by 5e-5 of the largest
+    reaction.)"""
     P, xP = 20.0, 0.51
     sc = pq.Scene(name="strip", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
                   edges={}, loads=[pq.PointLoad(P, xP, 0.5)],
-                  foundation=pq.Foundation(2.0e4, region=[0.27, 0.515, 0.0, 1.0]))
+                  foundation=pq.Foundation(2.0e7, region=[0.27, 0.515, 0.0, 1.0]))
     sc.validate()
     res = solve(sc, options={"predict": predict})
     cold = solve(sc, options={"predict": False})
@@ -253,6 +261,7 @@ def test_a_coarse_mesh_without_equilibrium_leaves_the_fine_solve_to_start_cold(n
     assert why.startswith("the coarse mesh failed: NoEquilibriumError"), why
     assert res.model.contacts.xy[:, 0].max() > xP
     R, xy = res.reactions, res.model.contacts.xy
-    np.testing.assert_allclose(R.sum(), P, rtol=1e-6)  # the answer is at its rounding floor here
-    np.testing.assert_allclose(R @ xy[:, 0], P * xP, rtol=1e-6)
-    same_answer(res, cold)
+    np.testing.assert_allclose(R.sum(), P, rtol=1e-8)
+    np.testing.assert_allclose(R @ xy[:, 0], P * xP, rtol=1e-8)
+    assert_contact(res)
+    same_answer(res, cold, rtol=1e-7)
