@@ -204,7 +204,9 @@ def test_a_coarse_mesh_that_cannot_be_built_leaves_a_cold_start():
     res = solve(sc, backend="pdas", options={"predict": True})
     cold = solve(sc, backend="pdas", options={"predict": False})
     assert res.extras["predicted"]["why"].startswith("the coarse mesh failed: SceneError")
-    assert res.extras["factorisations"] == cold.extras["factorisations"]
+    # the cold start's path: its active sets (not its factorisations, which a low-rank choice by
+    # measured times may change from run to run)
+    assert res.extras["first_phase"] == cold.extras["first_phase"] and res.iterations == cold.iterations
     same_answer(res, cold)
 
 
