@@ -158,8 +158,8 @@ factorisations. With a warm start the factor is that of its set, so a good one (
 previous answer; :mod:`plateqp.contact.predict`'s coarse mesh, 8 of 16 641 rows wrong on that
 bed) costs one factorisation (no Newton step where the set's own minimiser keeps it or moves
 at most the settled count of rows; those a Woodbury correction), and a bad one costs PCG
-iterations, not refactorisations
-(every row of the bed's set flipped at random in 10 %: three Newton steps, two factorisations).
+iterations, not refactorisations (every row of the bed's set flipped at random in 10 %: three
+Newton steps, two factorisations).
 
 Stiff rows (rigid posts) on a held plate, cold start: plain PDAS from the two-sided start cycles
 and falls back to Murty's one row per step (a 64 × 64 slab with 45 × 45 posts: 407 steps, each a
