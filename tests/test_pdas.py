@@ -329,8 +329,12 @@ def test_refuses_other_shapes():
         PD.solve(QP(P=P, q=np.ones(3), G=G, h=[1.0], A=G, b=[0.0]))
     with pytest.raises(SolverError, match="sparse"):
         PD.solve(QP(P=np.eye(3), q=np.ones(3), G=np.ones((1, 3)), h=[1.0]))
-    with pytest.raises(SolverError, match="few constraint rows"):
+    with pytest.raises(SolverError, match="at most n constraint rows"):
         PD.solve(QP(P=P, q=np.ones(3), G=sp.csr_matrix(np.ones((4, 3))), h=np.ones(4)))
+    with pytest.raises(SolverError, match=r"min\(n, 1\) \(option max_rows\)"):
+        PD.solve(QP(P=P, q=np.ones(3), G=sp.csr_matrix(np.eye(3)[:2]), h=np.ones(2)), options={"max_rows": 1})
+    with pytest.raises(ProblemError, match="max_rows"):
+        PD.solve(QP(P=P, q=np.ones(3), G=G, h=[1.0]), options={"max_rows": 0})
     with pytest.raises(SolverError, match="no inequality|needs inequality"):
         PD.solve(QP(P=P, q=np.ones(3)))
     with pytest.raises(ProblemError, match="unknown option"):
@@ -660,3 +664,26 @@ def test_random_stiff_beds_are_solved_exactly(seed):
     assert ref.status == Status.OPTIMAL
     assert res.status == Status.OPTIMAL and res.kkt.ok
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * np.abs(ref.reactions).max())
+
+
+def test_more_rows_than_the_old_cap_of_100000():
+    """pdas took at most 100 000 rows, and ``backend="auto"`` (pdas on the primal) then refused
+    every bed finer than 316 × 316 cells. A chain (1-D Laplacian, a small diagonal) under a
+    random downward load, with an obstacle under every other node at a random gap: 100 001 rows
+    on 200 003 unknowns. Checked by the KKT conditions written out here: stationarity
+    P x + q + Gᵀz = 0, G x ≤ h, z ≥ 0, z·(h − G x) = 0."""
+    n, m = 200_003, 100_001
+    off = np.full(n - 1, -1.0)
+    P = sp.diags([off, np.full(n, 2.0 + 1e-3), off], [-1, 0, 1], format="csc")
+    rng = np.random.default_rng(0)
+    q = -rng.uniform(0.0, 1.0, n)
+    G = sp.csr_matrix((np.ones(m), (np.arange(m), np.arange(0, 2 * m, 2))), shape=(m, n))
+    h = rng.uniform(0.0, 50.0, m)
+    sol = PD.solve(QP(P=P, q=q, G=G, h=h), accuracy="high")
+    assert sol.status == Status.OPTIMAL
+    x, z = sol.x, sol.z
+    assert np.abs(P @ x + q + G.T @ z).max() <= 1e-12 * np.abs(q).max()
+    gap = h - G @ x
+    assert gap.min() >= -1e-12 * np.abs(h).max() and z.min() >= 0.0
+    assert np.abs(z * gap).max() <= 1e-12 * np.abs(h).max() * np.abs(z).max()
+    assert 0 < np.count_nonzero(z) < m  # a real contact problem: some obstacles touched, not all

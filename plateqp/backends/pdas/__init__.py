@@ -302,7 +302,8 @@ class PDAS(Backend):
         Parameters
         ----------
         problem : QP
-            Sparse ``P``, ``G`` with ``m ≤ min(n, max_rows)`` rows, ``h``; nothing else.
+            Sparse ``P``, ``G`` with ``m ≤ n`` rows (``m ≤ min(n, max_rows)`` with that option),
+            ``h``; nothing else.
         accuracy : {"low", "default", "high"}, a float (a KKT tolerance; see base.preset) or an Accuracy
             Preset of :data:`ACCURACY`.
         options : dict, optional

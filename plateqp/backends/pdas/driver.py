@@ -126,7 +126,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     p = _option(settings, "p", lambda v: _is_int(v, 0), "an integer ≥ 0")
     max_dense = _option(settings, "max_dense", lambda v: (isinstance(v, str) and v == "auto") or _is_int(v, 0),
                         "'auto' or an integer ≥ 0")
-    max_rows = _option(settings, "max_rows", lambda v: _is_int(v, 1), "a positive integer")
+    max_rows = _option(settings, "max_rows", lambda v: v is None or _is_int(v, 1), "None or a positive integer")
     for key in ("dual_start", "lh_start", "anchor_start"):
         _option(settings, key, lambda v: isinstance(v, (bool, np.bool_)), "True or False")
     if not isinstance(trace, (bool, np.bool_)):

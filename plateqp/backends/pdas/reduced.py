@@ -39,7 +39,7 @@ class ReducedQP:
     """The QP read back as a contact problem ``(K, f, B, ρ, g)``: separable variables eliminated
     (see the package docstring, "The problem")."""
 
-    def __init__(self, qp: QP, max_rows: int) -> None:
+    def __init__(self, qp: QP, max_rows: int | None) -> None:
         if not isinstance(qp, QP):
             raise SolverError(f"the pdas backend solves QPs only (the primal formulation), got {type(qp).__name__}")
         if qp.A is not None or qp.lb is not None or qp.ub is not None:
@@ -52,9 +52,10 @@ class ReducedQP:
             raise SolverError("the pdas backend takes sparse P and G (the primal formulation); for a dense "
                               "problem use the condensed formulation with lemke or bpp")
         m, n = qp.G.shape
-        if m > min(n, max_rows):
-            raise SolverError(f"the pdas backend takes few constraint rows (m ≤ min(n, {max_rows})), "
-                              f"got m = {m}, n = {n}")
+        limit = n if max_rows is None else min(n, max_rows)
+        if m > limit:
+            cap = "n" if max_rows is None else f"min(n, {max_rows}) (option max_rows)"
+            raise SolverError(f"the pdas backend takes at most {cap} constraint rows, got m = {m}, n = {n}")
         P = sp.csc_matrix(qp.P, dtype=float)  # stored zeros kept: the ordering reads them (linalg.pattern)
         G = sp.csc_matrix(qp.G, dtype=float)
         G.eliminate_zeros()
