@@ -36,6 +36,7 @@ from .options import (
     LH_PROBE,
     LH_TIME,
     LOOSE_TOL,
+    LOWRANK_MAX,
     NEWTON_BUDGET,
     NEWTON_SETTLED,
     NEWTON_SETTLED_FRACTION,
@@ -139,8 +140,7 @@ def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, st
     to change; a bad one costs PCG iterations, each wrong row one more at most, never a
     factorisation), or of the two-sided matrix (every row active) on a cold start. Returns
     ``(u, A, steps)``; 0 steps where the warm start's own minimiser keeps its set or moves at
-    most ``max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION · m)`` rows of it (the exact steps
-    take those on the warm start's factor).
+    most LOWRANK_MAX rows of it (the exact steps take those on the warm start's factor).
     """
     B, K, f, g, D = pb.B, pb.K, pb.f, pb.g, pb.Kd
     first = W.copy() if start is None else np.where(start, W, 0.0)
@@ -149,11 +149,13 @@ def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, st
     A = B @ u - g > 0
     if start is not None:
         changes = int((A ^ start).sum())
-        if changes <= max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION * pb.m):
-            # u is that set's step and it keeps, or moves a few rows: the exact steps take them
-            # on this factor (a low-rank correction), as they would after a Newton step that
-            # settled, and that step's gradient and PCG solves are saved (2 of 7 on the
-            # benchmark bed at 128² from its coarse mesh's set, 8 rows moved)
+        if changes <= LOWRANK_MAX:
+            # u is that set's step and it keeps, or moves few enough rows for the exact steps to
+            # take them on this factor (a low-rank correction), as they would after a Newton
+            # step that settled; that step's gradient and PCG solves are saved (2 of 7 on the
+            # benchmark bed at 128² from its coarse mesh's set, 8 rows moved). More rows go to
+            # the Newton steps, not to exact exchanges: at 512² the coarse set (3 rows wrong)
+            # moved 156, and exact block exchanges from there took 3 factorisations
             if steps is not None:
                 steps.append({"step": "newton 0", "active": int(A.sum()), "infeasible": changes,
                               "solve": "warm start"})
