@@ -90,6 +90,10 @@ class Model:
     # all dofs × all dofs, or a function that assembles it (:attr:`K_full`, on first use)
     _K_full: sp.csr_matrix | Callable[[], sp.csr_matrix] = field(repr=False)
     contacts: ContactOperator | None = None
+    #: K is exactly symmetric, value for value (the rectangular assembly makes it so: see
+    #: :func:`_node_blocks`), so its CSR arrays are its CSC arrays
+    #: (:func:`plateqp.linalg.pattern.csc_of_symmetric`)
+    symmetric: bool = False
 
     @property
     def K_full(self) -> sp.csr_matrix:
@@ -258,6 +262,7 @@ def build_model(scene: Scene) -> Model:
         K_full = K_full()
         f -= (K_full @ u_c)[free]
     model = Model(scene, grid, el, K, f, free, fixed, values, n_full, cell_dofs, cells, f_full, K_full)
+    model.symmetric = True  # _node_blocks adds (p, q) and (q, p) in the same order
     model.contacts = _contacts(scene, model)
     return model
 

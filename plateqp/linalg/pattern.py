@@ -34,6 +34,18 @@ def scaled(K: sp.spmatrix, s: np.ndarray, factor: float = 1.0) -> sp.csr_matrix 
     return type(K)((data, K.indices.copy(), K.indptr.copy()), shape=K.shape)
 
 
+def csc_of_symmetric(K: sp.spmatrix, symmetric: bool) -> sp.csc_matrix:
+    """``K`` as CSC. Where ``symmetric`` (the caller vouches that ``K`` is exactly symmetric,
+    value for value) and ``K`` is CSR with sorted indices, its arrays are read as CSC: the CSR
+    arrays of ``Kᵀ = K`` are ``K``'s CSC arrays, so nothing is converted (SciPy's conversion
+    took 7 ms at 128², 0.3 s at 512² on a plate's K) and the arrays are shared, not copied."""
+    if symmetric and sp.isspmatrix_csr(K) and K.shape[0] == K.shape[1] and K.has_sorted_indices:
+        out = sp.csc_matrix((K.data, K.indices, K.indptr), shape=K.shape, copy=False)
+        out.has_sorted_indices = True
+        return out
+    return sp.csc_matrix(K)
+
+
 def add(*mats: sp.spmatrix) -> sp.csc_matrix:
     """The sum of sparse matrices of one shape, on the union of their stored patterns (an entry
     that sums to zero stays stored), sorted, CSC."""
