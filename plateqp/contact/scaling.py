@@ -74,7 +74,7 @@ class Scaled:
         Sm = sp.diags(S)
         # CSC, the format every factorisation and the primal QP take: converted here, once, so
         # that no copy of it is alive beside this one when K is factorised (15 MB at 128²)
-        K = pattern.scaled(pattern.csc_of_symmetric(model.K, getattr(model, "symmetric", False)), S,
+        K = pattern.scaled(pattern.csc_of_symmetric(model.K, model.symmetric), S,
                            1.0 / (F0 * W))  # its stored pattern kept (AMD); a copy, not model.K's arrays
         f = S * model.f / (F0 * W)
         B = (c.B @ Sm / W).tocsr()

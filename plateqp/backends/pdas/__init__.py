@@ -157,7 +157,7 @@ iterations, then one exact step and two rows exchanged (a Woodbury correction): 
 factorisations. With a warm start the factor is that of its set, so a good one (a sweep's
 previous answer; :mod:`plateqp.contact.predict`'s coarse mesh, 8 of 16 641 rows wrong on that
 bed) costs one factorisation (no Newton step where the set's own minimiser keeps it or moves
-at most the settled count of rows; those a Woodbury correction), and a bad one costs PCG
+at most LOWRANK_MAX rows; those a Woodbury correction), and a bad one costs PCG
 iterations, not refactorisations (every row of the bed's set flipped at random in 10 %: three
 Newton steps, two factorisations).
 
