@@ -7,10 +7,11 @@ diagonal pivoting: 2.3–2.5× faster than SuperLU's defaults at 256², but 1.3�
 from 128² on; see benchmarks/README.md). The matrix is first equilibrated, K̂ = S K S with
 S = diag(K)^(-1/2), since unknowns of one matrix may differ by orders of magnitude in scale.
 
-Every solve is followed by iterative refinement whose residual is summed in long double
-(where the platform has it): the double-precision residual ‖K u − f‖/‖f‖ has a floor of
-about eps·‖K‖‖u‖/‖f‖ (2e-8 on a 256² plate, even for the exact solution rounded to doubles),
-so it cannot show convergence; the long-double residual brings the forward error to ~1e-13.
+Every solve is followed by iterative refinement on a residual computed to about 2⁻⁷⁰ of
+``|K||u|`` (:class:`~plateqp.linalg.residual.Residual`: an error-free split of the product, in
+double arithmetic, on every platform): the double-precision residual ‖K u − f‖/‖f‖ has a floor
+of about eps·‖K‖‖u‖/‖f‖ (2e-8 on a 256² plate, even for the exact solution rounded to doubles),
+so it cannot show convergence; the exact residual brings the forward error to ~1e-14.
 """
 
 from __future__ import annotations
@@ -24,10 +25,7 @@ import scipy.sparse.linalg as spla
 from ..errors import SingularMatrixError
 from . import pattern
 from .cholmod import Cholesky, lower
-
-# residuals for iterative refinement are accumulated in long double where it is wider than
-# double (x86-64 Linux/macOS: 64-bit mantissa); elsewhere (Windows, arm64 macOS) plain double
-_EXTENDED = np.finfo(np.longdouble).eps < np.finfo(np.float64).eps
+from .residual import Residual
 
 METHODS = ("auto", "cholmod", "cvxopt", "superlu", "superlu-default")
 
@@ -52,18 +50,17 @@ class Refined:
         raise NotImplementedError
 
     def _residual(self, b: np.ndarray, x: np.ndarray) -> np.ndarray:
-        """b − K x, accumulated in long double where that is wider than double.
+        """b − K x to about 2⁻⁷⁰ of |K||x| (:class:`~plateqp.linalg.residual.Residual`).
 
         In double, the residual of any float64 x is no smaller than about eps·‖|K||x|‖ (the
         rounding of x alone), which for a fine plate mesh is 1e-8·‖b‖: refinement on a double
-        residual cannot see errors below that. In long double it can (forward error ~1e-13).
+        residual cannot see errors below that. With the error-free split it can (forward error
+        ~1e-14), in double arithmetic on every platform.
         """
-        if not _EXTENDED:
-            return b - self.K @ x
-        if getattr(self, "_KL", None) is None:
-            K = self.K  # the values widened; the index arrays shared, not copied
-            self._KL = type(K)((K.data.astype(np.longdouble), K.indices, K.indptr), shape=K.shape)
-        return (b.astype(np.longdouble) - self._KL @ x.astype(np.longdouble)).astype(np.float64)
+        if getattr(self, "_res", None) is None:
+            # K symmetric: the contract of both subclasses (only its lower triangle is factorised)
+            self._res = Residual(self.K, getattr(self, "s", None), symmetric=True)
+        return self._res(b, x)
 
     def solve(self, b, refine: int = 3) -> np.ndarray:
         """Solve K x = b (b may have several columns), with up to ``refine`` refinement steps.
@@ -146,7 +143,7 @@ class Factor(Refined):
         """Factorise new values; with CHOLMOD the analysis of the first matrix is re-used, so
         ``K`` must have that pattern (or a part of it)."""
         self.K = sp.csc_matrix(K)
-        self._KL = None
+        self._res = None
         self.s = equilibration(self.K)
         if self.chol is not None:
             A = lower(self.K, self.s, self.order, upper=self.chol.upper)

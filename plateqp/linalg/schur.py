@@ -222,7 +222,7 @@ class SchurFactor:
         row is one unknown and each unknown one row, ``S⁻¹`` by LAPACK's POTRI, rows and
         columns picked and scaled). Backward stable, but as an inverse of ``S`` its relative
         error is about cond(S)·ε. ``refine > 0``: the columns ``K⁻¹ Bᵀ`` by solves with this
-        factor in blocks, each refined (long-double residuals) to about ε: m solves, for a
+        factor in blocks, each refined (exact residuals, plateqp.linalg.residual) to about ε: m solves, for a
         caller that uses ``B K⁻¹ Bᵀ`` as its final data (an exported dual; plateqp.solve's dual
         takes the trailing block's and corrects its answer instead). Measured on a 6 × 6 plate with 34
         supports (cond K 1.8e5): relative error 6e-14 from the trailing block, 1e-16 refined,
