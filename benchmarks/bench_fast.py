@@ -37,6 +37,10 @@ Parts (``--parts``, comma-separated):
   of one support (``plateqp.sweep``) through auto and through pdas.
 * ``mesh``: the grid scene's ``pq.solve`` ÷ raw for ``--scale-meshes`` (32,64,128,256,512;
   one run at 512²).
+* ``residual``: the residual ``f − K u`` that refinement reads, at ``--meshes`` for
+  ``--scenes``: in double, in long double (the widened values made once) and by
+  ``plateqp.linalg.residual.Residual`` (K split once), the first and a further one, CPU
+  medians of ``--repeat`` interleaved.
 * ``flops``: why the grid's condensed method costs what it does: at ``--meshes``, one
   factorisation of the grid scene's equilibrated K in AMD order ("plain") and one with the 900
   contact dofs moved last (the condensed method's), each through plateqp's CHOLMOD seam: CPU
@@ -315,6 +319,50 @@ def flops_row(n: int, repeat: int) -> dict:
             "plain_flops": flops["plain"], "last_flops": flops["last"], "repeat": repeat}
 
 
+# ----------------------------------------------------------------------------- residual
+
+
+def residual_row(kind: str, n: int, repeat: int) -> dict:
+    """The residual ``f − K u`` that ``Factor.solve``'s refinement reads, three ways, on the
+    floor's matrix and a raw solve's ``u``: in double (the floor: one SciPy product); in long
+    double (what refinement read until issue 11's thirteenth session: the values widened once,
+    then a long-double product); and by ``plateqp.linalg.residual.Residual`` (the split of K,
+    then three double products). CPU ms, medians of ``repeat`` interleaved; "first" includes
+    the one-time widening or split, "again" is a further residual with it."""
+    from plateqp.linalg.factor import equilibration
+    from plateqp.linalg.residual import Residual
+
+    model = build_model(make_scene(kind, n))
+    K, f = plate_matrix(kind, model)
+    K = sp.csc_matrix(K)
+    s = equilibration(K)
+    u = Factor(K).solve(f, refine=0)
+
+    def widened():
+        return sp.csc_matrix((K.data.astype(np.longdouble), K.indices, K.indptr), shape=K.shape)
+
+    def long_double(KL):
+        return (f.astype(np.longdouble) - KL @ u.astype(np.longdouble)).astype(np.float64)
+
+    KL, R = widened(), Residual(K, s, symmetric=True)
+    steps = {
+        "double": lambda: f - K @ u,
+        "long_first": lambda: long_double(widened()),
+        "long_again": lambda: long_double(KL),
+        "split_first": lambda: Residual(K, s, symmetric=True)(f, u),
+        "split_again": lambda: R(f, u),
+    }
+    times: dict[str, list[float]] = {k: [] for k in steps}
+    for r in range(repeat):
+        names = list(steps)
+        names = names[r % len(names):] + names[:r % len(names)]
+        for name in names:
+            times[name].append(cpu(steps[name])[0])
+    med = {k: 1e3 * statistics.median(v) for k, v in times.items()}
+    return {"part": "residual", "scene": kind, "mesh": n, "dofs": K.shape[0], "nnz": K.nnz, "repeat": repeat,
+            **{f"{k}_ms": v for k, v in med.items()}}
+
+
 # ----------------------------------------------------------------------------- backend="auto"
 
 ROUTES = (("auto", "auto"), ("pdas", "primal"), ("bpp", "condensed"), ("lemke", "condensed"), ("bpp", "dual"))
@@ -534,6 +582,22 @@ def main():
                   f"{row['last_flops'] / 1e9:.2f} | {row['last_flops'] / row['last_s'] / 1e9:.1f} | "
                   f"{row['last_s'] / row['plain_s']:.2f} | {row['last_flops'] / row['plain_flops']:.2f} |", flush=True)
             write_csv(rows, args.out)
+
+    if "residual" in parts:
+        print("\n### The residual f − K u of refinement: double, long double, split (CPU ms, medians of "
+              f"{args.repeat} interleaved)\n")
+        print("| scene | mesh | nnz K | double | long double, first | again | split, first | again | "
+              "first: split ÷ long | again: split ÷ long |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+        for kind in kinds:
+            for n in (int(v) for v in args.meshes.split(",")):
+                row = residual_row(kind, n, args.repeat)
+                rows.append(row)
+                print(f"| {kind} | {n}² | {row['nnz']} | {row['double_ms']:.2f} | {row['long_first_ms']:.2f} | "
+                      f"{row['long_again_ms']:.2f} | {row['split_first_ms']:.2f} | {row['split_again_ms']:.2f} | "
+                      f"{row['split_first_ms'] / row['long_first_ms']:.2f} | "
+                      f"{row['split_again_ms'] / row['long_again_ms']:.2f} |", flush=True)
+                write_csv(rows, args.out)
 
     write_csv(rows, args.out)
     print(f"\nwritten {args.out}")
