@@ -440,6 +440,19 @@ def write_csv(rows, path):
         w.writerows(rows)
 
 
+def table(rows: list[dict], out: str, title: str, head: list[str], cases, cells) -> None:
+    """A markdown table: each case (a callable returning a row) run, kept in ``rows``, printed
+    as ``cells(row)`` and the CSV rewritten (a long run keeps what it measured)."""
+    print(f"\n### {title}\n")
+    print("| " + " | ".join(head) + " |")
+    print("|" + "---|" * len(head))
+    for case in cases:
+        row = case()
+        rows.append(row)
+        print("| " + " | ".join(str(c) for c in cells(row)) + " |", flush=True)
+        write_csv(rows, out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--parts", default="goal,backends,mesh")
@@ -569,35 +582,31 @@ def main():
             write_csv(rows, args.out)
 
     if "flops" in parts:
-        print("\n### grid_rigid(n, 30): CHOLMOD's factorisation of K, plain (AMD) and with the contact dofs last "
-              f"(CPU s, medians of {args.repeat})\n")
-        print("| mesh | dofs | contact dofs | plain s | plain G flops | GF/s | last s | last G flops | GF/s | "
-              "time ratio | flop ratio |")
-        print("|---|---|---|---|---|---|---|---|---|---|---|")
-        for n in (int(v) for v in args.meshes.split(",")):
-            row = flops_row(n, args.repeat)
-            rows.append(row)
-            print(f"| {n}² | {row['dofs']} | {row['rows']} | {row['plain_s']:.3f} | {row['plain_flops'] / 1e9:.2f} | "
-                  f"{row['plain_flops'] / row['plain_s'] / 1e9:.1f} | {row['last_s']:.3f} | "
-                  f"{row['last_flops'] / 1e9:.2f} | {row['last_flops'] / row['last_s'] / 1e9:.1f} | "
-                  f"{row['last_s'] / row['plain_s']:.2f} | {row['last_flops'] / row['plain_flops']:.2f} |", flush=True)
-            write_csv(rows, args.out)
+        table(rows, args.out,
+              "grid_rigid(n, 30): CHOLMOD's factorisation of K, plain (AMD) and with the contact dofs last "
+              f"(CPU s, medians of {args.repeat})",
+              ["mesh", "dofs", "contact dofs", "plain s", "plain G flops", "GF/s", "last s", "last G flops", "GF/s",
+               "time ratio", "flop ratio"],
+              (lambda n=n: flops_row(n, args.repeat) for n in (int(v) for v in args.meshes.split(","))),
+              lambda row: [f"{row['mesh']}²", row["dofs"], row["rows"], f"{row['plain_s']:.3f}",
+                           f"{row['plain_flops'] / 1e9:.2f}", f"{row['plain_flops'] / row['plain_s'] / 1e9:.1f}",
+                           f"{row['last_s']:.3f}", f"{row['last_flops'] / 1e9:.2f}",
+                           f"{row['last_flops'] / row['last_s'] / 1e9:.1f}", f"{row['last_s'] / row['plain_s']:.2f}",
+                           f"{row['last_flops'] / row['plain_flops']:.2f}"])
 
     if "residual" in parts:
-        print("\n### The residual f − K u of refinement: double, long double, split (CPU ms, medians of "
-              f"{args.repeat} interleaved)\n")
-        print("| scene | mesh | nnz K | double | long double, first | again | split, first | again | "
-              "first: split ÷ long | again: split ÷ long |")
-        print("|---|---|---|---|---|---|---|---|---|---|")
-        for kind in kinds:
-            for n in (int(v) for v in args.meshes.split(",")):
-                row = residual_row(kind, n, args.repeat)
-                rows.append(row)
-                print(f"| {kind} | {n}² | {row['nnz']} | {row['double_ms']:.2f} | {row['long_first_ms']:.2f} | "
-                      f"{row['long_again_ms']:.2f} | {row['split_first_ms']:.2f} | {row['split_again_ms']:.2f} | "
-                      f"{row['split_first_ms'] / row['long_first_ms']:.2f} | "
-                      f"{row['split_again_ms'] / row['long_again_ms']:.2f} |", flush=True)
-                write_csv(rows, args.out)
+        table(rows, args.out,
+              "The residual f − K u of refinement: double, long double, split (CPU ms, medians of "
+              f"{args.repeat} interleaved)",
+              ["scene", "mesh", "nnz K", "double", "long double, first", "again", "split, first", "again",
+               "first: split ÷ long", "again: split ÷ long"],
+              (lambda kind=kind, n=n: residual_row(kind, n, args.repeat)
+               for kind in kinds for n in (int(v) for v in args.meshes.split(","))),
+              lambda row: [row["scene"], f"{row['mesh']}²", row["nnz"], f"{row['double_ms']:.2f}",
+                           f"{row['long_first_ms']:.2f}", f"{row['long_again_ms']:.2f}",
+                           f"{row['split_first_ms']:.2f}", f"{row['split_again_ms']:.2f}",
+                           f"{row['split_first_ms'] / row['long_first_ms']:.2f}",
+                           f"{row['split_again_ms'] / row['long_again_ms']:.2f}"])
 
     write_csv(rows, args.out)
     print(f"\nwritten {args.out}")
