@@ -39,8 +39,9 @@ class Residual:
     ``scale``: the equilibration to balance ``K`` with (default ``diag(K)^(-1/2)``); the
     powers of two nearest it are used, so it changes the accuracy, never the exactness.
     ``symmetric``: the caller vouches that ``K``'s stored pattern is symmetric (an SPD matrix's
-    is, as assembled), so the longest column is the longest row. The split of ``K`` is made once; :meth:`__call__` takes ``b`` and ``x`` of shape (n,) or
-    (n, k). Non-finite entries in ``K`` (nothing to split) fall back to the double product.
+    is, as assembled), so the longest column is the longest row. The split of ``K`` is made
+    once; :meth:`__call__` takes ``b`` and ``x`` of shape (n,) or (n, k). Non-finite entries
+    in ``K`` (nothing to split) fall back to the double product.
     """
 
     def __init__(self, K: sp.spmatrix, scale: np.ndarray | None = None, symmetric: bool = False) -> None:
@@ -52,8 +53,9 @@ class Residual:
             with np.errstate(divide="ignore", invalid="ignore"):
                 scale = np.where(d > 0, 1.0 / np.sqrt(d), 1.0)
         scale = np.asarray(scale, dtype=float)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k = np.where((scale > 0) & np.isfinite(scale), np.rint(np.log2(np.where(scale > 0, scale, 1.0))), 0.0)
+        ok = (scale > 0) & np.isfinite(scale)  # elsewhere no scaling (2⁰)
+        k = np.zeros_like(scale)
+        k[ok] = np.rint(np.log2(scale[ok]))
         self.d = np.exp2(k)  # powers of two: scaling by them is exact
         self.dinv = np.exp2(-k)
         # two arrays of nnz, no more (fresh pages cost as much as the arithmetic here)
