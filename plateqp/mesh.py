@@ -63,6 +63,45 @@ class Grid:
         mask[self.cell_nodes()[self.cell_mask].ravel()] = True
         return mask
 
+    # -- the mesh as every generator gives it (plateqp.trimesh.TriMesh has the same names) ------
+    cell_type = "quad"
+
+    @property
+    def grid_shape(self) -> tuple[int, int]:
+        """(ny + 1, nx + 1): the grid view of a nodal field (:meth:`to_grid`)."""
+        return (self.ny + 1, self.nx + 1)
+
+    @property
+    def plate_node_ids(self) -> np.ndarray:
+        """(n,) the grid index of each node of the plate (a node of a kept cell), in grid order:
+        the mesh's nodes, as nodal fields and the dofs count them (node k's dofs are
+        ``plate_node_ids[k] · ndof_node + i``)."""
+        return np.flatnonzero(self.node_mask())
+
+    @property
+    def nodes(self) -> np.ndarray:
+        """(n, 2) coordinates of the plate's nodes (:attr:`plate_node_ids`)."""
+        return self.node_xy()[self.plate_node_ids]
+
+    @property
+    def cells(self) -> np.ndarray:
+        """(n_kept, 4) the kept cells' corners as indices into :attr:`nodes`, element corner order."""
+        new = np.full(self.n_nodes, -1)
+        new[self.plate_node_ids] = np.arange(self.plate_node_ids.size)
+        return new[self.cell_nodes()[self.cell_mask]]
+
+    def triangulation(self) -> np.ndarray:
+        """(2 n_kept, 3) counter-clockwise triangles on :attr:`nodes` (each quad split along its
+        diagonal from corner 0 to corner 2): for drawing only."""
+        c = self.cells
+        return np.vstack([c[:, [0, 1, 2]], c[:, [0, 2, 3]]])
+
+    def to_grid(self, values: np.ndarray) -> np.ndarray:
+        """A nodal field (one value per plate node) on the (ny + 1, nx + 1) grid, NaN off the plate."""
+        out = np.full(self.n_nodes, np.nan)
+        out[self.plate_node_ids] = values
+        return out.reshape(self.grid_shape)
+
     def node_at(self, x: float, y: float, rtol: float = 1e-9) -> int | None:
         """Index of the plate node at (x, y), or None if no kept node is there."""
         fi, fj = x / self.hx, y / self.hy

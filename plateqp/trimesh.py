@@ -79,6 +79,25 @@ class TriMesh:
     domain: Domain
     _tree: object = field(default=None, repr=False, compare=False)
 
+    # -- the mesh as every generator gives it (plateqp.mesh.Grid has the same names) ---------
+    cell_type = "triangle"
+    #: an unstructured mesh has no grid view
+    grid_shape = None
+
+    @property
+    def cells(self) -> np.ndarray:
+        """(nt, 3) the triangles (indices into :attr:`nodes`)."""
+        return self.triangles
+
+    @property
+    def plate_node_ids(self) -> np.ndarray:
+        """(n,) every node is on the plate, and node k's dofs are ``k · ndof_node + i``."""
+        return np.arange(self.n_nodes)
+
+    def triangulation(self) -> np.ndarray:
+        """(nt, 3) the triangles, for drawing."""
+        return self.triangles
+
     # -- the names the contact code reads from a grid ------------------------------------
     @property
     def n_nodes(self) -> int:
