@@ -19,15 +19,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
+from .constraints import prescribed, rigid_modes
 from .elements import ELEMENTS, RectElement
 from .errors import ResourceError, SceneError
 from .mesh import Grid
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
-
-# derivative orders of the nodal dofs, shared by ACM and BFS (BFS adds (1, 1))
-W, WX, WY, WXY = (0, 0), (1, 0), (0, 1), (1, 1)
 
 
 @dataclass
@@ -126,7 +123,7 @@ class Model:
         A rigid motion w = α + βx + γy (slopes β, γ, twist 0) of each connected piece of the
         plate, restricted to the free dofs, with the prescribed dofs held at zero.
         """
-        return _rigid_modes(self)
+        return rigid_modes(self)
 
     def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
         """(npts, n_full) sparse operator: derivative of w at points, from full dofs."""
@@ -238,7 +235,7 @@ def build_model(scene: Scene) -> Model:
 
     f_full = _loads(scene, grid, el, cells, cell_dofs, n_full)
 
-    fixed, values = _prescribed(scene, grid, el)
+    fixed, values = prescribed(scene, grid, el)
     node_mask = grid.node_mask()
     on_plate = np.repeat(node_mask, nd)
     is_fixed = np.zeros(n_full, dtype=bool)
@@ -351,95 +348,6 @@ def _loads(scene, grid, el, cells, cell_dofs, n_full) -> np.ndarray:
             dofs = (nodes[:, None] * el.ndof_node + np.arange(el.ndof_node)).ravel()
             np.add.at(f, dofs, ld.P * N)
     return f
-
-
-def _prescribed(scene, grid, el):
-    """Prescribed dofs and values from edges and pins; conflicts at corners are errors."""
-    nd = el.ndof_node
-    kinds = list(el.node_dofs)
-    node_mask = grid.node_mask()
-    presc: dict[int, tuple[float, str]] = {}
-
-    def put(node, order, value, who):
-        if order not in kinds or not node_mask[node]:
-            return
-        dof = node * nd + kinds.index(order)
-        if dof in presc and abs(presc[dof][0] - value) > 1e-14 * max(1.0, abs(value)):
-            raise SceneError(f"{who} and {presc[dof][1]} prescribe different values of "
-                             f"{el.dof_names[kinds.index(order)]} at their common node; make them agree")
-        presc[dof] = (value, who)
-
-    nx, ny = grid.nx, grid.ny
-    edge_nodes = {
-        "left": [j * (nx + 1) for j in range(ny + 1)],
-        "right": [j * (nx + 1) + nx for j in range(ny + 1)],
-        "bottom": list(range(nx + 1)),
-        "top": [ny * (nx + 1) + i for i in range(nx + 1)],
-    }
-    # (tangential slope order, normal slope order, sign of ∂/∂n relative to the slope dof)
-    geometry = {"left": (WY, WX, -1.0), "right": (WY, WX, 1.0), "bottom": (WX, WY, -1.0), "top": (WX, WY, 1.0)}
-    for name, e in scene.side_edges().items():
-        if e.kind == "free":
-            continue
-        tang, normal, sign = geometry[name]
-        who = f"edges.{name}"
-        for n in edge_nodes[name]:
-            put(n, W, e.w, who)
-            put(n, tang, 0.0, who)  # w constant along the edge
-            if e.kind == "clamped":
-                put(n, normal, sign * e.slope, who)
-                put(n, WXY, 0.0, who)  # the normal slope is constant along the edge
-    for i, pin in enumerate(scene.pins):
-        put(grid.node_at(pin.x, pin.y), W, pin.w, f"pins.{i}")
-    fixed = np.array(sorted(presc), dtype=int)
-    values = np.array([presc[d][0] for d in fixed], dtype=float)
-    return fixed, values
-
-
-def _rigid_modes(model: Model) -> np.ndarray:
-    grid, el = model.grid, model.element
-    nd = el.ndof_node
-    kinds = list(el.node_dofs)
-    cn = grid.cell_nodes()[model.cells]
-    n = grid.n_nodes
-    # connectivity of nodes through kept cells: each cell's first node to its others (the same
-    # components as every pair, with 3 edges a cell instead of 16)
-    r = np.repeat(cn[:, 0], cn.shape[1] - 1)
-    c = cn[:, 1:].ravel()
-    A = sp.csr_matrix((np.ones(r.size), (r, c)), shape=(n, n))
-    _, label = connected_components(A, directed=False)
-    node_mask = grid.node_mask()
-    xy = grid.node_xy()
-    fixed_node = model.fixed // nd
-    fixed_kind = model.fixed % nd
-    free_pos = -np.ones(model.n_full, dtype=int)
-    free_pos[model.free] = np.arange(model.n_free)
-    modes = []
-    for comp in np.unique(label[node_mask]):
-        in_comp = label[model.fixed // nd] == comp
-        rows = []
-        for node, k in zip(fixed_node[in_comp], fixed_kind[in_comp]):
-            order = kinds[k]
-            if order == W:
-                rows.append([1.0, xy[node, 0], xy[node, 1]])
-            elif order == WX:
-                rows.append([0.0, 1.0, 0.0])
-            elif order == WY:
-                rows.append([0.0, 0.0, 1.0])
-        R = np.array(rows).reshape(-1, 3)
-        # null space of the constraints on (α, β, γ)
-        _, s, vt = np.linalg.svd(R if len(R) else np.zeros((1, 3)), full_matrices=len(R) < 3)  # vt 3 × 3
-        s_full = np.zeros(3)
-        s_full[: len(s)] = s
-        null = vt[s_full <= 1e-10 * max(1.0, s_full.max())]
-        comp_nodes = np.flatnonzero((label == comp) & node_mask)
-        for a, b, g in null:
-            v = np.zeros(model.n_full)
-            v[comp_nodes * nd + kinds.index(W)] = a + b * xy[comp_nodes, 0] + g * xy[comp_nodes, 1]
-            v[comp_nodes * nd + kinds.index(WX)] = b
-            v[comp_nodes * nd + kinds.index(WY)] = g
-            modes.append(v[model.free])
-    return np.array(modes).T.reshape(model.n_free, len(modes))
 
 
 def _contacts(scene: Scene, model: Model) -> ContactOperator | None:

@@ -270,18 +270,35 @@ class Domain:
 TRI_ELEMENTS = ("dkt",)
 
 
-def scene_domain(scene) -> Domain:
-    """The Domain of a triangle-meshed scene: its shape (or the rectangle [0, a] × [0, b]) less its
-    holes, then its openings (each the rectangle [x0, x1] × [y0, y1] cut out exactly: holes
-    numbered after the ``[[holes]]``)."""
-    def fail(where, what):
-        scene._fail(where, what)
+def cutout_shapes(scene) -> list[Shape]:
+    """A scene's cut-outs, K = 0, 1, …: its ``[[holes]]`` (polygons, circles), then its
+    ``[[openings]]`` (each the box [x0, x1] × [y0, y1]). One concept with two spellings: the
+    edges of cut-out K are ``holeK`` on every mesh."""
+    holes = [parse_shape(h, f"holes.{i}", scene._fail) for i, h in enumerate(scene.holes)]
+    return holes + [Polygon(((o.x0, o.y0), (o.x1, o.y0), (o.x1, o.y1), (o.x0, o.y1))) for o in scene.openings]
 
+
+def scene_domain(scene) -> Domain:
+    """The Domain of a scene: its shape (or the rectangle [0, a] × [0, b]) less its cut-outs
+    (:func:`cutout_shapes`)."""
     p = scene.plate
-    outer = parse_shape(p.shape, "plate.shape", fail) if p.shape is not None else rectangle(p.a, p.b)
-    holes = tuple(parse_shape(h, f"holes.{i}", fail) for i, h in enumerate(scene.holes))
-    holes += tuple(Polygon(((o.x0, o.y0), (o.x1, o.y0), (o.x1, o.y1), (o.x0, o.y1))) for o in scene.openings)
-    return Domain(outer, holes)
+    outer = parse_shape(p.shape, "plate.shape", scene._fail) if p.shape is not None else rectangle(p.a, p.b)
+    return Domain(outer, tuple(cutout_shapes(scene)))
+
+
+def nearest_segment(shape: Shape, points: np.ndarray, normals: np.ndarray, h: float) -> np.ndarray:
+    """(npts,) the segment of ``shape`` each boundary edge of a mesh lies along: the nearest to
+    its midpoint ``points``, where an edge near a corner is as near two segments, the one whose
+    normal agrees with the edge's outward ``normals`` (the plate's outward normal on a cut-out's
+    boundary points into it). A circle is one segment, 0."""
+    if not isinstance(shape, Polygon):
+        return np.zeros(len(points), dtype=int)
+    seg = shape.segments()
+    d = np.stack([_point_segment(points[:, 0], points[:, 1], s) for s in seg], axis=1)
+    t = seg[:, 1] - seg[:, 0]
+    inward = np.column_stack([-t[:, 1], t[:, 0]]) / np.hypot(t[:, 0], t[:, 1])[:, None]  # left of a ccw side
+    agree = normals @ inward.T  # 1 where the plate's outward normal points into the cut-out across it
+    return np.argmin(d + 0.5 * h * (1.0 - agree), axis=1)
 
 
 class Region:
@@ -330,7 +347,10 @@ def validate_shaped(scene) -> Region:
     if p.shape is not None:
         x0, x1, y0, y1 = domain.outer.bbox
         p.a, p.b = x1 - x0, y1 - y0  # the length scales of a shaped plate: its bounding box
+    from .constraints import edge_table, warn_changed_all
+
     edge_table(scene, domain)  # every edge name known, and no segment named twice
+    warn_changed_all(scene, domain)
     if m.size is None:
         if p.shape is not None:
             fail("mesh.size", "a plate with a shape needs the element size h: [mesh] size = h")
@@ -501,53 +521,3 @@ def tidy_dict(scene, d: dict) -> None:
         del d["mesh"]["size"]
     if scene.holes:
         d["holes"] = [h.to_dict() if isinstance(h, (Polygon, Circle)) else dict(h) for h in scene.holes]
-
-
-# -- edges of a triangle-meshed plate, by name ----------------------------------------------------
-#: ``outer`` / ``holeK`` a whole boundary; ``outer_I`` / ``holeK_I`` segment I of a polygon (from
-#: vertex I to I + 1); ``outer_I-J`` / ``holeK_I-J`` segments I to J. Bare TOML keys, no quoting.
-EDGE_KEY = re.compile(r"^(outer|hole(\d+))(?:_(\d+)(?:-(\d+))?)?$")
-
-
-def edge_table(scene, domain: Domain) -> dict[tuple[int, int], tuple[str, object]]:
-    """(boundary, segment) → (edge name, Edge) for every segment of every boundary that an edge
-    name holds (a circle is one segment, 0); the most specific name wins: a segment range over a
-    whole boundary (``outer``, ``holeK``, or a rectangle's ``left``/``right``/``bottom``/``top``)
-    over ``all``. A name that is not one of these, or a segment two names of the same kind hold,
-    is a SceneError."""
-    shapes = (domain.outer, *domain.holes)
-    nseg = [len(s.vertices) if isinstance(s, Polygon) else 1 for s in shapes]
-    levels: list[dict[tuple[int, int], str]] = [{}, {}, {}]  # all, boundary, segments
-    for name in scene.edges:
-        where = f"edges.{name}"
-        if name == "all":
-            targets, level = [(k, i) for k in range(len(shapes)) for i in range(nseg[k])], 0
-        elif name in RECT_SEGMENTS and scene.plate.shape is None:
-            targets, level = [(0, RECT_SEGMENTS.index(name))], 2
-        else:
-            m = EDGE_KEY.match(name)
-            if m is None:
-                names = "all, outer, outer_I, outer_I-J, holeK, holeK_I, holeK_I-J" + (
-                    ", left, right, bottom, top" if scene.plate.shape is None else "")
-                scene._fail(where, f"unknown edge; on a triangle mesh edges are {names}")
-            k = 0 if m.group(2) is None else int(m.group(2)) + 1
-            if k > len(domain.holes):
-                scene._fail(where, f"there is no hole {k - 1} (the plate has {len(domain.holes)} holes)")
-            if m.group(3) is None:
-                targets, level = [(k, i) for i in range(nseg[k])], 1
-            else:
-                i, j = int(m.group(3)), int(m.group(4) or m.group(3))
-                if isinstance(shapes[k], Circle):
-                    scene._fail(where, "a circle has no segments; name the whole boundary")
-                if not i <= j < nseg[k]:
-                    scene._fail(where, f"segments {i} to {j} are not segments 0 to {nseg[k] - 1} of that polygon")
-                targets, level = [(k, s) for s in range(i, j + 1)], 2
-        for t in targets:
-            if t in levels[level]:
-                scene._fail(where, f"edges.{levels[level][t]} holds segment {t[1]} of that boundary too; "
-                            "name each segment once")
-            levels[level][t] = name
-    table = {}
-    for level in levels:
-        table.update({t: (name, scene.edges[name]) for t, name in level.items()})
-    return table

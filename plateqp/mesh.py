@@ -1,14 +1,21 @@
-"""Structured rectangular meshes with cell masks (openings and cut-outs).
+"""Structured rectangular meshes with cell masks (cut-outs: holes and openings).
 
 Nodes are numbered row by row: node (i, j) at (i·hx, j·hy) has index j·(nx + 1) + i.
 Cells likewise: cell (i, j) spans [i·hx, (i+1)·hx] × [j·hy, (j+1)·hy], index j·nx + i, with
 corner nodes in the element order (0,0), (1,0), (1,1), (0,1).
 A node belongs to the plate if at least one of its cells is kept.
+
+A cut-out (a ``[[holes]]`` shape or an ``[[openings]]`` box, numbered K in that order as in
+:func:`plateqp.geometry.scene_domain`) removes every cell whose centre lies in it (boundary
+included). The plate's boundary edges are the cell sides between a kept cell and the outside
+(boundary 0, the rectangle's segment: 0 bottom, 1 right, 2 top, 3 left) or a cell a cut-out
+removed (boundary K + 1, the cut-out's nearest segment), as on a triangle mesh
+(:class:`plateqp.trimesh.TriMesh`): the edge supports name them the same way on both meshes.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -20,19 +27,65 @@ class Grid:
     nx: int
     ny: int
     cell_mask: np.ndarray  # (nx*ny,) bool: cell kept
+    #: (nx*ny,) the cut-out that removed each cell (K, the first that holds its centre), −1 if kept
+    cutout: np.ndarray | None = field(default=None, repr=False)
+    #: the cut-outs' shapes (:class:`~plateqp.geometry.Polygon` / ``Circle``), K = 0, 1, …
+    cutouts: tuple = ()
 
     @classmethod
     def from_scene(cls, scene) -> Grid:
+        from .geometry import cutout_shapes
+
         p, m = scene.plate, scene.mesh
         nx, ny = m.nx, m.ny
         hx, hy = p.a / nx, p.b / ny
         cx = (np.arange(nx) + 0.5) * hx
         cy = (np.arange(ny) + 0.5) * hy
-        X, Y = np.meshgrid(cx, cy)  # (ny, nx): row j, column i -> index j*nx + i
-        keep = np.ones(X.shape, dtype=bool)
-        for o in scene.openings:
-            keep &= ~((X >= o.x0) & (X <= o.x1) & (Y >= o.y0) & (Y <= o.y1))
-        return cls(p.a, p.b, nx, ny, keep.ravel())
+        X, Y = (v.ravel() for v in np.meshgrid(cx, cy))  # row j, column i -> index j*nx + i
+        shapes = cutout_shapes(scene)
+        cut = np.full(X.shape, -1)
+        for k, shape in enumerate(shapes):
+            x0, x1, y0, y1 = shape.bbox
+            near = np.flatnonzero((cut < 0) & (X >= x0) & (X <= x1) & (Y >= y0) & (Y <= y1))
+            if near.size:
+                inside = shape.contains(X[near], Y[near], 1e-12 * max(p.a, p.b))
+                cut[near[inside]] = k
+        return cls(p.a, p.b, nx, ny, cut < 0, cut, tuple(shapes))
+
+    def boundary_edges(self):
+        """The plate's boundary as every mesh gives it: (edges (ne, 2) node pairs, outward unit
+        normals (ne, 2), boundary (ne,) 0 outer or K + 1 for cut-out K, segment (ne,) of that
+        boundary's shape). See the module docstring."""
+        from .geometry import nearest_segment
+
+        nx, ny = self.nx, self.ny
+        kept = self.cell_mask.reshape(ny, nx)
+        cut = (self.cutout if self.cutout is not None else np.where(self.cell_mask, -1, 0)).reshape(ny, nx)
+        J, I = np.nonzero(kept)
+        out = []
+        # (di, dj) to the neighbour, the side's corners (as cell corner offsets), outward normal,
+        # the rectangle's segment that side lies on
+        for di, dj, (c0, c1), n, seg in ((0, -1, ((0, 0), (1, 0)), (0.0, -1.0), 0),
+                                         (1, 0, ((1, 0), (1, 1)), (1.0, 0.0), 1),
+                                         (0, 1, ((1, 1), (0, 1)), (0.0, 1.0), 2),
+                                         (-1, 0, ((0, 1), (0, 0)), (-1.0, 0.0), 3)):
+            i2, j2 = I + di, J + dj
+            outside = (i2 < 0) | (i2 >= nx) | (j2 < 0) | (j2 >= ny)
+            ii, jj = np.clip(i2, 0, nx - 1), np.clip(j2, 0, ny - 1)
+            removed = ~outside & ~kept[jj, ii]
+            hit = outside | removed
+            a = (J[hit] + c0[1]) * (nx + 1) + I[hit] + c0[0]
+            b = (J[hit] + c1[1]) * (nx + 1) + I[hit] + c1[0]
+            k = np.where(outside[hit], 0, cut[jj[hit], ii[hit]] + 1)
+            out.append((np.column_stack([a, b]), np.tile(n, (hit.sum(), 1)), k, np.full(hit.sum(), seg)))
+        edges, normals, boundary, segment = (np.concatenate(v) for v in zip(*out))
+        xy = self.node_xy()
+        mid = 0.5 * (xy[edges[:, 0]] + xy[edges[:, 1]])
+        for k, shape in enumerate(self.cutouts):
+            on = np.flatnonzero(boundary == k + 1)
+            if on.size:
+                segment[on] = nearest_segment(shape, mid[on], normals[on], max(self.hx, self.hy))
+        return edges, normals, boundary, segment
 
     @property
     def hx(self) -> float:

@@ -21,7 +21,7 @@ from dataclasses import fields, is_dataclass
 import numpy as np
 
 from .errors import SceneError
-from .geometry import EDGE_KEY
+from .constraints import EDGE_KEY
 from .scene import EDGE_NAMES, Edge, Scene
 
 _TOP = ("name", "plate", "mesh", "edges", "openings", "pins", "loads", "supports", "foundation")

@@ -314,12 +314,10 @@ class Scene:
                        f"(at most {MAX_CELLS:.0e}); the memory a mesh needs is checked before assembly")
         if m.element not in ELEMENT_KINDS:
             self._fail("mesh.element", f"unknown element {m.element!r}; choose one of {ELEMENT_KINDS}")
-        if not self.triangles and (self.plate.shape is not None or self.holes or m.size is not None):
-            self._fail("plate.shape" if self.plate.shape is not None else "holes" if self.holes else "mesh.size",
+        if not self.triangles and (self.plate.shape is not None or m.size is not None):
+            self._fail("plate.shape" if self.plate.shape is not None else "mesh.size",
                        'needs a triangle mesh: set mesh.element = "dkt"')
-        for name, e in self.edges.items():
-            if name not in EDGE_NAMES and name != "all" and not self.triangles:  # triangles: geometry.edge_table
-                self._fail(f"edges.{name}", f"unknown edge; edges are all, {', '.join(EDGE_NAMES)}")
+        for name, e in self.edges.items():  # the names: plateqp.constraints.edge_table, below
             if e.kind not in EDGE_KINDS:
                 self._fail(f"edges.{name}", f"unknown kind {e.kind!r}; choose one of {EDGE_KINDS}")
             self._num(f"edges.{name}.w", e.w, physical=True)
@@ -338,7 +336,12 @@ class Scene:
 
         grid = validate_shaped(self) if self.triangles else Grid.from_scene(self)
         if not grid.cell_mask.any():
-            self._fail("openings", "the openings remove every cell of the plate")
+            self._fail("openings" if self.openings else "holes", "the cut-outs remove every cell of the plate")
+        if not self.triangles:
+            from .constraints import edge_table
+            from .geometry import scene_domain
+
+            edge_table(self, scene_domain(self))  # every edge name known, and no segment named twice
         for i, pin in enumerate(self.pins):
             self._num(f"pins.{i}.x", pin.x)
             self._num(f"pins.{i}.y", pin.y)

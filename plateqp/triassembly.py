@@ -21,12 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
 from .elements.dkt import DKT
 from .errors import ResourceError, SceneError
-from .geometry import clip_to_polygon, edge_table, inner_segments, mesh_size, region_outline, scene_domain
+from .constraints import prescribed
+from .geometry import clip_to_polygon, inner_segments, mesh_size, region_outline, scene_domain
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
 from .trimesh import TriMesh, estimate_nodes, mesh_domain
 
@@ -37,9 +37,6 @@ class TriModel(Model):
 
     def load_vector(self, scene: Scene) -> np.ndarray:
         return tri_loads(scene, self)
-
-    def rigid_modes(self) -> np.ndarray:
-        return _rigid_modes(self)
 
     def bed_areas(self) -> np.ndarray:
         """(n_nodes,) each node's tributary area of the scene's tensionless bed: a third of every
@@ -142,7 +139,7 @@ def build_tri_model(scene: Scene) -> TriModel:
     model = TriModel(scene, mesh, el, None, None, None, None, None, n_full, cell_dofs,
                      np.arange(len(cell_dofs)), None, K_full)
     f_full = model.f_full = tri_loads(scene, model)
-    fixed, values = _prescribed(scene, mesh)
+    fixed, values = prescribed(scene, mesh, el)
     free = np.setdiff1d(np.arange(n_full), fixed)
     u_c = np.zeros(n_full)
     u_c[fixed] = values
@@ -169,86 +166,6 @@ def tri_loads(scene: Scene, model: TriModel) -> np.ndarray:
         elif isinstance(ld, PatchLoad):
             f_full[0::3] += ld.q * patch_weights(mesh, (ld.x0, ld.x1, ld.y0, ld.y1))
     return f_full
-
-
-def _prescribed(scene: Scene, mesh: TriMesh):
-    presc: dict[int, tuple[float, str]] = {}
-
-    def put(dof, value, who):
-        if dof in presc and abs(presc[dof][0] - value) > 1e-12 * max(1.0, abs(value), abs(presc[dof][0])):
-            raise SceneError(f"{who} and {presc[dof][1]} prescribe different values of "
-                             f"{DKT.dof_names[dof % 3]} at their common node; make them agree")
-        presc[dof] = (value, who)
-
-    table = edge_table(scene, mesh.domain)
-    clamped: dict[int, list] = {}  # node -> [(outward normal, slope, who)] of its clamped edges
-    for (i, j), k, s, normal in zip(mesh.edges, mesh.boundary, mesh.segment, mesh.normals):
-        name, e = table.get((int(k), int(s)), (None, None))
-        if e is None or e.kind == "free":
-            continue
-        who = f"edges.{name}"
-        for n in (i, j):
-            put(3 * n, e.w, who)
-            if e.kind == "clamped":
-                clamped.setdefault(int(n), []).append((normal, e.slope, who))
-    for n, held in clamped.items():
-        for dof, value in zip((3 * n + 1, 3 * n + 2), _gradient(held)):
-            put(dof, value, held[0][2])
-    for i, pin in enumerate(scene.pins):
-        n = mesh.node_at(pin.x, pin.y)
-        if n is None:  # pragma: no cover - the mesher puts a node at every pin
-            raise SceneError(f"pins.{i}: no mesh node at ({pin.x}, {pin.y})")
-        put(3 * n, pin.w, f"pins.{i}")
-    fixed = np.array(sorted(presc), dtype=int)
-    return fixed, np.array([presc[d][0] for d in fixed], dtype=float)
-
-
-def _gradient(held) -> np.ndarray:
-    """∇w at a node of clamped edges [(outward normal, ∂w/∂n, who)]: w is constant along each, so
-    ∇w = (∂w/∂n) n. Along a smooth boundary (normals within 10°: a curve's two chords) n is their
-    mean direction and the slope their mean; at a corner every edge asks its own (∂w/∂n) n, and
-    they must agree (as on the rectangles: only zero slopes meet at a clamped corner)."""
-    N = np.array([h[0] for h in held])
-    s = np.array([h[1] for h in held])
-    mean = N.sum(axis=0)
-    if np.all(N @ mean / np.linalg.norm(mean) >= np.cos(np.radians(10.0))):
-        return s.mean() * mean / np.linalg.norm(mean)
-    g = s[:, None] * N
-    bad = np.flatnonzero(np.abs(g - g[0]).max(axis=1) > 1e-12 * max(np.abs(g).max(), 1e-300))
-    if bad.size:
-        raise SceneError(f"{held[0][2]} and {held[bad[0]][2]} prescribe different slopes at their common corner "
-                         "(w is constant along each clamped edge); make the slopes there zero")
-    return g[0]
-
-
-def _rigid_modes(model: TriModel) -> np.ndarray:
-    """Rigid motions w = α + βx + γy of each connected piece left free by the prescribed dofs."""
-    mesh: TriMesh = model.grid
-    t = mesh.triangles
-    n = mesh.n_nodes
-    A = sp.csr_matrix((np.ones(t.size * 3), (np.repeat(t, 3, axis=1).ravel(), np.tile(t, (1, 3)).ravel())),
-                      shape=(n, n))
-    _, label = connected_components(A, directed=False)
-    xy = mesh.nodes
-    modes = []
-    for comp in np.unique(label):
-        fx = model.fixed[label[model.fixed // 3] == comp]
-        node, kind = fx // 3, fx % 3
-        R = np.zeros((len(fx), 3))
-        R[kind == 0] = np.column_stack([np.ones((kind == 0).sum()), xy[node[kind == 0]]])
-        R[kind == 1, 1] = 1.0
-        R[kind == 2, 2] = 1.0
-        _, s, vt = np.linalg.svd(R if len(R) else np.zeros((1, 3)), full_matrices=len(R) < 3)  # vt 3 × 3
-        s_full = np.zeros(3)
-        s_full[: len(s)] = s
-        nodes = np.flatnonzero(label == comp)
-        for a, b, g in vt[s_full <= 1e-10 * max(1.0, s_full.max())]:
-            v = np.zeros(model.n_full)
-            v[3 * nodes] = a + b * xy[nodes, 0] + g * xy[nodes, 1]
-            v[3 * nodes + 1] = b
-            v[3 * nodes + 2] = g
-            modes.append(v[model.free])
-    return np.array(modes).T.reshape(model.n_free, len(modes))
 
 
 MESH_BUILDERS["dkt"] = build_tri_model

@@ -98,6 +98,11 @@ class TriMesh:
         """(nt, 3) the triangles, for drawing."""
         return self.triangles
 
+    def boundary_edges(self):
+        """(edges, outward normals, boundary, segment) of the plate's boundary, as every mesh
+        gives them (:meth:`plateqp.mesh.Grid.boundary_edges`)."""
+        return self.edges, self.normals, self.boundary, self.segment
+
     # -- the names the contact code reads from a grid ------------------------------------
     @property
     def n_nodes(self) -> int:

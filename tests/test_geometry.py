@@ -133,14 +133,18 @@ def test_rectangle_with_triangles_keeps_named_edges(tmp_path):
 
 
 def test_edge_names_resolve_most_specific_first():
-    from plateqp.geometry import edge_table, scene_domain
+    from plateqp.constraints import edge_table
+    from plateqp.geometry import scene_domain
 
     sc = pq.Scene(plate=pq.Plate(shape={"polygon": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]}),
                   mesh=pq.MeshSpec(element="dkt", size=0.25), holes=[{"circle": [0.5, 0.5, 0.2]}],
                   edges={"all": pq.Edge("simple"), "outer": pq.Edge("free"), "outer_1-2": pq.Edge("clamped")})
     t = {k: name for k, (name, _) in edge_table(sc, scene_domain(sc)).items()}
+    # edges.all holds the outer boundary only: the hole's edge is free unless named
     assert t == {(0, 0): "outer", (0, 1): "outer_1-2", (0, 2): "outer_1-2", (0, 3): "outer", (0, 4): "outer",
-                 (0, 5): "outer", (1, 0): "all"}
+                 (0, 5): "outer"}
+    sc.edges["hole0"] = pq.Edge("clamped")
+    assert edge_table(sc, scene_domain(sc))[(1, 0)][0] == "hole0"
 
 
 def test_shapes_given_in_python_save_as_toml(tmp_path):

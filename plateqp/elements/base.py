@@ -41,6 +41,10 @@ class RectElement:
     monomials: tuple[tuple[int, int], ...] = ()
     node_dofs: tuple[tuple[int, int], ...] = ()  # derivative orders (dx, dy) per nodal dof
     dof_names: tuple[str, ...] = ()
+    #: the slope dofs are physical derivatives shared along straight, axis-parallel edges: a
+    #: simple edge (w constant along it) also prescribes the tangential slope
+    #: (:mod:`plateqp.constraints`)
+    holds_tangent_slope: bool = True
 
     def __init__(self) -> None:
         # A[k, m]: dof k evaluated on monomial m, in reference coordinates
