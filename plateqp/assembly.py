@@ -16,6 +16,7 @@ import dataclasses
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -25,6 +26,10 @@ from .elements import ELEMENTS, RectElement
 from .errors import ResourceError, SceneError
 from .mesh import Grid
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .elements import DKT
+    from .trimesh import TriMesh
 
 
 @dataclass
@@ -73,8 +78,8 @@ class ContactOperator:
 @dataclass
 class Model:
     scene: Scene
-    grid: Grid
-    element: RectElement
+    grid: Grid | TriMesh  # the mesh (either generator's; they answer the same names)
+    element: RectElement | DKT  # an element of :data:`plateqp.elements.ELEMENTS`
     K: sp.csr_matrix  # free × free
     f: np.ndarray  # free loads, prescribed-dof contribution included
     free: np.ndarray  # full dof indices of the free dofs
@@ -162,7 +167,7 @@ def estimate_memory(scene: Scene) -> int:
     """Bytes a build and solve of ``scene`` is expected to need at its peak (see BYTES_PER_DOF)."""
     if scene.triangles:
         from .trimesh import estimate_nodes
-        return int(BYTES_PER_DOF * 3 * estimate_nodes(scene))
+        return int(BYTES_PER_DOF * len(ELEMENTS[scene.mesh.element].node_dofs) * estimate_nodes(scene))
     nd = len(ELEMENTS[scene.mesh.element].node_dofs)
     return int(BYTES_PER_DOF * (scene.mesh.nx + 1) * (scene.mesh.ny + 1) * nd)
 
@@ -208,19 +213,20 @@ def check_memory(scene: Scene) -> None:
                             f"use a coarser mesh, or raise the limit (--max-memory or ${MEMORY_ENV})")
 
 
-#: Model builders of the elements that are not on the rectangular grid, by ``mesh.element``; a
-#: module registers its own on import (:mod:`plateqp.triassembly` "dkt", imported by ``plateqp``),
-#: so that this module does not import it (no import cycle).
+#: Model builders by the element's ``cell_type``, for the meshes other than the rectangular grid;
+#: a module registers its own on import (:mod:`plateqp.triassembly` "triangle", imported by
+#: ``plateqp``), so that this module does not import it (no import cycle).
 MESH_BUILDERS: dict[str, Callable[[Scene], Model]] = {}
 
 
 def build_model(scene: Scene) -> Model:
     """Assemble the stiffness, loads, two-sided constraints and contact operator of a scene
-    (after :func:`check_memory`: a mesh too large for the machine is refused before assembly).
-    A scene on another mesh is built by its builder in :data:`MESH_BUILDERS` (triangles, DKT:
-    :func:`plateqp.triassembly.build_tri_model`)."""
-    if scene.mesh.element in MESH_BUILDERS:
-        return MESH_BUILDERS[scene.mesh.element](scene)
+    (after :func:`check_memory`: a mesh too large for the machine is refused before assembly),
+    on the mesh its element's ``cell_type`` names: the structured grid ("quad") here, another by
+    its builder in :data:`MESH_BUILDERS` (triangles: :func:`plateqp.triassembly.build_tri_model`)."""
+    builder = MESH_BUILDERS.get(ELEMENTS[scene.mesh.element].cell_type)
+    if builder is not None:
+        return builder(scene)
     check_memory(scene)
     grid = Grid.from_scene(scene)
     el = ELEMENTS[scene.mesh.element]()

@@ -267,7 +267,6 @@ class Domain:
 
 
 # -- the scene's side: a shaped (triangle-meshed) scene's checks ------------------------------
-TRI_ELEMENTS = ("dkt",)
 
 
 def cutout_shapes(scene) -> list[Shape]:
@@ -333,7 +332,7 @@ class Region:
 
 def validate_shaped(scene) -> Region:
     """The shape-specific checks of a scene with ``mesh.element`` a triangle element: the shape,
-    the holes and openings, the edge names (:func:`edge_table`) and the mesh size. Returns the
+    the holes and openings and the mesh size. Returns the
     Region for the point checks."""
     p, m = scene.plate, scene.mesh
     fail = scene._fail
@@ -347,10 +346,6 @@ def validate_shaped(scene) -> Region:
     if p.shape is not None:
         x0, x1, y0, y1 = domain.outer.bbox
         p.a, p.b = x1 - x0, y1 - y0  # the length scales of a shaped plate: its bounding box
-    from .constraints import edge_table, warn_changed_all
-
-    edge_table(scene, domain)  # every edge name known, and no segment named twice
-    warn_changed_all(scene, domain)
     if m.size is None:
         if p.shape is not None:
             fail("mesh.size", "a plate with a shape needs the element size h: [mesh] size = h")

@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any, Callable
 
+from .elements import ELEMENTS
 from .errors import SceneError
 
 #: Magnitudes plateqp computes with safely: a non-zero physical number (length, modulus, load,
@@ -36,7 +37,6 @@ MAX_FILE_BYTES = 16 * 2**20
 
 EDGE_KINDS = ("free", "simple", "clamped")
 EDGE_NAMES = ("left", "right", "bottom", "top")  # x = 0, x = a, y = 0, y = b
-ELEMENT_KINDS = ("acm", "bfs", "dkt")
 GAP_PROFILES = ("uniform", "linear", "trough", "bump")
 
 
@@ -312,8 +312,8 @@ class Scene:
         if m.nx * m.ny > MAX_CELLS:
             self._fail("mesh", f"{m.nx} x {m.ny} = {m.nx * m.ny:.2g} cells is more than any plate needs "
                        f"(at most {MAX_CELLS:.0e}); the memory a mesh needs is checked before assembly")
-        if m.element not in ELEMENT_KINDS:
-            self._fail("mesh.element", f"unknown element {m.element!r}; choose one of {ELEMENT_KINDS}")
+        if not isinstance(m.element, str) or m.element not in ELEMENTS:
+            self._fail("mesh.element", f"unknown element {_short(m.element)}; choose one of {tuple(ELEMENTS)}")
         if not self.triangles and (self.plate.shape is not None or m.size is not None):
             self._fail("plate.shape" if self.plate.shape is not None else "mesh.size",
                        'needs a triangle mesh: set mesh.element = "dkt"')
@@ -337,11 +337,12 @@ class Scene:
         grid = validate_shaped(self) if self.triangles else Grid.from_scene(self)
         if not grid.cell_mask.any():
             self._fail("openings" if self.openings else "holes", "the cut-outs remove every cell of the plate")
-        if not self.triangles:
-            from .constraints import edge_table
-            from .geometry import scene_domain
+        from .constraints import edge_table, warn_changed_all
+        from .geometry import scene_domain
 
-            edge_table(self, scene_domain(self))  # every edge name known, and no segment named twice
+        domain = grid.domain if self.triangles else scene_domain(self)
+        edge_table(self, domain)  # every edge name known, and no segment named twice
+        warn_changed_all(self, domain)
         for i, pin in enumerate(self.pins):
             self._num(f"pins.{i}.x", pin.x)
             self._num(f"pins.{i}.y", pin.y)
@@ -438,7 +439,9 @@ class Scene:
         check_scales(self, SAFE_DERIVED)
 
     # -- convenience ----------------------------------------------------------------------
-    triangles = property(lambda self: self.mesh.element == "dkt", doc="True if meshed with triangles (DKT).")
+    triangles = property(lambda self: isinstance(self.mesh.element, str)
+                         and getattr(ELEMENTS.get(self.mesh.element), "cell_type", None) == "triangle",
+                         doc="True if meshed with triangles (its element's ``cell_type``: DKT).")
 
     @property
     def one_sided(self) -> bool:

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
-from .elements.dkt import DKT
+from .elements import ELEMENTS
 from .errors import ResourceError, SceneError
 from .constraints import prescribed
 from .geometry import clip_to_polygon, inner_segments, mesh_size, region_outline, scene_domain
@@ -36,7 +36,7 @@ class TriModel(Model):
     ``cells`` the triangles, ``cell_dofs`` their 9 dofs)."""
 
     def load_vector(self, scene: Scene) -> np.ndarray:
-        return tri_loads(scene, self)
+        return tri_loads(scene, self.grid, self.element, self.cell_dofs, self.n_full)
 
     def bed_areas(self) -> np.ndarray:
         """(n_nodes,) each node's tributary area of the scene's tensionless bed: a third of every
@@ -54,35 +54,40 @@ class TriModel(Model):
         return area
 
     def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
-        """(npts, n_full) sparse operator, from the full dofs, at points: w (the node's w at a node,
-        the element's cubic inside); the slopes (dx + dy = 1) and curvatures (dx + dy = 2) are
-        DKT's own, from its quadratic slope field β: w,x = βx, w,xx = βx,x, w,xy = (βx,y + βy,x)/2
-        (so moments and stresses are the element's M = −D_b κ). On an element edge: one neighbour's."""
-        if dx + dy > 2:
-            raise SceneError(f"derivatives of w of order {dx + dy} > 2 do not exist in a plate element")
-        mesh: TriMesh = self.grid
-        x = np.atleast_1d(np.asarray(x, dtype=float))
-        y = np.atleast_1d(np.asarray(y, dtype=float))
-        tri, lam = mesh.locate(x, y)
-        if np.any(tri < 0):
-            bad = np.flatnonzero(tri < 0)[0]
-            raise SceneError(f"point ({x[bad]}, {y[bad]}) is not on the plate")
-        xy = mesh.nodes[mesh.triangles[tri]]
-        if dx + dy == 1:
-            N = self.element.slope_matrix(xy, lam[:, None, :])[:, 0, dy]
-        elif dx + dy == 2:
-            B = self.element.curvature_matrix(xy, lam[:, None, :])[:, 0]
-            N = B[:, 0] if dx == 2 else B[:, 1] if dy == 2 else 0.5 * B[:, 2]
-        else:
-            N = self.element.shape(xy, lam[:, None, :])[:, 0]
-        dofs = self.cell_dofs[tri]
-        at_node = (lam.max(axis=1) >= 1.0 - 1e-12) & (dx + dy < 2)  # a vertex: its own dof, no rounding noise
+        """(npts, n_full) sparse operator, from the full dofs, at points: :func:`interpolation`."""
+        return interpolation(self.grid, self.element, self.cell_dofs, self.n_full, x, y, dx, dy)
+
+
+def interpolation(mesh: TriMesh, el, cell_dofs, n_full: int, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
+    """(npts, n_full) sparse operator, from the full dofs, at points: w (the node's w at a node,
+    the element's cubic inside); the slopes (dx + dy = 1) and curvatures (dx + dy = 2) are
+    DKT's own, from its quadratic slope field β: w,x = βx, w,xx = βx,x, w,xy = (βx,y + βy,x)/2
+    (so moments and stresses are the element's M = −D_b κ). On an element edge: one neighbour's."""
+    if dx + dy > 2:
+        raise SceneError(f"derivatives of w of order {dx + dy} > 2 do not exist in a plate element")
+    x = np.atleast_1d(np.asarray(x, dtype=float))
+    y = np.atleast_1d(np.asarray(y, dtype=float))
+    tri, lam = mesh.locate(x, y)
+    if np.any(tri < 0):
+        bad = np.flatnonzero(tri < 0)[0]
+        raise SceneError(f"point ({x[bad]}, {y[bad]}) is not on the plate")
+    xy = mesh.nodes[mesh.triangles[tri]]
+    if dx + dy == 1:
+        N = el.slope_matrix(xy, lam[:, None, :])[:, 0, dy]
+    elif dx + dy == 2:
+        B = el.curvature_matrix(xy, lam[:, None, :])[:, 0]
+        N = B[:, 0] if dx == 2 else B[:, 1] if dy == 2 else 0.5 * B[:, 2]
+    else:
+        N = el.shape(xy, lam[:, None, :])[:, 0]
+    dofs = cell_dofs[tri]
+    at_node = (lam.max(axis=1) >= 1.0 - 1e-12) & (dx + dy < 2)  # a vertex: its own dof, no rounding noise
+    if at_node.any():
         N[at_node] = 0.0
-        N[at_node, 3 * lam[at_node].argmax(axis=1) + (dx + 2 * dy)] = 1.0
-        rows = np.repeat(np.arange(len(tri)), 9)
-        A = sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(tri), self.n_full))
-        A.eliminate_zeros()
-        return A
+        N[at_node, el.ndof_node * lam[at_node].argmax(axis=1) + list(el.node_dofs).index((dx, dy))] = 1.0
+    rows = np.repeat(np.arange(len(tri)), el.ndof)
+    A = sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(tri), n_full))
+    A.eliminate_zeros()
+    return A
 
 
 def bed_lines(scene: Scene, domain) -> list:
@@ -110,7 +115,7 @@ def patch_weights(mesh: TriMesh, box) -> np.ndarray:
 
 def check_memory_tri(scene: Scene, h: float) -> None:
     """ResourceError before meshing if the triangle mesh would need more memory than allowed."""
-    need = BYTES_PER_DOF * 3 * estimate_nodes(scene)
+    need = BYTES_PER_DOF * len(ELEMENTS[scene.mesh.element].node_dofs) * estimate_nodes(scene)
     if need > memory_limit():
         raise ResourceError(f"mesh.size: a triangle mesh of size {h:g} needs about {human_bytes(need)} to build "
                             f"and solve, above the limit of {human_bytes(memory_limit())}; use a larger mesh.size")
@@ -125,47 +130,45 @@ def build_tri_model(scene: Scene) -> TriModel:
     points = [(s.x, s.y) for s in scene.supports] + [(ld.x, ld.y) for ld in scene.loads
                                                      if isinstance(ld, PointLoad)] + [(p.x, p.y) for p in scene.pins]
     mesh = mesh_domain(domain, h, points, bed_lines(scene, domain))
-    el = DKT()
+    el = ELEMENTS[scene.mesh.element]()
+    nd = el.ndof_node
     p = scene.plate
-    n_full = 3 * mesh.n_nodes
+    n_full = nd * mesh.n_nodes
     xy = mesh.nodes[mesh.triangles]
-    cell_dofs = (mesh.triangles[:, :, None] * 3 + np.arange(3)).reshape(-1, 9)
+    cell_dofs = (mesh.triangles[:, :, None] * nd + np.arange(nd)).reshape(-1, el.ndof)
     Ke = el.stiffness(xy, p.D, p.nu)
-    rows = np.repeat(cell_dofs, 9, axis=1).ravel()
-    cols = np.tile(cell_dofs, (1, 9)).ravel()
+    rows = np.repeat(cell_dofs, el.ndof, axis=1).ravel()
+    cols = np.tile(cell_dofs, (1, el.ndof)).ravel()
     K_full = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(n_full, n_full))
     K_full.sum_duplicates()
 
-    model = TriModel(scene, mesh, el, None, None, None, None, None, n_full, cell_dofs,
-                     np.arange(len(cell_dofs)), None, K_full)
-    f_full = model.f_full = tri_loads(scene, model)
+    f_full = tri_loads(scene, mesh, el, cell_dofs, n_full)
     fixed, values = prescribed(scene, mesh, el)
     free = np.setdiff1d(np.arange(n_full), fixed)
     u_c = np.zeros(n_full)
     u_c[fixed] = values
-    model.K = K_full[free][:, free].tocsr()
-    model.f = f_full[free] - (K_full @ u_c)[free]
-    model.free, model.fixed, model.values = free, fixed, values
+    K = K_full[free][:, free].tocsr()
+    f = f_full[free] - (K_full @ u_c)[free]
+    model = TriModel(scene, mesh, el, K, f, free, fixed, values, n_full, cell_dofs, np.arange(len(cell_dofs)),
+                     f_full, K_full)
     model.contacts = _contacts(scene, model)
     return model
 
 
-def tri_loads(scene: Scene, model: TriModel) -> np.ndarray:
-    """The load vector (all dofs) of ``scene.loads`` on ``model``'s mesh: uniform pressure by the
-    element's consistent load, point loads at their (embedded) points, patch loads integrated
-    exactly over the clipped triangles. Also used to re-use a model with new loads (sweeps)."""
-    mesh, el = model.grid, model.element
-    f_full = np.zeros(model.n_full)
+def tri_loads(scene: Scene, mesh: TriMesh, el, cell_dofs: np.ndarray, n_full: int) -> np.ndarray:
+    """The load vector (all ``n_full`` dofs) of ``scene.loads`` on a triangle mesh: uniform pressure
+    by the element's load, point loads at their (embedded) points, patch loads integrated exactly
+    over the clipped triangles. Also used to re-use a model with new loads (sweeps)."""
+    f_full = np.zeros(n_full)
     xy = mesh.nodes[mesh.triangles]
     for ld in scene.loads:
         if isinstance(ld, UniformLoad):
-            f_full += np.bincount(model.cell_dofs.ravel(), weights=(ld.q * el.load(xy)).ravel(),
-                                  minlength=model.n_full)
+            f_full += np.bincount(cell_dofs.ravel(), weights=(ld.q * el.load(xy)).ravel(), minlength=n_full)
         elif isinstance(ld, PointLoad):
-            f_full += ld.P * np.asarray(model.interpolation(ld.x, ld.y).todense()).ravel()
+            f_full += ld.P * interpolation(mesh, el, cell_dofs, n_full, ld.x, ld.y).toarray().ravel()
         elif isinstance(ld, PatchLoad):
-            f_full[0::3] += ld.q * patch_weights(mesh, (ld.x0, ld.x1, ld.y0, ld.y1))
+            f_full[0::el.ndof_node] += ld.q * patch_weights(mesh, (ld.x0, ld.x1, ld.y0, ld.y1))
     return f_full
 
 
-MESH_BUILDERS["dkt"] = build_tri_model
+MESH_BUILDERS["triangle"] = build_tri_model

@@ -125,11 +125,26 @@ def test_rectangle_with_triangles_keeps_named_edges(tmp_path):
     sc = pq.Scene(plate=pq.Plate(a=2.0, b=1.0), mesh=pq.MeshSpec(8, 4, "dkt"),
                   edges={"left": pq.Edge("clamped")}, holes=[{"circle": [1.0, 0.5, 0.2]}])
     assert sc.triangles and sc.plate.a == 2.0
-    with pytest.raises(pq.SceneError, match="holes: needs a triangle mesh"):
-        pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), holes=[{"circle": [0.5, 0.5, 0.2]}])
-    with pytest.raises(pq.SceneError, match="edges.outer: unknown edge"):  # a triangle mesh's name
-        pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), edges={"outer": pq.Edge("simple")})
     pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), edges={"all": pq.Edge("simple")})  # every side (test_scene)
+
+
+def test_the_grid_speaks_the_same_language():
+    """Holes and the triangle mesh's edge names on the rectangle grid: a hole removes the cells
+    whose centre lies in it, ``outer`` is the rectangle, ``hole0`` the hole's staircase edge (one
+    edge per side a kept cell shares with a removed one)."""
+    from plateqp.mesh import Grid
+
+    sc = pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), holes=[{"circle": [0.5, 0.5, 0.2]}],
+                  edges={"outer": pq.Edge("simple"), "hole0": pq.Edge("clamped")})
+    g = Grid.from_scene(sc)
+    removed = {(i, j) for i in range(8) for j in range(8) if math.hypot((i + 0.5) / 8 - 0.5, (j + 0.5) / 8 - 0.5) <= 0.2}
+    assert sorted(np.flatnonzero(~g.cell_mask).tolist()) == sorted(8 * j + i for i, j in removed)
+    shared = sum((i + di, j + dj) in removed for i in range(8) for j in range(8) if (i, j) not in removed
+                 for di, dj in ((1, 0), (-1, 0), (0, 1), (0, -1)))
+    _, _, boundary, _ = g.boundary_edges()
+    assert len(removed) == 12 and (boundary == 1).sum() == shared == 16 and (boundary == 0).sum() == 32
+    with pytest.raises(pq.SceneError, match="holes.0.polygon: the vertices run clockwise"):
+        pq.Scene(mesh=pq.MeshSpec(8, 8, "acm"), holes=[{"polygon": [[0.4, 0.4], [0.4, 0.6], [0.6, 0.6]]}])
 
 
 def test_edge_names_resolve_most_specific_first():

@@ -115,12 +115,22 @@ def contact_spacing(model: Model) -> np.ndarray:
         return np.full(c.m, max(p.a, p.b))
     d, _ = cKDTree(pts).query(c.xy, k=2)
     s = np.where(d[:, 1] > 0, d[:, 1], max(p.a, p.b))
-    # an edge held along its length holds the plate between its nodes too: nearer than its nodes
-    x, y = c.xy[:, 0], c.xy[:, 1]
-    for name, dist in (("left", x), ("right", p.a - x), ("bottom", y), ("top", p.b - y)):
-        e = model.scene.side_edges().get(name)
-        if e is not None and e.kind != "free":
-            s = np.where(dist > 0, np.minimum(s, dist), s)
+    # an edge held along its length (w prescribed at both its nodes) holds the plate between its
+    # nodes too: nearer than its nodes
+    edges = model.grid.boundary_edges()[0]
+    is_held = np.zeros(model.n_full // nd, dtype=bool)
+    is_held[held] = True
+    edges = edges[is_held[edges[:, 0]] & is_held[edges[:, 1]]]
+    if edges.size:
+        xy = model.grid.node_xy()
+        a, b = xy[edges[:, 0]], xy[edges[:, 1]]
+        k = min(4, len(edges))
+        _, near = cKDTree(0.5 * (a + b)).query(c.xy, k=k)  # the nearest edges by midpoint, then exactly
+        near = near.reshape(c.m, k)
+        d = b[near] - a[near]
+        t = np.clip(np.einsum("mkj,mkj->mk", c.xy[:, None] - a[near], d) / np.einsum("mkj,mkj->mk", d, d), 0, 1)
+        dist = np.hypot(*(c.xy[:, None] - a[near] - t[..., None] * d).transpose(2, 0, 1)).min(axis=1)
+        s = np.where(dist > 0, np.minimum(s, dist), s)
     return s
 
 

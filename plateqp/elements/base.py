@@ -38,6 +38,7 @@ class RectElement:
     """Base class: subclasses set ``name``, ``monomials`` and ``node_dofs``."""
 
     name: str = ""
+    cell_type: str = "quad"
     monomials: tuple[tuple[int, int], ...] = ()
     node_dofs: tuple[tuple[int, int], ...] = ()  # derivative orders (dx, dy) per nodal dof
     dof_names: tuple[str, ...] = ()

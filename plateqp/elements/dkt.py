@@ -44,6 +44,7 @@ class DKT:
     (3, 2) or (nt, 3, 2), counter-clockwise."""
 
     name = "dkt"
+    cell_type = "triangle"
     node_dofs = ((0, 0), (1, 0), (0, 1))
     dof_names = ("w", "wx", "wy")
     ndof_node = 3
