@@ -232,15 +232,36 @@ def _mesh_domain(domain: Domain, size: float, points=(), lines=()) -> TriMesh:
 
 
 def _mesh(gmsh, domain: Domain, h: float, points, lines=()) -> TriMesh:
-    geo = gmsh.model.geo
+    """The steps of :func:`mesh_domain` inside one gmsh model: the boundary curves, the embedded
+    points and lines, the size field, the mesh, and the mesh read back."""
     tol = 1e-9 * domain.size
-    curve_owner: dict[int, tuple[int, int]] = {}  # curve tag -> (boundary, segment)
-    curve_geom: dict[int, tuple] = {}  # curve tag -> ("seg", p, q) or ("arc", a0, a1): for _curve_at
-    curves_of: list[list[int]] = []
-    vertex_tags: list[tuple[float, float, int]] = []
-    loops = []
-    # the ends of the lines that lie on a boundary split its curves there (a line must end at a
-    # point of the boundary's own curves to be meshed conformingly)
+    curves = _boundary_curves(gmsh.model.geo, domain, lines, tol)
+    surf = gmsh.model.geo.addPlaneSurface(curves.loops)
+    gmsh.model.geo.synchronize()
+    embedded = _embed(gmsh, surf, domain, curves, points, lines, tol)
+    _size_field(gmsh, h, [t for t, _ in embedded])
+    gmsh.model.mesh.generate(2)
+    return _read_mesh(gmsh, surf, curves.owner, h, domain)
+
+
+@dataclass
+class _Curves:
+    """The gmsh curves of a domain's boundaries: ``owner`` curve tag → (boundary, segment),
+    ``geom`` curve tag → ("seg", p, q) or ("arc", a0, a1) (for :func:`_curve_at`), ``of`` the tags
+    of each boundary, ``vertices`` [(x, y, point tag)], ``loops`` one curve loop a boundary."""
+
+    owner: dict
+    geom: dict
+    of: list
+    vertices: list
+    loops: list
+
+
+def _boundary_curves(geo, domain: Domain, lines, tol: float) -> _Curves:
+    """One gmsh curve per polygon segment (split where a line of ``lines`` ends on it: a line must
+    end at a point of the boundary's own curves to be meshed conformingly), a circle as arcs (split
+    at the quarter points and where a line ends on it)."""
+    c = _Curves({}, {}, [], [], [])
     ends = [e for seg in lines for e in seg]
     for k, shape in enumerate((domain.outer, *domain.holes)):
         on = [e for e in ends if shape.distance(*e)[0] <= tol]
@@ -253,13 +274,13 @@ def _mesh(gmsh, domain: Domain, h: float, points, lines=()) -> TriMesh:
                               if float(_point_segment(e[0], e[1], (p0, p1))) <= tol})
                 verts += [(tuple(p0), i)] + [(tuple(p0 + t * d), i) for t in cut if tol < t * np.hypot(*d) < np.hypot(*d) - tol]
             pts = [geo.addPoint(x, y, 0.0) for (x, y), _ in verts]
-            vertex_tags += [(x, y, t) for ((x, y), _), t in zip(verts, pts)]
+            c.vertices += [(x, y, t) for ((x, y), _), t in zip(verts, pts)]
             for n, ((xy, i), t) in enumerate(zip(verts, pts)):
                 nxt = (n + 1) % len(pts)
-                c = geo.addLine(t, pts[nxt])
-                curve_owner[c] = (k, i)
-                curve_geom[c] = ("seg", np.array(xy), np.array(verts[nxt][0]))
-                tags.append(c)
+                tag = geo.addLine(t, pts[nxt])
+                c.owner[tag] = (k, i)
+                c.geom[tag] = ("seg", np.array(xy), np.array(verts[nxt][0]))
+                tags.append(tag)
         else:
             centre = geo.addPoint(shape.xc, shape.yc, 0.0)
             angles = sorted({0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi,
@@ -267,27 +288,31 @@ def _mesh(gmsh, domain: Domain, h: float, points, lines=()) -> TriMesh:
             angles = [a_ for n, a_ in enumerate(angles) if n == 0 or a_ - angles[n - 1] > tol / shape.r]
             xy = [(shape.xc + shape.r * math.cos(t), shape.yc + shape.r * math.sin(t)) for t in angles]
             pts = [geo.addPoint(x, y, 0.0) for x, y in xy]
-            vertex_tags += [(x, y, t) for (x, y), t in zip(xy, pts)]
+            c.vertices += [(x, y, t) for (x, y), t in zip(xy, pts)]
             for i in range(len(pts)):
-                c = geo.addCircleArc(pts[i], centre, pts[(i + 1) % len(pts)])
-                curve_owner[c] = (k, 0)
-                curve_geom[c] = ("arc", angles[i], angles[i + 1] if i + 1 < len(angles) else 2 * math.pi)
-                tags.append(c)
-        curves_of.append(tags)
-        loop = geo.addCurveLoop(tags)
-        loops.append(loop)
-    surf = geo.addPlaneSurface(loops)
-    geo.synchronize()
+                tag = geo.addCircleArc(pts[i], centre, pts[(i + 1) % len(pts)])
+                c.owner[tag] = (k, 0)
+                c.geom[tag] = ("arc", angles[i], angles[i + 1] if i + 1 < len(angles) else 2 * math.pi)
+                tags.append(tag)
+        c.of.append(tags)
+        c.loops.append(geo.addCurveLoop(tags))
+    return c
 
+
+def _embed(gmsh, surf: int, domain: Domain, curves: _Curves, points, lines, tol: float) -> list:
+    """Embed ``lines`` in the surface and every point of ``points`` (not already a boundary
+    vertex or a line's end) in the curve it lies on, a line, or the surface. Returns the embedded
+    points [(tag, curve or None)]."""
+    geo = gmsh.model.geo
     embedded, seen = [], []
-    line_tags, line_ends = _lines(geo, vertex_tags, lines, tol)
+    line_tags, line_ends = _lines(geo, curves.vertices, lines, tol)
     for x, y in points:
         if any(math.hypot(x - u, y - v) <= tol for u, v in seen):
             continue
         seen.append((x, y))
-        if any(math.hypot(x - u, y - v) <= tol for u, v, _ in vertex_tags + line_ends):
+        if any(math.hypot(x - u, y - v) <= tol for u, v, _ in curves.vertices + line_ends):
             continue
-        on = _curve_at(domain, curves_of, curve_geom, x, y, tol)
+        on = _curve_at(domain, curves.of, curves.geom, x, y, tol)
         if on is None:  # on an embedded line: a point of that line
             on = next((c for c, (p, q) in line_tags if float(_point_segment(x, y, (p, q))) <= tol), None)
         # built-in kernel: new points after synchronize need another synchronize before embedding
@@ -301,25 +326,34 @@ def _mesh(gmsh, domain: Domain, h: float, points, lines=()) -> TriMesh:
             gmsh.model.mesh.embed(0, [t], 2, surf)
         else:
             gmsh.model.mesh.embed(0, [t], 1, on)
+    return embedded
 
-    f_const = gmsh.model.mesh.field.add("MathEval")
-    gmsh.model.mesh.field.setString(f_const, "F", repr(h))
+
+def _size_field(gmsh, h: float, refined: list) -> None:
+    """The mesh size: h everywhere, :data:`REFINE` · h at the points ``refined`` (tags), growing
+    to h at 2h away."""
+    field = gmsh.model.mesh.field
+    f_const = field.add("MathEval")
+    field.setString(f_const, "F", repr(h))
     fields = [f_const]
-    if embedded:
-        f_dist = gmsh.model.mesh.field.add("Distance")
-        gmsh.model.mesh.field.setNumbers(f_dist, "PointsList", [t for t, _ in embedded])
-        f_thr = gmsh.model.mesh.field.add("Threshold")
-        gmsh.model.mesh.field.setNumber(f_thr, "InField", f_dist)
-        gmsh.model.mesh.field.setNumber(f_thr, "SizeMin", REFINE * h)
-        gmsh.model.mesh.field.setNumber(f_thr, "SizeMax", h)
-        gmsh.model.mesh.field.setNumber(f_thr, "DistMin", 0.0)
-        gmsh.model.mesh.field.setNumber(f_thr, "DistMax", 2.0 * h)
+    if refined:
+        f_dist = field.add("Distance")
+        field.setNumbers(f_dist, "PointsList", refined)
+        f_thr = field.add("Threshold")
+        field.setNumber(f_thr, "InField", f_dist)
+        field.setNumber(f_thr, "SizeMin", REFINE * h)
+        field.setNumber(f_thr, "SizeMax", h)
+        field.setNumber(f_thr, "DistMin", 0.0)
+        field.setNumber(f_thr, "DistMax", 2.0 * h)
         fields.append(f_thr)
-    f_min = gmsh.model.mesh.field.add("Min")
-    gmsh.model.mesh.field.setNumbers(f_min, "FieldsList", fields)
-    gmsh.model.mesh.field.setAsBackgroundMesh(f_min)
-    gmsh.model.mesh.generate(2)
+    f_min = field.add("Min")
+    field.setNumbers(f_min, "FieldsList", fields)
+    field.setAsBackgroundMesh(f_min)
 
+
+def _read_mesh(gmsh, surf: int, curve_owner: dict, h: float, domain: Domain) -> TriMesh:
+    """The generated mesh as a :class:`TriMesh`: the nodes of its triangles numbered from 0,
+    triangles turned counter-clockwise, boundary edges by curve with their outward normals."""
     tags, coords, _ = gmsh.model.mesh.getNodes()
     index = np.full(int(tags.max()) + 1, -1)
     xyz = coords.reshape(-1, 3)
