@@ -77,6 +77,11 @@ class ContactOperator:
 
 @dataclass
 class Model:
+    """A plate's two-sided problem on a mesh, K u = f on the free dofs, and its one-sided contact
+    operator: what the contact code reads. The mesh's own operations (loads, interpolation, a
+    bed's tributary areas) are its subclass's: :class:`GridModel` on the rectangle grid,
+    :class:`plateqp.triassembly.TriModel` on triangles."""
+
     scene: Scene
     grid: Grid | TriMesh  # the mesh (either generator's; they answer the same names)
     element: RectElement | DKT  # an element of :data:`plateqp.elements.ELEMENTS`
@@ -86,8 +91,8 @@ class Model:
     fixed: np.ndarray  # full dof indices of the prescribed dofs
     values: np.ndarray  # their prescribed values
     n_full: int
-    cell_dofs: np.ndarray  # (n_kept_cells, ndof) full dof indices
-    cells: np.ndarray  # kept cell indices
+    cell_dofs: np.ndarray  # (n_cells, ndof) full dof indices of the plate's cells
+    cells: np.ndarray  # the plate's cells, as the mesh indexes them
     f_full: np.ndarray  # consistent loads on all dofs (for reactions at prescribed dofs)
     # all dofs × all dofs, or a function that assembles it (:attr:`K_full`, on first use)
     _K_full: sp.csr_matrix | Callable[[], sp.csr_matrix] = field(repr=False)
@@ -118,17 +123,35 @@ class Model:
         return u
 
     def load_vector(self, scene: Scene) -> np.ndarray:
+        """The load vector (all dofs) of ``scene.loads`` on this model's mesh and element, without
+        assembling the stiffness (a model re-used with new loads). Each mesh's model gives it."""
+        raise NotImplementedError
+
+    def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
+        """(npts, n_full) sparse operator: the derivative ∂^(dx+dy) w / ∂x^dx ∂y^dy at points,
+        from the full dofs (a SceneError for a point off the plate). Each mesh's model gives it."""
+        raise NotImplementedError
+
+    def bed_areas(self) -> np.ndarray:
+        """(n_nodes,) each node's tributary area of the scene's tensionless bed. Each mesh's model
+        gives it."""
+        raise NotImplementedError
+
+    def rigid_modes(self) -> np.ndarray:
+        """(n_free, k) basis of the rigid motions the two-sided supports leave free (k = 0..3 per
+        piece): :func:`plateqp.constraints.rigid_modes`."""
+        return rigid_modes(self)
+
+
+@dataclass
+class GridModel(Model):
+    """A :class:`Model` on the structured rectangle grid (``grid`` a :class:`~plateqp.mesh.Grid`,
+    ``cells`` the kept cells, ``cell_dofs`` their dofs; the element a :class:`RectElement`)."""
+
+    def load_vector(self, scene: Scene) -> np.ndarray:
         """The consistent load vector (all dofs) of ``scene.loads`` on this model's mesh and
         element, without assembling the stiffness (a model re-used with new loads)."""
         return _loads(scene, self.grid, self.element, self.cells, self.cell_dofs, self.n_full)
-
-    def rigid_modes(self) -> np.ndarray:
-        """(n_free, k) basis of the rigid motions the two-sided supports leave free (k = 0..3 per piece).
-
-        A rigid motion w = α + βx + γy (slopes β, γ, twist 0) of each connected piece of the
-        plate, restricted to the free dofs, with the prescribed dofs held at zero.
-        """
-        return rigid_modes(self)
 
     def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
         """(npts, n_full) sparse operator: derivative of w at points, from full dofs."""
@@ -264,7 +287,7 @@ def build_model(scene: Scene) -> Model:
         u_c[fixed] = values
         K_full = K_full()
         f -= (K_full @ u_c)[free]
-    model = Model(scene, grid, el, K, f, free, fixed, values, n_full, cell_dofs, cells, f_full, K_full)
+    model = GridModel(scene, grid, el, K, f, free, fixed, values, n_full, cell_dofs, cells, f_full, K_full)
     model.symmetric = True  # _node_blocks adds (p, q) and (q, p) in the same order
     model.contacts = _contacts(scene, model)
     return model

@@ -33,7 +33,7 @@ from .trimesh import TriMesh, estimate_nodes, mesh_domain
 @dataclass
 class TriModel(Model):
     """A :class:`~plateqp.assembly.Model` on a triangle mesh (``grid`` is the :class:`TriMesh`,
-    ``cells`` the triangles, ``cell_dofs`` their 9 dofs)."""
+    ``cells`` the triangles, ``cell_dofs`` their dofs)."""
 
     def load_vector(self, scene: Scene) -> np.ndarray:
         return tri_loads(scene, self.grid, self.element, self.cell_dofs, self.n_full)
