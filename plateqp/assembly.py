@@ -129,8 +129,8 @@ class Model:
 
     def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
         """(npts, n_full) sparse operator: the derivative ∂^(dx+dy) w / ∂x^dx ∂y^dy at points,
-        from the full dofs (a SceneError for a point off the plate). Each mesh's model gives it."""
-        raise NotImplementedError
+        from the full dofs (a SceneError for a point off the plate): :func:`interpolation`."""
+        return interpolation(self.grid, self.element, self.cell_dofs, self.n_full, x, y, dx, dy)
 
     def bed_areas(self) -> np.ndarray:
         """(n_nodes,) each node's tributary area of the scene's tensionless bed. Each mesh's model
@@ -153,17 +153,6 @@ class GridModel(Model):
         element, without assembling the stiffness (a model re-used with new loads)."""
         return _loads(scene, self.grid, self.element, self.cells, self.cell_dofs, self.n_full)
 
-    def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
-        """(npts, n_full) sparse operator: derivative of w at points, from full dofs."""
-        cell, xi, eta = self.grid.locate(x, y)
-        if np.any(cell < 0):
-            bad = np.flatnonzero(cell < 0)[0]
-            raise SceneError(f"point ({np.atleast_1d(x)[bad]}, {np.atleast_1d(y)[bad]}) is not on the plate")
-        N = self.element.shape(xi, eta, self.grid.hx, self.grid.hy, dx, dy)
-        dofs = self.grid_cell_dofs(cell)
-        rows = np.repeat(np.arange(len(cell)), N.shape[1])
-        return sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(cell), self.n_full))
-
     def bed_areas(self) -> np.ndarray:
         """(n_nodes,) each node's tributary area of the scene's tensionless bed: a quarter of every
         kept cell centred in the bed's region (the whole plate without one) that has it as a corner."""
@@ -177,6 +166,26 @@ class GridModel(Model):
         nd = self.element.ndof_node
         nodes = self.grid.cell_nodes()[cell]
         return (nodes[:, :, None] * nd + np.arange(nd)).reshape(len(cell), -1)
+
+
+def interpolation(mesh, element, cell_dofs: np.ndarray, n_full: int, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
+    """(npts, n_full) sparse operator, from the full dofs, at points (x, y): ∂^(dx+dy) w / ∂x^dx ∂y^dy
+    by the element's basis in the cell the mesh locates each point in (on a cell boundary: one
+    neighbour's), on any mesh (``mesh.locate``, ``mesh.cells``, ``mesh.nodes``) and element
+    (``element.basis``). A point off the plate, or a derivative of order above 2, is a SceneError."""
+    if dx + dy > 2:
+        raise SceneError(f"derivatives of w of order {dx + dy} > 2 do not exist in a plate element")
+    x = np.atleast_1d(np.asarray(x, dtype=float))
+    y = np.atleast_1d(np.asarray(y, dtype=float))
+    cell, local = mesh.locate(x, y)
+    if np.any(cell < 0):
+        bad = np.flatnonzero(cell < 0)[0]
+        raise SceneError(f"point ({x[bad]}, {y[bad]}) is not on the plate")
+    N = element.basis(mesh.nodes[mesh.cells[cell]], local, dx, dy)
+    rows = np.repeat(np.arange(len(cell)), N.shape[1])
+    A = sp.csr_matrix((N.ravel(), (rows, cell_dofs[cell].ravel())), shape=(len(cell), n_full))
+    A.eliminate_zeros()
+    return A
 
 
 #: Peak memory of building and solving a scene, per dof of its grid: measured (resident set
@@ -371,11 +380,7 @@ def _loads(scene, grid, el, cells, cell_dofs, n_full) -> np.ndarray:
                 fe = el.load(hx, hy, np.column_stack([x0, x1, y0, y1])[hit])
                 np.add.at(f, cell_dofs[hit], ld.q * fe)
         elif isinstance(ld, PointLoad):
-            cell, xi, eta = grid.locate(ld.x, ld.y)
-            N = el.shape(xi, eta, hx, hy)[0]
-            nodes = grid.cell_nodes()[cell[0]]
-            dofs = (nodes[:, None] * el.ndof_node + np.arange(el.ndof_node)).ravel()
-            np.add.at(f, dofs, ld.P * N)
+            f += ld.P * interpolation(grid, el, cell_dofs, n_full, ld.x, ld.y).toarray().ravel()
     return f
 
 

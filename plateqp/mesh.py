@@ -16,6 +16,7 @@ removed (boundary K + 1, the cut-out's nearest segment), as on a triangle mesh
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -111,7 +112,11 @@ class Grid:
         return np.column_stack([n0, n0 + 1, n0 + self.nx + 2, n0 + self.nx + 1])
 
     def node_mask(self) -> np.ndarray:
-        """(n_nodes,) bool: node belongs to a kept cell."""
+        """(n_nodes,) bool: node belongs to a kept cell (a copy: the caller may change it)."""
+        return self._node_mask.copy()
+
+    @cached_property
+    def _node_mask(self) -> np.ndarray:
         mask = np.zeros(self.n_nodes, dtype=bool)
         mask[self.cell_nodes()[self.cell_mask].ravel()] = True
         return mask
@@ -124,19 +129,19 @@ class Grid:
         """(ny + 1, nx + 1): the grid view of a nodal field (:meth:`to_grid`)."""
         return (self.ny + 1, self.nx + 1)
 
-    @property
+    @cached_property
     def plate_node_ids(self) -> np.ndarray:
         """(n,) the grid index of each node of the plate (a node of a kept cell), in grid order:
         the mesh's nodes, as nodal fields and the dofs count them (node k's dofs are
         ``plate_node_ids[k] · ndof_node + i``)."""
-        return np.flatnonzero(self.node_mask())
+        return np.flatnonzero(self._node_mask)
 
-    @property
+    @cached_property
     def nodes(self) -> np.ndarray:
         """(n, 2) coordinates of the plate's nodes (:attr:`plate_node_ids`)."""
         return self.node_xy()[self.plate_node_ids]
 
-    @property
+    @cached_property
     def cells(self) -> np.ndarray:
         """(n_kept, 4) the kept cells' corners as indices into :attr:`nodes`, element corner order."""
         new = np.full(self.n_nodes, -1)
@@ -164,13 +169,24 @@ class Grid:
         if not (0 <= i <= self.nx and 0 <= j <= self.ny):
             return None
         n = j * (self.nx + 1) + i
-        return n if self.node_mask()[n] else None
+        return n if self._node_mask[n] else None
+
+    @cached_property
+    def _kept_index(self) -> np.ndarray:
+        return np.cumsum(self.cell_mask) - 1
 
     def locate(self, x, y):
-        """Kept cell index and local coordinates (ξ, η) of points; cell −1 where off the plate.
+        """(cell, local): each point's cell, as an index into :attr:`cells` (the kept cells; −1
+        where off the plate), and its local coordinates (npts, 2) = (ξ, η) in that cell, as
+        every mesh gives them (:meth:`plateqp.trimesh.TriMesh.locate`).
 
         A point on a cell boundary is given to a kept neighbour when there is one.
         """
+        cell, xi, eta = self._grid_locate(x, y)
+        return np.where(cell >= 0, self._kept_index[np.maximum(cell, 0)], -1), np.column_stack([xi, eta])
+
+    def _grid_locate(self, x, y):
+        """The grid's own cell index (j·nx + i, kept cells only; −1 off the plate) and (ξ, η)."""
         x = np.atleast_1d(np.asarray(x, dtype=float))
         y = np.atleast_1d(np.asarray(y, dtype=float))
         # clipped: a point far off the plate stays off it, and its cell index cannot overflow
@@ -197,7 +213,7 @@ class Grid:
 
     def covers(self, x: float, y: float) -> bool:
         """True if (x, y) lies on a kept cell (boundaries included)."""
-        return bool(self.locate(x, y)[0][0] >= 0)
+        return bool(self._grid_locate(x, y)[0][0] >= 0)
 
     def cells_centred_in(self, x0: float, x1: float, y0: float, y1: float) -> np.ndarray:
         """Indices of the kept cells whose centre lies in [x0, x1] × [y0, y1] (bounds included)."""

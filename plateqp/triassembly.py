@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, memory_limit
+from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, interpolation, memory_limit
 from .elements import ELEMENTS
 from .errors import ResourceError, SceneError
 from .constraints import prescribed
@@ -52,42 +52,6 @@ class TriModel(Model):
         if not area.any():
             raise SceneError(f"foundation.region: {region} does not overlap the plate's mesh")
         return area
-
-    def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
-        """(npts, n_full) sparse operator, from the full dofs, at points: :func:`interpolation`."""
-        return interpolation(self.grid, self.element, self.cell_dofs, self.n_full, x, y, dx, dy)
-
-
-def interpolation(mesh: TriMesh, el, cell_dofs, n_full: int, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
-    """(npts, n_full) sparse operator, from the full dofs, at points: w (the node's w at a node,
-    the element's cubic inside); the slopes (dx + dy = 1) and curvatures (dx + dy = 2) are
-    DKT's own, from its quadratic slope field β: w,x = βx, w,xx = βx,x, w,xy = (βx,y + βy,x)/2
-    (so moments and stresses are the element's M = −D_b κ). On an element edge: one neighbour's."""
-    if dx + dy > 2:
-        raise SceneError(f"derivatives of w of order {dx + dy} > 2 do not exist in a plate element")
-    x = np.atleast_1d(np.asarray(x, dtype=float))
-    y = np.atleast_1d(np.asarray(y, dtype=float))
-    tri, lam = mesh.locate(x, y)
-    if np.any(tri < 0):
-        bad = np.flatnonzero(tri < 0)[0]
-        raise SceneError(f"point ({x[bad]}, {y[bad]}) is not on the plate")
-    xy = mesh.nodes[mesh.triangles[tri]]
-    if dx + dy == 1:
-        N = el.slope_matrix(xy, lam[:, None, :])[:, 0, dy]
-    elif dx + dy == 2:
-        B = el.curvature_matrix(xy, lam[:, None, :])[:, 0]
-        N = B[:, 0] if dx == 2 else B[:, 1] if dy == 2 else 0.5 * B[:, 2]
-    else:
-        N = el.shape(xy, lam[:, None, :])[:, 0]
-    dofs = cell_dofs[tri]
-    at_node = (lam.max(axis=1) >= 1.0 - 1e-12) & (dx + dy < 2)  # a vertex: its own dof, no rounding noise
-    if at_node.any():
-        N[at_node] = 0.0
-        N[at_node, el.ndof_node * lam[at_node].argmax(axis=1) + list(el.node_dofs).index((dx, dy))] = 1.0
-    rows = np.repeat(np.arange(len(tri)), el.ndof)
-    A = sp.csr_matrix((N.ravel(), (rows, dofs.ravel())), shape=(len(tri), n_full))
-    A.eliminate_zeros()
-    return A
 
 
 def bed_lines(scene: Scene, domain) -> list:

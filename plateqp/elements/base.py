@@ -29,6 +29,22 @@ GAUSS_X = 0.5 * (_gp + 1.0)
 GAUSS_W = 0.5 * _gw
 
 
+def _sizes(xy) -> list[tuple[tuple[float, float], np.ndarray]]:
+    """Cells given by their corners (ncell, 4, 2), grouped by size: [((hx, hy), indices)]. Sides
+    within 1e-9 of each other are one size (a grid's corners i·h differ from one another by a
+    rounding), evaluated at the group's median."""
+    xy = np.asarray(xy, dtype=float)
+    hxy = np.column_stack([xy[:, 1, 0] - xy[:, 0, 0], xy[:, 3, 1] - xy[:, 0, 1]])
+    if len(hxy) == 0:
+        return [((1.0, 1.0), np.arange(0))]
+    ref = np.median(hxy, axis=0)
+    if np.all(np.abs(hxy - ref) <= 1e-9 * ref):  # one size: a grid
+        return [(tuple(ref), np.arange(len(hxy)))]
+    _, first, which = np.unique(np.round(np.log2(hxy) * 2**30), axis=0, return_index=True, return_inverse=True)
+    which = which.ravel()
+    return [(tuple(np.median(hxy[which == k], axis=0)), np.flatnonzero(which == k)) for k in range(len(first))]
+
+
 def bending_matrix(D: float, nu: float) -> np.ndarray:
     """Constitutive matrix D_b with M = −D_b κ, κ = (w,xx, w,yy, 2w,xy)."""
     return D * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - nu)]])
@@ -99,6 +115,32 @@ class RectElement:
             ],
             axis=1,
         )
+
+    # -- the protocol every element answers (cells given by their corners' coordinates) --------
+    def basis(self, xy, local, dx: int = 0, dy: int = 0) -> np.ndarray:
+        """(npts, ndof): ∂^(dx+dy) N / ∂x^dx ∂y^dy of each point's cell, the points given by their
+        cell's corners ``xy`` (npts, 4, 2) and their local coordinates ``local`` (npts, 2) = (ξ, η)
+        (:meth:`plateqp.mesh.Grid.locate`). Cells of one size share one evaluation."""
+        local = np.asarray(local, dtype=float).reshape(-1, 2)
+        out = np.empty((local.shape[0], self.ndof))
+        for (sx, sy), at in _sizes(xy):
+            out[at] = self.shape(local[at, 0], local[at, 1], sx, sy, dx, dy)
+        return out
+
+    def cell_stiffness(self, xy, D: float, nu: float) -> np.ndarray:
+        """(ncell, ndof, ndof): :meth:`stiffness` of each cell (corners ``xy`` (ncell, 4, 2))."""
+        return self._per_size(xy, lambda sx, sy: self.stiffness(sx, sy, D, nu))
+
+    def cell_load(self, xy) -> np.ndarray:
+        """(ncell, ndof): the consistent load of a unit pressure over each cell."""
+        return self._per_size(xy, lambda sx, sy: self.load(sx, sy))
+
+    def _per_size(self, xy, make) -> np.ndarray:
+        groups = _sizes(xy)
+        out = np.empty((len(np.asarray(xy)),) + np.shape(make(*groups[0][0])))
+        for (sx, sy), at in groups:
+            out[at] = make(sx, sy)
+        return out
 
     # -- element matrices -------------------------------------------------------------------
     def _gauss(self):

@@ -159,6 +159,36 @@ class DKT:
         f[:, 0::3] = area[:, None] / 3.0
         return f
 
+    # -- the protocol every element answers (cells given by their corners' coordinates) --------
+    def basis(self, xy, local, dx: int = 0, dy: int = 0) -> np.ndarray:
+        """(npts, 9): the basis of ∂^(dx+dy) w / ∂x^dx ∂y^dy at points given by their triangle's
+        vertices ``xy`` (npts, 3, 2) and barycentric coordinates ``local`` (npts, 3)
+        (:meth:`plateqp.trimesh.TriMesh.locate`): w the cubic (a vertex's own w dof exactly at a
+        vertex), the slopes (dx + dy = 1) and curvatures (dx + dy = 2) DKT's own, from its quadratic
+        slope field β: w,x = βx, w,xx = βx,x, w,xy = (βx,y + βy,x)/2 (so moments and stresses are
+        the element's M = −D_b κ)."""
+        lam = np.asarray(local, dtype=float).reshape(-1, 3)
+        if dx + dy == 1:
+            N = self.slope_matrix(xy, lam[:, None, :])[:, 0, dy]
+        elif dx + dy == 2:
+            B = self.curvature_matrix(xy, lam[:, None, :])[:, 0]
+            N = B[:, 0] if dx == 2 else B[:, 1] if dy == 2 else 0.5 * B[:, 2]
+        else:
+            N = self.shape(xy, lam[:, None, :])[:, 0]
+        at_node = (lam.max(axis=1) >= 1.0 - 1e-12) & (dx + dy < 2)  # a vertex: its own dof, no rounding noise
+        if at_node.any():
+            N[at_node] = 0.0
+            N[at_node, 3 * lam[at_node].argmax(axis=1) + list(self.node_dofs).index((dx, dy))] = 1.0
+        return N
+
+    def cell_stiffness(self, xy, D: float, nu: float) -> np.ndarray:
+        """(nt, 9, 9): :meth:`stiffness`."""
+        return self.stiffness(xy, D, nu)
+
+    def cell_load(self, xy) -> np.ndarray:
+        """(nt, 9): :meth:`load`, a unit pressure lumped on each triangle."""
+        return self.load(xy)
+
     def slope_matrix(self, xy, lam) -> np.ndarray:
         """(nt, npts, 2, 9): the slope field β = (βx, βy) ≈ ∇w at barycentric points (as
         :meth:`curvature_matrix` takes them): the 6-node quadratic interpolation of the nodal slopes."""
