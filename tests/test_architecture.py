@@ -10,7 +10,10 @@ studies, plots, report, cli). These tests hold the package to it:
   words (accuracy, errors), the linear algebra, and itself;
 - CHOLMOD's bindings (cvxopt, scikit-sparse) are imported in ``plateqp.linalg`` only;
 - no source file over :data:`MAX_LINES` lines (a file that needs a table of contents wants to
-  be two files).
+  be two files);
+- no function over :data:`MAX_FUNCTION_LINES` lines in the model and contact floors (a body of
+  stages wants its stages as functions), no module docstring over :data:`MAX_DOCSTRING_LINES`
+  lines anywhere (docstrings state contracts; the design story belongs in the docs).
 """
 
 from __future__ import annotations
@@ -32,6 +35,16 @@ CHOLMOD_BINDINGS = ("cvxopt", "sksparse")
 #: check, so that a fix removes it from here and nothing new can hide behind it.
 KNOWN_TOO_LONG: set[str] = set()
 KNOWN_CHOLMOD_OUTSIDE_LINALG: set[str] = set()
+MAX_FUNCTION_LINES = 80
+MAX_DOCSTRING_LINES = 60
+#: The model floor (scene to matrices) and the contact floor (the contact problem and its
+#: answer): the modules whose functions :data:`MAX_FUNCTION_LINES` holds.
+FLOORS = ("plateqp.scene", "plateqp.geometry", "plateqp.paths", "plateqp.mesh", "plateqp.trimesh",
+          "plateqp.elements", "plateqp.constraints", "plateqp.assembly", "plateqp.triassembly",
+          "plateqp.contact")
+KNOWN_LONG_FUNCTIONS: set[str] = {"plateqp.scene:validate", "plateqp.contact.pipeline:solve_contact"}
+KNOWN_LONG_DOCSTRINGS: set[str] = {"plateqp.backends.pdas", "plateqp.backends.bpp", "plateqp.backends.lemke",
+                                   "plateqp.backends.pgs"}
 
 
 def module_name(path: Path) -> str:
@@ -185,3 +198,44 @@ def test_known_failures_name_existing_files():
     """A known-too-long entry whose file is gone (moved, split) would pass silently: refuse it."""
     missing = sorted(rel for rel in KNOWN_TOO_LONG if not (ROOT / rel).is_file())
     assert not missing, f"KNOWN_TOO_LONG names files that do not exist: {missing}"
+
+
+def long_functions() -> dict[str, int]:
+    """``module:function`` → its length in lines, for the functions of the floors over the limit."""
+    out = {}
+    for name, path in sources().items():
+        if not any(name == f or name.startswith(f + ".") for f in FLOORS):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                n = node.end_lineno - node.lineno + 1
+                if n > MAX_FUNCTION_LINES:
+                    out[f"{name}:{node.name}"] = n
+    return out
+
+
+def test_the_floors_functions_are_short():
+    found = long_functions()
+    assert set(found) - KNOWN_LONG_FUNCTIONS == set(), f"functions over {MAX_FUNCTION_LINES} lines: {found}"
+    fixed = KNOWN_LONG_FUNCTIONS - set(found)
+    assert not fixed, f"{sorted(fixed)} are short now (or gone): remove them from KNOWN_LONG_FUNCTIONS"
+
+
+def test_module_docstrings_state_contracts():
+    long = {}
+    for name, path in sources().items():
+        doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8")))
+        if doc and len(doc.splitlines()) > MAX_DOCSTRING_LINES:
+            long[name] = len(doc.splitlines())
+    assert set(long) - KNOWN_LONG_DOCSTRINGS == set(), f"module docstrings over {MAX_DOCSTRING_LINES} lines: {long}"
+    fixed = KNOWN_LONG_DOCSTRINGS - set(long)
+    assert not fixed, f"{sorted(fixed)} are short now: remove them from KNOWN_LONG_DOCSTRINGS"
+
+
+def test_the_length_checks_see_a_long_function(tmp_path, monkeypatch):
+    """The function-length check finds a planted long function (a check that cannot fail is no check)."""
+    pkg = tmp_path / "plateqp"
+    pkg.mkdir()
+    (pkg / "scene.py").write_text("def f():\n" + "    x = 1\n" * MAX_FUNCTION_LINES + "    return x\n")
+    monkeypatch.setattr(__import__(__name__), "ROOT", pkg)
+    assert long_functions() == {"plateqp.scene:f": MAX_FUNCTION_LINES + 2}
