@@ -124,8 +124,8 @@ class Model:
 
     def load_vector(self, scene: Scene) -> np.ndarray:
         """The load vector (all dofs) of ``scene.loads`` on this model's mesh and element, without
-        assembling the stiffness (a model re-used with new loads). Each mesh's model gives it."""
-        raise NotImplementedError
+        assembling the stiffness (a model re-used with new loads): :func:`load_vector`."""
+        return load_vector(scene, self.grid, self.element, self.cell_dofs, self.n_full)
 
     def interpolation(self, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
         """(npts, n_full) sparse operator: the derivative ∂^(dx+dy) w / ∂x^dx ∂y^dy at points,
@@ -147,11 +147,6 @@ class Model:
 class GridModel(Model):
     """A :class:`Model` on the structured rectangle grid (``grid`` a :class:`~plateqp.mesh.Grid`,
     ``cells`` the kept cells, ``cell_dofs`` their dofs; the element a :class:`RectElement`)."""
-
-    def load_vector(self, scene: Scene) -> np.ndarray:
-        """The consistent load vector (all dofs) of ``scene.loads`` on this model's mesh and
-        element, without assembling the stiffness (a model re-used with new loads)."""
-        return _loads(scene, self.grid, self.element, self.cells, self.cell_dofs, self.n_full)
 
     def bed_areas(self) -> np.ndarray:
         """(n_nodes,) each node's tributary area of the scene's tensionless bed: a quarter of every
@@ -186,6 +181,24 @@ def interpolation(mesh, element, cell_dofs: np.ndarray, n_full: int, x, y, dx: i
     A = sp.csr_matrix((N.ravel(), (rows, cell_dofs[cell].ravel())), shape=(len(cell), n_full))
     A.eliminate_zeros()
     return A
+
+
+def load_vector(scene: Scene, mesh, element, cell_dofs: np.ndarray, n_full: int) -> np.ndarray:
+    """The load vector (all ``n_full`` dofs) of ``scene.loads`` on any mesh and element: a uniform
+    pressure by the element's load of each cell (``element.cell_load``), a patch by the element's
+    integral over each cell's part in it (``element.region_load``), a point load by the
+    interpolation at its point (:func:`interpolation`)."""
+    f = np.zeros(n_full)
+    xy = mesh.nodes[mesh.cells] if any(not isinstance(ld, PointLoad) for ld in scene.loads) else None
+    for ld in scene.loads:
+        if isinstance(ld, UniformLoad):
+            f += np.bincount(cell_dofs.ravel(), weights=(ld.q * element.cell_load(xy)).ravel(), minlength=n_full)
+        elif isinstance(ld, PatchLoad):
+            hit, fe = element.region_load(xy, (ld.x0, ld.x1, ld.y0, ld.y1))
+            np.add.at(f, cell_dofs[hit], ld.q * fe)
+        elif isinstance(ld, PointLoad):
+            f += ld.P * interpolation(mesh, element, cell_dofs, n_full, ld.x, ld.y).toarray().ravel()
+    return f
 
 
 #: Peak memory of building and solving a scene, per dof of its grid: measured (resident set
@@ -271,7 +284,7 @@ def build_model(scene: Scene) -> Model:
     nodes = grid.cell_nodes()[cells]
     cell_dofs = (nodes[:, :, None] * nd + np.arange(nd)).reshape(len(cells), -1)
 
-    f_full = _loads(scene, grid, el, cells, cell_dofs, n_full)
+    f_full = load_vector(scene, grid, el, cell_dofs, n_full)
 
     fixed, values = prescribed(scene, grid, el)
     node_mask = grid.node_mask()
@@ -359,29 +372,6 @@ def _csr_from_blocks(V, cnode, pos, ncol):
     A.has_sorted_indices = True
     A.has_canonical_format = True
     return A
-
-
-def _loads(scene, grid, el, cells, cell_dofs, n_full) -> np.ndarray:
-    hx, hy = grid.hx, grid.hy
-    f = np.zeros(n_full)
-    for ld in scene.loads:
-        if isinstance(ld, UniformLoad):
-            fe = el.load(hx, hy)
-            f += np.bincount(cell_dofs.ravel(), weights=np.tile(ld.q * fe, len(cells)), minlength=n_full)
-        elif isinstance(ld, PatchLoad):
-            ci = cells % grid.nx
-            cj = cells // grid.nx
-            x0 = np.clip((ld.x0 - ci * hx) / hx, 0, 1)
-            x1 = np.clip((ld.x1 - ci * hx) / hx, 0, 1)
-            y0 = np.clip((ld.y0 - cj * hy) / hy, 0, 1)
-            y1 = np.clip((ld.y1 - cj * hy) / hy, 0, 1)
-            hit = (x1 > x0) & (y1 > y0)
-            if np.any(hit):
-                fe = el.load(hx, hy, np.column_stack([x0, x1, y0, y1])[hit])
-                np.add.at(f, cell_dofs[hit], ld.q * fe)
-        elif isinstance(ld, PointLoad):
-            f += ld.P * interpolation(grid, el, cell_dofs, n_full, ld.x, ld.y).toarray().ravel()
-    return f
 
 
 def _contacts(scene: Scene, model: Model) -> ContactOperator | None:

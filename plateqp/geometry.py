@@ -420,6 +420,23 @@ def clip_to_polygon(tris: np.ndarray, outline) -> tuple[np.ndarray, np.ndarray]:
     return out_a, out_c
 
 
+def lumped_region(tris: np.ndarray, region) -> tuple[np.ndarray, np.ndarray]:
+    """(hit, weights): the triangles (nt, 3, 2) a unit pressure on ``region`` (:func:`region_outline`)
+    covers in part, and each one's vertex weights (len(hit), 3): over the triangle's part A_t in the
+    region, ∫ λ_i dA = |A_t| λ_i(centroid of A_t) (λ the barycentric coordinates). Statically
+    exact: the weights sum to the region's area on the triangles, their moment is its moment."""
+    tris = np.asarray(tris, dtype=float)
+    area, cent = clip_to_polygon(tris, region_outline(region))
+    hit = np.flatnonzero(area > 0.0)
+    p = tris[hit]
+    (x1, y1), (x2, y2), (x3, y3) = p[:, 0].T, p[:, 1].T, p[:, 2].T
+    det = (x2 - x1) * (y3 - y1) - (x3 - x1) * (y2 - y1)
+    x, y = cent[hit, 0], cent[hit, 1]
+    l2 = ((x - x1) * (y3 - y1) - (x3 - x1) * (y - y1)) / det
+    l3 = ((x2 - x1) * (y - y1) - (x - x1) * (y2 - y1)) / det
+    return hit, area[hit, None] * np.column_stack([1.0 - l2 - l3, l2, l3])
+
+
 def box_outline(box) -> np.ndarray:
     """The counter-clockwise outline (4, 2) of the box [x0, x1, y0, y1]."""
     x0, x1, y0, y1 = (float(v) for v in box)

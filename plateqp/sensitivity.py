@@ -353,13 +353,11 @@ def parameters(model, data: Scaled, R: np.ndarray, wrt: str):
         drho = np.column_stack(cols) if cols else np.zeros((m, 0))
         return labels, np.zeros((n, len(cols))), np.zeros((m, len(cols))), drho
     if wrt == "loads":
-        from .assembly import _loads  # the load vector of one load alone (no stiffness assembly)
-
         cols = []
         for ld in scene.loads:
             one = copy.copy(scene)  # the scene with this load alone (a shallow copy: nothing else changes)
             one.loads = [ld]
-            f_full = _loads(one, model.grid, model.element, model.cells, model.cell_dofs, model.n_full)
+            f_full = model.load_vector(one)  # the load vector of one load alone (no stiffness assembly)
             cols.append(data.dof_scale * f_full[model.free] / (data.F0 * data.W))
         df = np.column_stack(cols) if cols else np.zeros((n, 0))
         p = df.shape[1]

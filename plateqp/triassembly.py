@@ -22,11 +22,11 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, interpolation, memory_limit
+from .assembly import BYTES_PER_DOF, MESH_BUILDERS, Model, _contacts, human_bytes, load_vector, memory_limit
 from .elements import ELEMENTS
 from .errors import ResourceError, SceneError
 from .constraints import prescribed
-from .geometry import clip_to_polygon, inner_segments, mesh_size, region_outline, scene_domain
+from .geometry import inner_segments, lumped_region, mesh_size, region_outline, scene_domain
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
 from .trimesh import TriMesh, estimate_nodes, mesh_domain
 
@@ -34,9 +34,6 @@ from .trimesh import TriMesh, estimate_nodes, mesh_domain
 class TriModel(Model):
     """A :class:`~plateqp.assembly.Model` on a triangle mesh (``grid`` is the :class:`TriMesh`,
     ``cells`` the triangles, ``cell_dofs`` their dofs)."""
-
-    def load_vector(self, scene: Scene) -> np.ndarray:
-        return tri_loads(scene, self.grid, self.element, self.cell_dofs, self.n_full)
 
     def bed_areas(self) -> np.ndarray:
         """(n_nodes,) each node's tributary area of the scene's tensionless bed: a third of every
@@ -68,13 +65,8 @@ def patch_weights(mesh: TriMesh, box) -> np.ndarray:
     barycentric coordinates). The uniform load's lumping (area / 3 per vertex) where the box
     covers a triangle; statically exact everywhere: the total is the area of the box on the
     mesh, and the moment that of the pressure on it."""
-    from .trimesh import _barycentric
-
-    xy = mesh.nodes[mesh.triangles]
-    area, cent = clip_to_polygon(xy, region_outline(box))
-    hit = np.flatnonzero(area > 0.0)
-    lam = _barycentric(xy[hit], cent[hit, 0], cent[hit, 1])
-    return np.bincount(mesh.triangles[hit].ravel(), weights=(area[hit, None] * lam).ravel(), minlength=mesh.n_nodes)
+    hit, weights = lumped_region(mesh.nodes[mesh.triangles], box)
+    return np.bincount(mesh.triangles[hit].ravel(), weights=weights.ravel(), minlength=mesh.n_nodes)
 
 
 def check_memory_tri(scene: Scene, h: float) -> None:
@@ -106,7 +98,7 @@ def build_tri_model(scene: Scene) -> TriModel:
     K_full = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(n_full, n_full))
     K_full.sum_duplicates()
 
-    f_full = tri_loads(scene, mesh, el, cell_dofs, n_full)
+    f_full = load_vector(scene, mesh, el, cell_dofs, n_full)
     fixed, values = prescribed(scene, mesh, el)
     free = np.setdiff1d(np.arange(n_full), fixed)
     u_c = np.zeros(n_full)
@@ -117,22 +109,6 @@ def build_tri_model(scene: Scene) -> TriModel:
                      f_full, K_full)
     model.contacts = _contacts(scene, model)
     return model
-
-
-def tri_loads(scene: Scene, mesh: TriMesh, el, cell_dofs: np.ndarray, n_full: int) -> np.ndarray:
-    """The load vector (all ``n_full`` dofs) of ``scene.loads`` on a triangle mesh: uniform pressure
-    by the element's load, point loads at their (embedded) points, patch loads integrated exactly
-    over the clipped triangles. Also used to re-use a model with new loads (sweeps)."""
-    f_full = np.zeros(n_full)
-    xy = mesh.nodes[mesh.triangles]
-    for ld in scene.loads:
-        if isinstance(ld, UniformLoad):
-            f_full += np.bincount(cell_dofs.ravel(), weights=(ld.q * el.load(xy)).ravel(), minlength=n_full)
-        elif isinstance(ld, PointLoad):
-            f_full += ld.P * interpolation(mesh, el, cell_dofs, n_full, ld.x, ld.y).toarray().ravel()
-        elif isinstance(ld, PatchLoad):
-            f_full[0::el.ndof_node] += ld.q * patch_weights(mesh, (ld.x0, ld.x1, ld.y0, ld.y1))
-    return f_full
 
 
 MESH_BUILDERS["triangle"] = build_tri_model

@@ -135,6 +135,25 @@ class RectElement:
         """(ncell, ndof): the consistent load of a unit pressure over each cell."""
         return self._per_size(xy, lambda sx, sy: self.load(sx, sy))
 
+    def region_load(self, xy, box) -> tuple[np.ndarray, np.ndarray]:
+        """(hit, loads): the cells (indices into ``xy``) a unit pressure on the box
+        [x0, x1] × [y0, y1] covers in part, and their consistent loads (len(hit), ndof), the box
+        integrated exactly over each cell (:meth:`load` on the sub-box)."""
+        x0, x1, y0, y1 = (float(v) for v in box)
+        xy = np.asarray(xy, dtype=float)
+        hits, loads = [], []
+        for (sx, sy), at in _sizes(xy):
+            ox, oy = xy[at, 0, 0], xy[at, 0, 1]
+            b = np.column_stack([np.clip((x0 - ox) / sx, 0, 1), np.clip((x1 - ox) / sx, 0, 1),
+                                 np.clip((y0 - oy) / sy, 0, 1), np.clip((y1 - oy) / sy, 0, 1)])
+            hit = (b[:, 1] > b[:, 0]) & (b[:, 3] > b[:, 2])
+            if hit.any():
+                hits.append(at[hit])
+                loads.append(self.load(sx, sy, b[hit]))
+        if not hits:
+            return np.zeros(0, dtype=int), np.zeros((0, self.ndof))
+        return np.concatenate(hits), np.vstack(loads)
+
     def _per_size(self, xy, make) -> np.ndarray:
         groups = _sizes(xy)
         out = np.empty((len(np.asarray(xy)),) + np.shape(make(*groups[0][0])))

@@ -189,6 +189,20 @@ class DKT:
         """(nt, 9): :meth:`load`, a unit pressure lumped on each triangle."""
         return self.load(xy)
 
+    def region_load(self, xy, region) -> tuple[np.ndarray, np.ndarray]:
+        """(hit, loads): the triangles (indices into ``xy``) a unit pressure on ``region`` (a box
+        [x0, x1, y0, y1] or a polygon region, :func:`plateqp.geometry.region_outline`) covers in
+        part, and their loads (len(hit), 9), lumped on the vertices' w: over each triangle's part
+        A_t in the region, ∫ λ_i dA = |A_t| λ_i(centroid of A_t) (λ the barycentric coordinates).
+        The uniform load's lumping where the region covers a triangle; statically exact: the
+        total is the region's area on the mesh, the moment that of the pressure on it."""
+        from ..geometry import lumped_region
+
+        hit, weights = lumped_region(_as_tris(xy), region)
+        f = np.zeros((hit.size, 9))
+        f[:, 0::3] = weights
+        return hit, f
+
     def slope_matrix(self, xy, lam) -> np.ndarray:
         """(nt, npts, 2, 9): the slope field β = (βx, βy) ≈ ∇w at barycentric points (as
         :meth:`curvature_matrix` takes them): the 6-node quadratic interpolation of the nodal slopes."""
