@@ -38,7 +38,6 @@ from .scene import (
 )
 from .sensitivity import Sensitivity, sensitivity
 from .solving import solve, solve_bilateral
-from . import triassembly as _triassembly  # noqa: F401,E402 - registers the DKT (triangle) model builder
 
 __version__ = "0.1.0"
 

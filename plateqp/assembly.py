@@ -25,11 +25,11 @@ from .constraints import prescribed, rigid_modes
 from .elements import ELEMENTS, RectElement
 from .errors import ResourceError, SceneError
 from .mesh import Grid
+from .trimesh import TriMesh
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
 
 if TYPE_CHECKING:  # pragma: no cover
     from .elements import DKT
-    from .trimesh import TriMesh
 
 
 @dataclass
@@ -78,9 +78,9 @@ class ContactOperator:
 @dataclass
 class Model:
     """A plate's two-sided problem on a mesh, K u = f on the free dofs, and its one-sided contact
-    operator: what the contact code reads. The mesh's own operations (loads, interpolation, a
-    bed's tributary areas) are its subclass's: :class:`GridModel` on the rectangle grid,
-    :class:`plateqp.triassembly.TriModel` on triangles."""
+    operator: what the contact code reads, the same on every mesh (``grid`` is the mesh: a
+    :class:`~plateqp.mesh.Grid` or a :class:`~plateqp.trimesh.TriMesh`, which answer the same
+    names). Node n of the mesh's dof numbering carries dofs ``n · ndof_node + k``."""
 
     scene: Scene
     grid: Grid | TriMesh  # the mesh (either generator's; they answer the same names)
@@ -97,8 +97,8 @@ class Model:
     # all dofs × all dofs, or a function that assembles it (:attr:`K_full`, on first use)
     _K_full: sp.csr_matrix | Callable[[], sp.csr_matrix] = field(repr=False)
     contacts: ContactOperator | None = None
-    #: K is exactly symmetric, value for value (the rectangular assembly makes it so: see
-    #: :func:`_node_blocks`), so its CSR arrays are its CSC arrays
+    #: K is exactly symmetric, value for value (the mesh's assembly says so: the grid's does, see
+    #: :meth:`plateqp.mesh.Grid.assemble`), so its CSR arrays are its CSC arrays
     #: (:func:`plateqp.linalg.pattern.csc_of_symmetric`)
     symmetric: bool = False
 
@@ -133,34 +133,14 @@ class Model:
         return interpolation(self.grid, self.element, self.cell_dofs, self.n_full, x, y, dx, dy)
 
     def bed_areas(self) -> np.ndarray:
-        """(n_nodes,) each node's tributary area of the scene's tensionless bed. Each mesh's model
-        gives it."""
-        raise NotImplementedError
+        """(n_nodes,) each node's tributary area of the scene's tensionless bed (its region, the
+        whole plate without one), by the mesh's rule (``mesh.tributary_areas``)."""
+        return self.grid.tributary_areas(self.scene.foundation.region)
 
     def rigid_modes(self) -> np.ndarray:
         """(n_free, k) basis of the rigid motions the two-sided supports leave free (k = 0..3 per
         piece): :func:`plateqp.constraints.rigid_modes`."""
         return rigid_modes(self)
-
-
-@dataclass
-class GridModel(Model):
-    """A :class:`Model` on the structured rectangle grid (``grid`` a :class:`~plateqp.mesh.Grid`,
-    ``cells`` the kept cells, ``cell_dofs`` their dofs; the element a :class:`RectElement`)."""
-
-    def bed_areas(self) -> np.ndarray:
-        """(n_nodes,) each node's tributary area of the scene's tensionless bed: a quarter of every
-        kept cell centred in the bed's region (the whole plate without one) that has it as a corner."""
-        grid, fnd = self.grid, self.scene.foundation
-        x0, x1, y0, y1 = fnd.region if fnd.region is not None else (0.0, grid.a, 0.0, grid.b)
-        area = np.zeros(grid.n_nodes)
-        np.add.at(area, grid.cell_nodes()[grid.cells_centred_in(x0, x1, y0, y1)].ravel(), 0.25 * grid.hx * grid.hy)
-        return area
-
-    def grid_cell_dofs(self, cell: np.ndarray) -> np.ndarray:
-        nd = self.element.ndof_node
-        nodes = self.grid.cell_nodes()[cell]
-        return (nodes[:, :, None] * nd + np.arange(nd)).reshape(len(cell), -1)
 
 
 def interpolation(mesh, element, cell_dofs: np.ndarray, n_full: int, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
@@ -209,12 +189,10 @@ MEMORY_ENV = "PLATEQP_MAX_MEMORY"
 
 
 def estimate_memory(scene: Scene) -> int:
-    """Bytes a build and solve of ``scene`` is expected to need at its peak (see BYTES_PER_DOF)."""
-    if scene.triangles:
-        from .trimesh import estimate_nodes
-        return int(BYTES_PER_DOF * len(ELEMENTS[scene.mesh.element].node_dofs) * estimate_nodes(scene))
+    """Bytes a build and solve of ``scene`` is expected to need at its peak (see BYTES_PER_DOF):
+    the dofs of the mesh its generator expects (``estimate_nodes``)."""
     nd = len(ELEMENTS[scene.mesh.element].node_dofs)
-    return int(BYTES_PER_DOF * (scene.mesh.nx + 1) * (scene.mesh.ny + 1) * nd)
+    return int(BYTES_PER_DOF * nd * _generator(scene).estimate_nodes(scene))
 
 
 def memory_limit() -> int:
@@ -253,125 +231,56 @@ def check_memory(scene: Scene) -> None:
     """ResourceError before any allocation if ``scene`` would need more memory than allowed."""
     need, limit = estimate_memory(scene), memory_limit()
     if need > limit:
-        raise ResourceError(f"mesh: a {scene.mesh.nx} x {scene.mesh.ny} {scene.mesh.element} mesh needs about "
-                            f"{human_bytes(need)} to build and solve, above the limit of {human_bytes(limit)}; "
-                            f"use a coarser mesh, or raise the limit (--max-memory or ${MEMORY_ENV})")
+        where, mesh, fix = _generator(scene).describe(scene)
+        raise ResourceError(f"{where}: a {mesh} needs about {human_bytes(need)} to build and solve, above the limit "
+                            f"of {human_bytes(limit)}; {fix}, or raise the limit (--max-memory or ${MEMORY_ENV})")
 
 
-#: Model builders by the element's ``cell_type``, for the meshes other than the rectangular grid;
-#: a module registers its own on import (:mod:`plateqp.triassembly` "triangle", imported by
-#: ``plateqp``), so that this module does not import it (no import cycle).
-MESH_BUILDERS: dict[str, Callable[[Scene], Model]] = {}
+#: The mesh generator of each ``cell_type`` (:data:`plateqp.elements.ELEMENTS`): its class
+#: answers ``from_scene``, ``estimate_nodes``, ``describe``, and its meshes the names every mesh
+#: answers (nodes, cells, locate, boundary_edges, assemble, tributary_areas, …).
+GENERATORS = {"quad": Grid, "triangle": TriMesh}
+
+
+def _generator(scene: Scene):
+    return GENERATORS[ELEMENTS[scene.mesh.element].cell_type]
 
 
 def build_model(scene: Scene) -> Model:
-    """Assemble the stiffness, loads, two-sided constraints and contact operator of a scene
-    (after :func:`check_memory`: a mesh too large for the machine is refused before assembly),
-    on the mesh its element's ``cell_type`` names: the structured grid ("quad") here, another by
-    its builder in :data:`MESH_BUILDERS` (triangles: :func:`plateqp.triassembly.build_tri_model`)."""
-    builder = MESH_BUILDERS.get(ELEMENTS[scene.mesh.element].cell_type)
-    if builder is not None:
-        return builder(scene)
+    """Mesh a scene (after :func:`check_memory`: a mesh too large for the machine is refused
+    before any allocation) and assemble its stiffness on the free dofs (``mesh.assemble``), its
+    loads (:func:`load_vector`), its two-sided supports (:func:`plateqp.constraints.prescribed`)
+    and its contact operator; the same steps on every mesh."""
     check_memory(scene)
-    grid = Grid.from_scene(scene)
+    mesh = _generator(scene).from_scene(scene)
     el = ELEMENTS[scene.mesh.element]()
     nd = el.ndof_node
-    p = scene.plate
-    hx, hy = grid.hx, grid.hy
-    n_full = grid.n_nodes * nd
-
-    cells = np.flatnonzero(grid.cell_mask)
-    nodes = grid.cell_nodes()[cells]
-    cell_dofs = (nodes[:, :, None] * nd + np.arange(nd)).reshape(len(cells), -1)
-
-    f_full = load_vector(scene, grid, el, cell_dofs, n_full)
-
-    fixed, values = prescribed(scene, grid, el)
-    node_mask = grid.node_mask()
-    on_plate = np.repeat(node_mask, nd)
-    is_fixed = np.zeros(n_full, dtype=bool)
-    is_fixed[fixed] = True
-    free = np.flatnonzero(on_plate & ~is_fixed)
-
-    # stiffness: every cell has the same element matrix; CSR built directly from node blocks
-    V, cnode = _node_blocks(grid, el.stiffness(hx, hy, p.D, p.nu), nd)
-
-    def K_full():  # off-plate rows empty; the node blocks made again (not kept with the model)
-        Vf, cf = _node_blocks(grid, el.stiffness(hx, hy, p.D, p.nu), nd)
-        return _csr_from_blocks(Vf, cf, np.arange(n_full), n_full)
-
+    D, nu = scene.plate.D, scene.plate.nu
+    n_full = mesh.n_nodes * nd
+    cell_dofs = (mesh.plate_node_ids[mesh.cells][:, :, None] * nd + np.arange(nd)).reshape(len(mesh.cells), -1)
+    f_full = load_vector(scene, mesh, el, cell_dofs, n_full)
+    fixed, values = prescribed(scene, mesh, el)
+    is_free = np.zeros(n_full, dtype=bool)
+    is_free[(mesh.plate_node_ids[:, None] * nd + np.arange(nd)).ravel()] = True
+    is_free[fixed] = False
+    free = np.flatnonzero(is_free)
     pos = np.full(n_full, -1)
     pos[free] = np.arange(free.size)
-    K = _csr_from_blocks(V, cnode, pos, free.size)
+    K = mesh.assemble(el, D, nu, pos, free.size)
+
+    def K_full():  # every dof (off-plate rows empty): assembled on first use, not kept meanwhile
+        return mesh.assemble(el, D, nu, np.arange(n_full), n_full)
+
     f = f_full[free]  # (a copy)
     if np.any(values != 0):  # the prescribed values' loads on the free dofs
         u_c = np.zeros(n_full)
         u_c[fixed] = values
         K_full = K_full()
         f -= (K_full @ u_c)[free]
-    model = GridModel(scene, grid, el, K, f, free, fixed, values, n_full, cell_dofs, cells, f_full, K_full)
-    model.symmetric = True  # _node_blocks adds (p, q) and (q, p) in the same order
+    model = Model(scene, mesh, el, K, f, free, fixed, values, n_full, cell_dofs, mesh.cell_ids, f_full, K_full,
+                  symmetric=mesh.symmetric_assembly)
     model.contacts = _contacts(scene, model)
     return model
-
-
-CORNER_IJ = ((0, 0), (1, 0), (1, 1), (0, 1))  # element corner order (di, dj)
-
-
-def _node_blocks(grid, Ke, nd):
-    """Node-level stencil of the assembled stiffness.
-
-    Every kept cell has the same Ke, so the nd×nd block coupling node p to its neighbour
-    p + (di, dj) (o = 3(dj+1) + di+1, ascending in node number) is the sum of Ke's corner blocks
-    over the kept cells that hold both nodes; which of those exist is one of 16 patterns per node.
-    Returns V (n_nodes, nd, 9, nd), cnode (n_nodes, 9) neighbour node or -1 where no block.
-    """
-    nn = grid.n_nodes
-    kept = np.zeros((nn, 4))
-    cn = grid.cell_nodes()[grid.cell_mask]
-    for a in range(4):
-        kept[cn[:, a], a] = 1.0  # the cell having node p as its corner a is kept
-    T = np.zeros((4, nd, 9, nd))
-    S = np.zeros((4, 9))
-    for a, (ia, ja) in enumerate(CORNER_IJ):
-        for b, (ib, jb) in enumerate(CORNER_IJ):
-            o = 3 * (jb - ja + 1) + (ib - ia + 1)
-            T[a, :, o, :] = Ke[a * nd:(a + 1) * nd, b * nd:(b + 1) * nd]
-            S[a, o] = 1.0
-    # a node's blocks depend only on which of its <= 4 cells are kept: 16 patterns. Sum each
-    # pattern's corner blocks in ascending cell order (corners 2, 3, 1, 0 of the node), so the
-    # (p, q) and (q, p) entries add the same numbers in the same order: K exactly symmetric.
-    bits = (kept * np.array([1, 2, 4, 8])).sum(axis=1).astype(np.intp)
-    table = np.zeros((16, nd * 9 * nd))
-    Tf = T.reshape(4, -1)
-    for pat in range(16):
-        for a in (2, 3, 1, 0):
-            if pat >> a & 1:
-                table[pat] += Tf[a]
-    V = table[bits].reshape(nn, nd, 9, nd)
-    off = np.array([dj * (grid.nx + 1) + di for dj in (-1, 0, 1) for di in (-1, 0, 1)])
-    cnode = np.where(kept @ S > 0, np.arange(nn)[:, None] + off, -1)
-    return V, cnode
-
-
-def _csr_from_blocks(V, cnode, pos, ncol):
-    """Rows/cols: dofs with pos >= 0 (pos: new index per full dof, increasing). Canonical CSR."""
-    nn, nd = V.shape[:2]
-    posn = pos.reshape(nn, nd)
-    G = np.where(cnode[:, :, None] >= 0, posn[np.maximum(cnode, 0)], -1).reshape(nn, 9 * nd)
-    G = G.astype(np.int32)
-    colok = G >= 0
-    rowok = posn >= 0
-    m = rowok[:, :, None] & colok[:, None, :]
-    data = V.reshape(nn, nd, 9 * nd)[m]
-    indices = np.broadcast_to(G[:, None, :], m.shape)[m]
-    counts = np.broadcast_to(colok.sum(axis=1)[:, None], rowok.shape)[rowok]
-    indptr = np.zeros(counts.size + 1, dtype=np.int32)
-    np.cumsum(counts, out=indptr[1:])
-    A = sp.csr_matrix((data, indices, indptr), shape=(counts.size, ncol))
-    A.has_sorted_indices = True
-    A.has_canonical_format = True
-    return A
 
 
 def _contacts(scene: Scene, model: Model) -> ContactOperator | None:

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+import scipy.sparse as sp
 
 
 @dataclass
@@ -52,6 +53,43 @@ class Grid:
                 inside = shape.contains(X[near], Y[near], 1e-12 * max(p.a, p.b))
                 cut[near[inside]] = k
         return cls(p.a, p.b, nx, ny, cut < 0, cut, tuple(shapes))
+
+    # -- the generator's side of building a model (plateqp.assembly.build_model) ----------------
+    #: the stiffness :meth:`assemble` gives is exactly symmetric, value for value
+    symmetric_assembly = True
+
+    @staticmethod
+    def estimate_nodes(scene) -> int:
+        """The nodes the grid of ``scene`` numbers (its dofs' nodes): (nx + 1)(ny + 1)."""
+        return (scene.mesh.nx + 1) * (scene.mesh.ny + 1)
+
+    @staticmethod
+    def describe(scene) -> tuple[str, str, str]:
+        """(field, the mesh in words, what makes it smaller) for a message about its size."""
+        m = scene.mesh
+        return "mesh", f"{m.nx} x {m.ny} {m.element} mesh", "use a coarser mesh"
+
+    @cached_property
+    def cell_ids(self) -> np.ndarray:
+        """(n_kept,) the grid index (j·nx + i) of each cell of :attr:`cells`."""
+        return np.flatnonzero(self.cell_mask)
+
+    def assemble(self, element, D: float, nu: float, pos: np.ndarray, ncol: int) -> sp.csr_matrix:
+        """The stiffness on the dofs with ``pos`` ≥ 0 (``pos``: each dof's new index, increasing;
+        ``ncol`` of them), in canonical CSR. Every cell of a grid has the same element matrix, so
+        the matrix is built directly from the node-level stencil (:func:`_node_blocks`), exactly
+        symmetric."""
+        V, cnode = _node_blocks(self, element.stiffness(self.hx, self.hy, D, nu), element.ndof_node)
+        return _csr_from_blocks(V, cnode, pos, ncol)
+
+    def tributary_areas(self, region) -> np.ndarray:
+        """(n_nodes,) each node's tributary area of a bed on ``region`` (a box [x0, x1, y0, y1];
+        None: the whole plate): a quarter of every kept cell centred in it that has the node as a
+        corner."""
+        x0, x1, y0, y1 = region if region is not None else (0.0, self.a, 0.0, self.b)
+        area = np.zeros(self.n_nodes)
+        np.add.at(area, self.cell_nodes()[self.cells_centred_in(x0, x1, y0, y1)].ravel(), 0.25 * self.hx * self.hy)
+        return area
 
     def boundary_edges(self):
         """The plate's boundary as every mesh gives it: (edges (ne, 2) node pairs, outward unit
@@ -230,3 +268,62 @@ class Grid:
         oy = np.minimum(y1, (j + 1) * self.hy) - np.maximum(y0, j * self.hy) > 0
         hit = np.outer(oy, ox).ravel()  # index j*nx + i, like cell_mask
         return bool(np.any(hit & self.cell_mask))
+
+
+CORNER_IJ = ((0, 0), (1, 0), (1, 1), (0, 1))  # element corner order (di, dj)
+
+
+def _node_blocks(grid, Ke, nd):
+    """Node-level stencil of the assembled stiffness.
+
+    Every kept cell has the same Ke, so the nd×nd block coupling node p to its neighbour
+    p + (di, dj) (o = 3(dj+1) + di+1, ascending in node number) is the sum of Ke's corner blocks
+    over the kept cells that hold both nodes; which of those exist is one of 16 patterns per node.
+    Returns V (n_nodes, nd, 9, nd), cnode (n_nodes, 9) neighbour node or -1 where no block.
+    """
+    nn = grid.n_nodes
+    kept = np.zeros((nn, 4))
+    cn = grid.cell_nodes()[grid.cell_mask]
+    for a in range(4):
+        kept[cn[:, a], a] = 1.0  # the cell having node p as its corner a is kept
+    T = np.zeros((4, nd, 9, nd))
+    S = np.zeros((4, 9))
+    for a, (ia, ja) in enumerate(CORNER_IJ):
+        for b, (ib, jb) in enumerate(CORNER_IJ):
+            o = 3 * (jb - ja + 1) + (ib - ia + 1)
+            T[a, :, o, :] = Ke[a * nd:(a + 1) * nd, b * nd:(b + 1) * nd]
+            S[a, o] = 1.0
+    # a node's blocks depend only on which of its <= 4 cells are kept: 16 patterns. Sum each
+    # pattern's corner blocks in ascending cell order (corners 2, 3, 1, 0 of the node), so the
+    # (p, q) and (q, p) entries add the same numbers in the same order: K exactly symmetric.
+    bits = (kept * np.array([1, 2, 4, 8])).sum(axis=1).astype(np.intp)
+    table = np.zeros((16, nd * 9 * nd))
+    Tf = T.reshape(4, -1)
+    for pat in range(16):
+        for a in (2, 3, 1, 0):
+            if pat >> a & 1:
+                table[pat] += Tf[a]
+    V = table[bits].reshape(nn, nd, 9, nd)
+    off = np.array([dj * (grid.nx + 1) + di for dj in (-1, 0, 1) for di in (-1, 0, 1)])
+    cnode = np.where(kept @ S > 0, np.arange(nn)[:, None] + off, -1)
+    return V, cnode
+
+
+def _csr_from_blocks(V, cnode, pos, ncol):
+    """Rows/cols: dofs with pos >= 0 (pos: new index per full dof, increasing). Canonical CSR."""
+    nn, nd = V.shape[:2]
+    posn = pos.reshape(nn, nd)
+    G = np.where(cnode[:, :, None] >= 0, posn[np.maximum(cnode, 0)], -1).reshape(nn, 9 * nd)
+    G = G.astype(np.int32)
+    colok = G >= 0
+    rowok = posn >= 0
+    m = rowok[:, :, None] & colok[:, None, :]
+    data = V.reshape(nn, nd, 9 * nd)[m]
+    indices = np.broadcast_to(G[:, None, :], m.shape)[m]
+    counts = np.broadcast_to(colok.sum(axis=1)[:, None], rowok.shape)[rowok]
+    indptr = np.zeros(counts.size + 1, dtype=np.int32)
+    np.cumsum(counts, out=indptr[1:])
+    A = sp.csr_matrix((data, indices, indptr), shape=(counts.size, ncol))
+    A.has_sorted_indices = True
+    A.has_canonical_format = True
+    return A

@@ -25,9 +25,10 @@ import threading
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 
 from .errors import SceneError
-from .geometry import Domain, Polygon, _point_segment
+from .geometry import Domain, Polygon, _point_segment, inner_segments, lumped_region, region_outline
 
 #: refinement around embedded points: size REFINE·h at the point, h from 2h away
 REFINE = 0.25
@@ -102,6 +103,65 @@ class TriMesh:
         """(edges, outward normals, boundary, segment) of the plate's boundary, as every mesh
         gives them (:meth:`plateqp.mesh.Grid.boundary_edges`)."""
         return self.edges, self.normals, self.boundary, self.segment
+
+    # -- the generator's side of building a model (plateqp.assembly.build_model) ----------------
+    #: the summed element matrices are symmetric to rounding, not value for value
+    symmetric_assembly = False
+    estimate_nodes = staticmethod(lambda scene: estimate_nodes(scene))
+
+    @classmethod
+    def from_scene(cls, scene) -> TriMesh:
+        """The scene's plate meshed by gmsh at its element size, with a node at every support,
+        point load and pin, and the bed region's outline drawn into the mesh (:func:`mesh_domain`)."""
+        from .geometry import mesh_size, scene_domain
+        from .scene import PointLoad
+
+        domain = scene_domain(scene)
+        points = [(s.x, s.y) for s in scene.supports] + [(ld.x, ld.y) for ld in scene.loads
+                                                         if isinstance(ld, PointLoad)] + [(p.x, p.y) for p in scene.pins]
+        lines = [] if scene.foundation is None or scene.foundation.region is None else inner_segments(
+            domain, region_outline(scene.foundation.region))
+        return mesh_domain(domain, mesh_size(scene), points, lines)
+
+    @staticmethod
+    def describe(scene) -> tuple[str, str, str]:
+        """(field, the mesh in words, what makes it smaller) for a message about its size."""
+        from .geometry import mesh_size
+
+        return "mesh.size", f"triangle mesh of size {mesh_size(scene):g}", "use a larger mesh.size"
+
+    @property
+    def cell_ids(self) -> np.ndarray:
+        """(nt,) every triangle is a cell of the plate."""
+        return np.arange(len(self.triangles))
+
+    def assemble(self, element, D: float, nu: float, pos: np.ndarray, ncol: int) -> sp.csr_matrix:
+        """The stiffness on the dofs with ``pos`` ≥ 0 (``pos``: each dof's new index; ``ncol`` of
+        them), in CSR: the element matrices of every triangle (``element.cell_stiffness``, batched)
+        summed."""
+        nd = element.ndof_node
+        Ke = element.cell_stiffness(self.nodes[self.triangles], D, nu)
+        dofs = pos[(self.triangles[:, :, None] * nd + np.arange(nd)).reshape(len(self.triangles), -1)]
+        rows = np.repeat(dofs, dofs.shape[1], axis=1).ravel()
+        cols = np.tile(dofs, (1, dofs.shape[1])).ravel()
+        keep = (rows >= 0) & (cols >= 0)
+        K = sp.csr_matrix((Ke.ravel()[keep], (rows[keep], cols[keep])), shape=(ncol, ncol))
+        K.sum_duplicates()
+        return K
+
+    def tributary_areas(self, region) -> np.ndarray:
+        """(n_nodes,) each node's tributary area of a bed on ``region`` (a box [x0, x1, y0, y1] or a
+        polygon region; None: the whole plate): a third of every triangle, or of each triangle's
+        part in the region, weighted as a patch load is (:func:`plateqp.geometry.lumped_region`).
+        The region's outline is a line of the mesh (:meth:`from_scene`), so the region is a union
+        of whole triangles and the areas sum to its area on the plate exactly."""
+        if region is None:
+            return np.bincount(self.triangles.ravel(), weights=np.repeat(self.areas() / 3, 3), minlength=self.n_nodes)
+        hit, weights = lumped_region(self.nodes[self.triangles], region)
+        area = np.bincount(self.triangles[hit].ravel(), weights=weights.ravel(), minlength=self.n_nodes)
+        if not area.any():
+            raise SceneError(f"foundation.region: {region} does not overlap the plate's mesh")
+        return area
 
     # -- the names the contact code reads from a grid ------------------------------------
     @property

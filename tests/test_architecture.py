@@ -40,7 +40,7 @@ MAX_DOCSTRING_LINES = 60
 #: The model floor (scene to matrices) and the contact floor (the contact problem and its
 #: answer): the modules whose functions :data:`MAX_FUNCTION_LINES` holds.
 FLOORS = ("plateqp.scene", "plateqp.geometry", "plateqp.paths", "plateqp.mesh", "plateqp.trimesh",
-          "plateqp.elements", "plateqp.constraints", "plateqp.assembly", "plateqp.triassembly",
+          "plateqp.elements", "plateqp.constraints", "plateqp.assembly",
           "plateqp.contact")
 KNOWN_LONG_FUNCTIONS: set[str] = {"plateqp.scene:validate", "plateqp.contact.pipeline:solve_contact"}
 KNOWN_LONG_DOCSTRINGS: set[str] = {"plateqp.backends.pdas", "plateqp.backends.bpp", "plateqp.backends.lemke",

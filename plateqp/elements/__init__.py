@@ -2,7 +2,7 @@
 registry (the scene's choices, the mesh each element is assembled on).
 
 Every element class names its ``cell_type`` ("quad": the structured rectangle grid,
-:mod:`plateqp.assembly`; "triangle": a gmsh triangle mesh, :mod:`plateqp.triassembly`), its
+:class:`plateqp.mesh.Grid`; "triangle": a gmsh triangle mesh, :class:`plateqp.trimesh.TriMesh`), its
 ``node_dofs`` (the derivative orders (dx, dy) of w at each node, (0, 0) first, among (1, 0),
 (0, 1), (1, 1)) and ``dof_names``. A new element is its module and one line below. ACM and BFS are
 rectangles (:class:`RectElement`); DKT is a triangle (:mod:`plateqp.elements.dkt`).
