@@ -18,8 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .data import _bbox, _cell_edges, _triangulation
-from .marks import _supports_on_surface
-from .plan import _draw_outline, _draw_supports, _legend_handles, _plan_axes
+from .marks import _draw_outline, _draw_supports, _legend_handles, _plan_axes, _supports_on_surface
 from .style import (ONE_SIDED, TWO_SIDED, _fig_legend, _figure, _fmt, _lab, _levels, _name, _range,
                     _stress_unit, _symmetric_or_not, _units, _w_label)
 

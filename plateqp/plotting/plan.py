@@ -2,8 +2,8 @@
 contact, hollow lifted off, shaped and coloured by the sign of their gap), the bed's contact
 nodes, point loads, reactions and the section lines drawn on the plate.
 
-Also the axes and the outline every plan-view map shares (:func:`_plan_axes`,
-:func:`_draw_outline`; the markers are in :mod:`.marks`) and the choice of section lines (:func:`default_sections`). A result on a triangle mesh is
+The axes, outline and markers every plan-view map shares are in :mod:`.marks`; here also the
+choice of section lines (:func:`default_sections`). A result on a triangle mesh is
 drawn by :mod:`.tri`.
 """
 
@@ -13,50 +13,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .data import _bbox, _point_loads, _supports, support_spacing
+from .data import _point_loads, _supports, support_spacing
 from .marks import _draw_supports, _legend_handles, _norm_sections  # noqa: F401  (shared by the maps)
-from .style import _figure, _fmt, _frame, _lab, _units
+from .style import _figure, _fmt, _lab, _units
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
     from ..results import Result
-
-
-# -- axes and outline shared by the plan-view maps (the markers: .marks) -----------------------
-def _plan_axes(ax, result: Result, units, title: str | None = None, margin: float = 0.04):
-    """Equal-aspect axes over the plate's bounding box with a margin, labelled with ``units``."""
-    x0, x1, y0, y1 = _bbox(result)
-    m = margin * max(x1 - x0, y1 - y0)
-    _frame(ax, (x0 - m, x1 + m), (y0 - m, y1 + m), units, title)
-
-
-def _boundary_edges(mesh) -> np.ndarray:
-    """(m, 2) the sides of the cells that belong to one cell only: the plate's boundary, holes
-    and openings included, as pairs of indices into ``mesh.nodes``."""
-    c = mesh.cells
-    e = np.sort(np.vstack([c[:, [k, (k + 1) % c.shape[1]]] for k in range(c.shape[1])]), axis=1)
-    uniq, count = np.unique(e, axis=0, return_counts=True)
-    return uniq[count == 1]
-
-
-def _draw_outline(ax, result: Result, lw: float = 1.2):
-    """The plate's outline. A shaped plate: the outer boundary and the holes as polygons on its
-    own boundary points (gid "outline" and "hole", holes filled white); a grid: the boundary
-    sides of its kept cells (gid "outline"), openings included."""
-    from matplotlib.collections import LineCollection
-    from matplotlib.patches import Polygon
-
-    mesh = result.model.grid
-    if mesh.grid_shape is None:  # the boundary loops of the geometry
-        from .tri import outline_loops
-
-        for k, pts in outline_loops(mesh):
-            ax.add_patch(Polygon(pts, closed=True, fill=(k > 0), facecolor="white", edgecolor="k", lw=lw,
-                                 zorder=2, gid="outline" if k == 0 else "hole"))
-        return
-    ax.add_collection(LineCollection(mesh.nodes[_boundary_edges(mesh)], colors="k", linewidths=lw, zorder=2,
-                                     gid="outline"))
 
 
 # -- the mesh, the supports, their reactions --------------------------------------------------

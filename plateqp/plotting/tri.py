@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .data import _bbox, _supports, _triangulation
-from .plan import _draw_outline, _plan_axes
+from .marks import _draw_outline, _plan_axes
 from .style import _figure, _fmt, _units
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -30,22 +30,6 @@ if TYPE_CHECKING:  # pragma: no cover
 def on_triangles(result) -> bool:
     """Whether ``result`` lies on a triangle mesh (a shaped plate: its own plan view and sections)."""
     return getattr(getattr(result.model, "grid", None), "cell_type", None) == "triangle"
-
-
-def outline_loops(mesh) -> list[tuple[int, np.ndarray]]:
-    """The boundary as closed loops of node coordinates: [(boundary, (n, 2) points)], 0 the outer
-    boundary, k ≥ 1 hole k − 1 (the mesh's boundary nodes in order along each loop)."""
-    out = []
-    for k in np.unique(mesh.boundary):
-        e = mesh.edges[mesh.boundary == k]
-        nxt = {int(i): int(j) for i, j in e}
-        start = int(e[0, 0])
-        seq, n = [start], nxt[start]
-        while n != start and len(seq) <= len(e):
-            seq.append(n)
-            n = nxt.get(n, start)
-        out.append((int(k), mesh.nodes[seq]))
-    return out
 
 
 # -- plan view --------------------------------------------------------------------------------
