@@ -123,6 +123,11 @@ def test_the_field_figures_draw_every_mesh_and_write_files(result, tmp_path):
         path = tmp_path / f"{name}.png"
         pl.save(fig, path)
         assert path.stat().st_size > 10_000, name
+    from matplotlib.tri import TriContourSet
+
+    for name in ("contours", "s1", "difference"):  # the nodal values on the mesh's triangulation, every mesh
+        assert all(isinstance(c, TriContourSet) for c in figs[name].axes[0].collections
+                   if hasattr(c, "levels")), name
     cs = [c for c in figs["contours"].axes[0].collections if getattr(c, "filled", False)][0]
     w = np.concatenate([result.w_nodes(), two.w_nodes()])
     assert cs.levels[0] <= w.min() and cs.levels[-1] >= w.max()
