@@ -63,7 +63,8 @@ class Quantities:
     w_max: float  # max |w| over the plate
     reactions: np.ndarray  # discrete supports' reactions, scene order
     p_max: float | None  # the bed's largest pressure (None without a bed)
-    w_nodes: np.ndarray | None = None  # w at the nodes, (ny+1, nx+1)
+    #: w at the nodes on a structured grid's view, (ny+1, nx+1) NaN off the plate (None on triangles)
+    w_grid: np.ndarray | None = None
 
     @classmethod
     def of(cls, res: Result) -> Quantities:
@@ -74,8 +75,9 @@ class Quantities:
             R = np.asarray(res.reactions, dtype=float)[src == "support"]
             if sc.foundation is not None:  # pressure = k × compression of the bed
                 p = float(sc.foundation.k * np.asarray(res.compressions)[src == "bed"].max(initial=0.0))
-        w = res.w_nodes()
-        return cls(mesh_cells(sc), float(np.nanmax(np.abs(w))), R, p, w)
+        w, mesh = res.w_nodes(), res.model.grid
+        return cls(mesh_cells(sc), float(np.max(np.abs(w))), R, p,
+                   mesh.to_grid(w) if mesh.grid_shape is not None else None)
 
 
 def changes(coarse: Quantities, fine: Quantities) -> dict[str, float]:
@@ -87,10 +89,9 @@ def changes(coarse: Quantities, fine: Quantities) -> dict[str, float]:
     support's reaction relative to the largest reaction; ``bed``: of the largest bed pressure.
     """
     out = {"w": _rel(fine.w_max, coarse.w_max), "reactions": 0.0, "bed": 0.0}
-    cw, fw = coarse.w_nodes, fine.w_nodes
+    cw, fw = coarse.w_grid, fine.w_grid
     # a grid's nodes are nodes of the grid with half the cells (a triangle mesh's are not: there max |w|)
-    if cw is not None and fw is not None and cw.ndim == fw.ndim == 2 \
-            and fw.shape == (2 * cw.shape[0] - 1, 2 * cw.shape[1] - 1):
+    if cw is not None and fw is not None and fw.shape == (2 * cw.shape[0] - 1, 2 * cw.shape[1] - 1):
         d = np.abs(fw[::2, ::2] - cw)
         out["w"] = max(out["w"], float(np.nanmax(d)) / max(fine.w_max, coarse.w_max, 1e-300))
     if fine.reactions.size and coarse.reactions.size == fine.reactions.size:

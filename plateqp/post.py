@@ -10,17 +10,13 @@ face, with the angle θ1 of σ1 from the x axis:
     \sigma_{1,2} = \tfrac12(\sigma_x + \sigma_y) \pm
     \sqrt{\tfrac14(\sigma_x - \sigma_y)^2 + \tau_{xy}^2}.
 
-For the ACM element moments are discontinuous between cells (non-conforming). A nodal value
-(:class:`NodalOperator`) is the average, over the kept cells around a node, of each cell's own
-value just inside its corner at that node; NaN at nodes off the plate. The operator holds the
-interpolation at those points, built once per mesh, so that many solutions on one mesh (a
+Moments are discontinuous between cells (ACM is non-conforming; DKT's curvatures are linear
+in each triangle). A nodal value (:class:`NodalOperator`) is the average, over the cells around
+a node, of each cell's own value at its corner there. On every mesh a nodal field is a (n,)
+array, one value per node of the plate in the order of ``mesh.nodes`` (on the structured grid
+the nodes of the kept cells, in grid order; ``Grid.to_grid`` gives its (ny + 1, nx + 1) view,
+NaN off the plate). The operator is built once per mesh, so that many solutions on one mesh (a
 sweep) cost a sparse product each.
-
-On a triangle mesh (:class:`~plateqp.triassembly.TriModel`, the DKT element) :class:`TriNodalOperator`
-does the same: each triangle's own curvatures at each of its three vertices (DKT's linear
-curvature field, :meth:`~plateqp.elements.dkt.DKT.curvature_matrix`), averaged over the triangles
-around each node; w is the node's own dof. Values come as (n_nodes,) arrays in the mesh's node
-order, every node on the plate.
 """
 
 from __future__ import annotations
@@ -78,48 +74,63 @@ def from_curvatures(plate, quantity: str, kxx, kyy, kxy) -> np.ndarray:
     raise ValueError(f"{quantity!r} is not recovered from the curvatures")
 
 
-#: The cell corners in the order of Grid.cell_nodes, in cell coordinates.
+#: The corners of a quad cell in the order of Grid.cell_nodes, in cell coordinates.
 _CORNERS = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
 
 
 class NodalOperator:
-    """Nodal averages of the fields of one mesh.
+    """Nodal averages of the fields of one mesh (the structured grid or a triangle mesh).
 
-    Each kept cell is evaluated just inside (1e-9 of a cell) each of its four corners, so
-    that it contributes its own value, and the values at a node are averaged over the kept
-    cells around it. The interpolation operators at those points are built on first use
-    (for w, and stacked for w,xx, w,yy, w,xy) and kept. Valid for every model that shares
-    the grid, element and kept cells of ``model`` (an adapted model of a sweep).
+    Every cell gives its own value at each of its corners, and a node's value is the plain
+    mean over the cells that hold it. Values come as (n,) arrays, one per node of the plate in
+    the order of ``mesh.nodes``. The operator from the full dofs to the cells' corner
+    curvatures (w,xx, w,yy, w,xy) is built on first use and kept, so that many solutions on
+    one mesh (a sweep) cost a sparse product each. Valid for every model that shares the mesh,
+    element and kept cells of ``model`` (an adapted model of a sweep).
+
+    How a cell gives its corner values depends only on its element: a quad (ACM, BFS) is
+    evaluated just inside (1e-9 of a cell) each corner through the model's interpolation, w
+    included; a triangle (DKT) gives its linear curvature field at its vertices
+    (:meth:`~plateqp.elements.dkt.DKT.curvature_matrix`), and w is the node's own dof.
 
     Parameters
     ----------
-    model : :class:`~plateqp.assembly.Model`
+    model : :class:`~plateqp.assembly.Model` or :class:`~plateqp.triassembly.TriModel`
     """
 
     def __init__(self, model) -> None:
-        g, cells = model.grid, model.cells
+        mesh = model.grid
         self.model = model
-        self.shape = (g.ny + 1, g.nx + 1)
-        self.nc = cells.size
-        cn = g.cell_nodes()[cells]
-        x0 = (cells % g.nx) * g.hx
-        y0 = (cells // g.nx) * g.hy
-        self._points = []
-        for cx, cy in _CORNERS:
-            xi = 1e-9 + (1 - 2e-9) * cx  # just inside the cell
-            eta = 1e-9 + (1 - 2e-9) * cy
-            self._points.append((x0 + xi * g.hx, y0 + eta * g.hy))
-        # averaging: (n_nodes, 4 nc) with 1/count at (node, its corner point), corners stacked
-        nodes = cn.T.ravel()  # corner 0 of every cell, then corner 1, ...
-        cnt = np.bincount(nodes, minlength=g.n_nodes).astype(float)
-        self._on = cnt > 0
-        A = sp.csr_matrix((np.ones(nodes.size), (nodes, np.arange(nodes.size))), shape=(g.n_nodes, nodes.size))
-        self._average = sp.diags(np.where(self._on, 1.0 / np.where(self._on, cnt, 1.0), 0.0)) @ A
+        self.n_nodes = len(mesh.plate_node_ids)
+        self._ids = mesh.plate_node_ids
+        self._nd = model.element.ndof_node
+        cells = mesh.cells
         self._w = None
         self._curv = None
+        self._points = None
+        if mesh.cell_type == "triangle":
+            self._curv = _triangle_vertex_curvatures(model)
+            corner_nodes = cells.ravel()  # vertex v of triangle k at 3 k + v, as its rows
+        else:
+            x0 = (model.cells % mesh.nx) * mesh.hx
+            y0 = (model.cells // mesh.nx) * mesh.hy
+            self._points = [(x0 + (1e-9 + (1 - 2e-9) * cx) * mesh.hx, y0 + (1e-9 + (1 - 2e-9) * cy) * mesh.hy)
+                            for cx, cy in _CORNERS]  # just inside each corner of each cell
+            corner_nodes = cells.T.ravel()  # corner 0 of every cell, then corner 1, ...
+        # averaging: (n, n_corners) with 1/count at (node, each of its corners)
+        cnt = np.bincount(corner_nodes, minlength=self.n_nodes).astype(float)
+        self._on = cnt > 0
+        A = sp.csr_matrix((np.ones(corner_nodes.size), (corner_nodes, np.arange(corner_nodes.size))),
+                          shape=(self.n_nodes, corner_nodes.size))
+        self._average = sp.diags(np.where(self._on, 1.0 / np.where(self._on, cnt, 1.0), 0.0)) @ A
+
+    @property
+    def shape(self) -> tuple[int]:
+        """(n,): one value per node of the plate."""
+        return (self.n_nodes,)
 
     def _op(self, orders) -> sp.csr_matrix:
-        """The corner points' interpolation (w and its derivatives ``orders``), stacked as
+        """The quad corner points' interpolation (w and its derivatives ``orders``), stacked as
         [order 0: corners 0..3; order 1: corners 0..3; ...], from the full dofs."""
         m = self.model
         return sp.vstack([m.interpolation(x, y, dx, dy) for dx, dy in orders for x, y in self._points],
@@ -128,13 +139,15 @@ class NodalOperator:
     def _averaged(self, values: np.ndarray) -> np.ndarray:
         out = self._average @ values
         out[~self._on] = np.nan
-        return out.reshape(self.shape)
+        return out
 
     def __call__(self, u: np.ndarray, plate, quantity: str = "w") -> np.ndarray:
-        """(ny+1, nx+1) nodal values of ``quantity`` (one of :data:`QUANTITIES`) of the full
-        dof vector ``u`` of a plate (``plate``: its :class:`~plateqp.scene.Plate`)."""
+        """(n,) nodal values of ``quantity`` (one of :data:`QUANTITIES`) of the full dof vector
+        ``u`` of a plate (``plate``: its :class:`~plateqp.scene.Plate`), in ``mesh.nodes`` order."""
         check_quantity(quantity)
         if quantity == "w":
+            if self._points is None:  # a triangle's w at its vertex is the node's own dof
+                return nodal_w(self.model, u)
             if self._w is None:
                 self._w = self._op(((0, 0),))
             return self._averaged(self._w @ u)
@@ -144,70 +157,33 @@ class NodalOperator:
         return self._averaged(from_curvatures(plate, quantity, kxx, kyy, kxy))
 
 
-class TriNodalOperator:
-    """Nodal averages of the fields of one triangle mesh (the triangle analogue of :class:`NodalOperator`).
-
-    Each triangle's curvatures (w,xx, w,yy, w,xy) at its three vertices are taken from the
-    element (its own value there, not a neighbour's), the fields recovered from them, and each
-    node's value is the plain mean over the triangles that hold it. The operator from the full
-    dofs to those 3 × n_triangles vertex curvatures is built once. Valid for every model on the
-    same mesh.
-
-    Parameters
-    ----------
-    model : :class:`~plateqp.triassembly.TriModel`
-    """
-
-    def __init__(self, model) -> None:
-        mesh = model.grid
-        self.model = model
-        t = mesh.triangles
-        nt, n = len(t), mesh.n_nodes
-        self.n_nodes = n
-        xy = mesh.nodes[t]
-        B = model.element.curvature_matrix(xy, np.eye(3))  # (nt, 3 vertices, 3 curvatures, 9)
-        B = B.copy()
-        B[..., 2, :] *= 0.5  # κ3 = 2 w,xy -> w,xy
-        # rows: curvature c of vertex v of triangle k at c * (3 nt) + 3 k + v
-        rows = (np.arange(3)[None, None, :, None] * 3 * nt + 3 * np.arange(nt)[:, None, None, None]
-                + np.arange(3)[None, :, None, None])
-        rows = np.broadcast_to(rows, B.shape)
-        cols = np.broadcast_to(model.cell_dofs[:, None, None, :], B.shape)
-        self._curv = sp.csr_matrix((B.ravel(), (rows.ravel(), cols.ravel())), shape=(9 * nt, model.n_full))
-        nodes = t.ravel()  # vertex v of triangle k at 3 k + v, as the rows above
-        cnt = np.bincount(nodes, minlength=n).astype(float)
-        self._on = cnt > 0
-        A = sp.csr_matrix((np.ones(nodes.size), (nodes, np.arange(nodes.size))), shape=(n, nodes.size))
-        self._average = sp.diags(np.where(self._on, 1.0 / np.where(self._on, cnt, 1.0), 0.0)) @ A
-        self._nd = model.element.ndof_node
-
-    def __call__(self, u: np.ndarray, plate, quantity: str = "w") -> np.ndarray:
-        """(n_nodes,) nodal values of ``quantity`` (one of :data:`QUANTITIES`) of the full dof
-        vector ``u`` of a plate (``plate``: its :class:`~plateqp.scene.Plate`)."""
-        check_quantity(quantity)
-        if quantity == "w":
-            return np.asarray(u[0::self._nd][: self.n_nodes], dtype=float).copy()
-        kxx, kyy, kxy = (self._curv @ u).reshape(3, -1)
-        out = self._average @ from_curvatures(plate, quantity, kxx, kyy, kxy)
-        out[~self._on] = np.nan
-        return out
+def _triangle_vertex_curvatures(model) -> sp.csr_matrix:
+    """(9 nt, n_full): the curvatures (w,xx, w,yy, w,xy) of each triangle at each of its
+    vertices, row c · (3 nt) + 3 k + v for curvature c of vertex v of triangle k."""
+    t = model.grid.cells
+    nt = len(t)
+    B = model.element.curvature_matrix(model.grid.nodes[t], np.eye(3)).copy()  # (nt, 3, 3, 9)
+    B[..., 2, :] *= 0.5  # κ3 = 2 w,xy -> w,xy
+    rows = (np.arange(3)[None, None, :, None] * 3 * nt + 3 * np.arange(nt)[:, None, None, None]
+            + np.arange(3)[None, :, None, None])
+    rows = np.broadcast_to(rows, B.shape)
+    cols = np.broadcast_to(model.cell_dofs[:, None, None, :], B.shape)
+    return sp.csr_matrix((B.ravel(), (rows.ravel(), cols.ravel())), shape=(9 * nt, model.n_full))
 
 
-def nodal_operator(model):
-    """The nodal-average operator of ``model``: :class:`TriNodalOperator` on a triangle mesh,
-    :class:`NodalOperator` on the structured grid."""
-    from .trimesh import TriMesh
+#: The former name of :class:`NodalOperator` on a triangle mesh (the same class).
+TriNodalOperator = NodalOperator
 
-    return TriNodalOperator(model) if isinstance(model.grid, TriMesh) else NodalOperator(model)
+
+def nodal_operator(model) -> NodalOperator:
+    """The nodal-average operator of ``model`` (any mesh): :class:`NodalOperator`."""
+    return NodalOperator(model)
 
 
 def nodal_w(model, u: np.ndarray) -> np.ndarray:
-    """w at every plate node from the nodal dofs (NaN off the plate), shape (ny+1, nx+1)."""
-    g = model.grid
-    nd = model.element.ndof_node
-    w = u[0::nd][: g.n_nodes].astype(float).copy()
-    w[~g.node_mask()] = np.nan
-    return w.reshape(g.ny + 1, g.nx + 1)
+    """(n,) w at the plate's nodes (``mesh.nodes`` order): each node's own dof."""
+    ids = model.grid.plate_node_ids
+    return np.asarray(u, dtype=float)[ids * model.element.ndof_node].copy()
 
 
 __all__ = ["CURVATURE_QUANTITIES", "NodalOperator", "QUANTITIES", "TriNodalOperator", "check_quantity",

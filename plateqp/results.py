@@ -7,7 +7,8 @@ Principal stresses σ1 ≥ σ2 of the bottom face, with the angle of σ1 from th
 
 For the ACM element moments are discontinuous between cells (non-conforming); values at a
 point on a cell boundary come from one neighbour, and :meth:`Result.nodal` averages the
-cells around each node for smooth plots.
+cells around each node for smooth plots. Nodal fields are (n,) arrays on every mesh, one value
+per node of the plate in the order of ``model.grid.nodes``.
 """
 
 from __future__ import annotations
@@ -158,25 +159,23 @@ class Result:
         return table[quantity]()
 
     def nodal(self, quantity: str = "w") -> np.ndarray:
-        """(ny+1, nx+1) smoothed nodal values (average over the kept cells at each node; NaN off
-        the plate): :class:`plateqp.post.NodalOperator`; on a triangle mesh (n_nodes,), averaged
-        over the triangles at each node: :class:`plateqp.post.TriNodalOperator`. ``quantity`` as
-        for :meth:`section`."""
+        """(n,) smoothed nodal values, one per node of the plate in ``mesh.nodes`` order, on
+        every mesh: each cell's own value at its corner, averaged over the cells around the node
+        (:class:`plateqp.post.NodalOperator`). On the structured grid ``model.grid.to_grid``
+        gives the (ny+1, nx+1) view (NaN off the plate), and :meth:`to_xarray` the same on x, y.
+        ``quantity`` as for :meth:`section`."""
         return post.nodal_operator(self.model)(self.u, self.scene.plate, quantity)
 
     # -- summaries --------------------------------------------------------------------------
     def w_nodes(self) -> np.ndarray:
-        """w at every plate node (NaN off the plate), shape (ny+1, nx+1); on triangles (n_nodes,)."""
-        if self.scene.triangles:  # the mesh's nodes carry w as their first dof
-            return self.u[0::self.model.element.ndof_node].copy()
+        """(n,) w at the nodes of the plate (``mesh.nodes`` order): each node's own dof."""
         return post.nodal_w(self.model, self.u)
 
     def w_max(self) -> tuple[float, float, float]:
         """(w, x, y) of the node with the largest |w|."""
-        g = self.model.grid
-        w = self.w_nodes().ravel()
-        k = int(np.nanargmax(np.abs(w)))
-        x, y = g.node_xy()[k]
+        w = self.w_nodes()
+        k = int(np.argmax(np.abs(w)))
+        x, y = self.model.grid.nodes[k]
         return float(w[k]), float(x), float(y)
 
     @property
@@ -214,11 +213,12 @@ class Result:
         return d
 
     # -- in the tools users already use (plateqp.io.fields, plateqp.io.vtk) -----------------------
-    def to_xarray(self, quantities=post.QUANTITIES):
-        """The nodal fields (w, moments, stresses, σ1, σ2) as an :class:`xarray.Dataset` on the
-        node coordinates, NaN off the plate: :func:`plateqp.io.fields.to_xarray`."""
+    def to_xarray(self, quantities=post.QUANTITIES, *, nodes: bool = False):
+        """The nodal fields (w, moments, stresses, σ1, σ2) as an :class:`xarray.Dataset`: on the
+        structured grid its grid view on ``x``, ``y`` (NaN off the plate), on a triangle mesh (or
+        with ``nodes=True`` on any mesh) on a ``node`` dimension: :func:`plateqp.io.fields.to_xarray`."""
         from .io.fields import to_xarray
-        return to_xarray(self, quantities)
+        return to_xarray(self, quantities, nodes=nodes)
 
     @property
     def supports(self):

@@ -79,7 +79,7 @@ def test_zones_by_nearest_support():
     sc = pq.Scene(**{f.name: getattr(sc, f.name) for f in dataclasses.fields(sc) if f.init})
     res = pq.solve(sc)
     res = dataclasses.replace(res, active=np.array([True, False, False, False]))
-    z = demo.zones(res)  # nodes at 0, 0.25, ..., 1 in each direction; z[j, i] at (x_i, y_j)
+    z = res.model.grid.to_grid(demo.zones(res))  # nodes at 0, 0.25, ..., 1; z[j, i] at (x_i, y_j)
     assert (z == 1).sum() == 4 and (z[:2, :2] == 1).all()
     # on x = 0.5 or y = 0.5 up to the centre: equidistant from (0, 0) and a lifted support
     assert (z[2, :3] == 0).all() and (z[:3, 2] == 0).all() and (z == 0).sum() == 5

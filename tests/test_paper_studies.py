@@ -197,9 +197,8 @@ def test_sections_2_and_4_normalisation():
     one, two = pq.solve(sc, accuracy="high"), pq.solve_bilateral(sc)
     c = demo.compare(one, two)
     # sections 2 and 4 are the rows y = 200 and y = 600; recompute on those nodes by hand
-    g = one.model.grid
-    nodes = g.node_xy().reshape(g.ny + 1, g.nx + 1, 2)
-    on = np.isin(np.round(nodes[..., 1], 9), [200.0, 600.0])
+    nodes = one.model.grid.nodes  # one row per node of the plate, as the nodal fields
+    on = np.isin(np.round(nodes[:, 1], 9), [200.0, 600.0])
     sel = on & (demo.zones(one) == 1)
     w1, w2 = one.w_nodes(), two.w_nodes()
     dw = np.abs(w1 - w2)[sel].max()
@@ -218,8 +217,8 @@ def test_sigma1_at_a_fixed_distance_converges_where_the_peak_does_not():
         one, two = pq.solve(sc, accuracy="high"), pq.solve_bilateral(sc)
         c = demo.compare(one, two)
         # the four points (x ± r, y), (x, y ± r) are mesh nodes here: the mean of their nodal σ1
-        S = one.nodal("s1")
         g = one.model.grid
+        S = g.to_grid(one.nodal("s1"))  # the grid view: S[j, i] at (i hx, j hy)
         r = c.s1_ring_radius
         pts = [(300 + r, 500), (300 - r, 500), (300, 500 + r), (300, 500 - r)]
         direct = np.mean([S[int(round(y / g.hy)), int(round(x / g.hx))] for x, y in pts])

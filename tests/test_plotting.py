@@ -60,7 +60,7 @@ FIGURES = {
     "mesh": lambda one, two, u: pl.plot_mesh(one, u, sections=pl.default_sections(one)),
     "sections": lambda one, two, u: pl.plot_sections(one, two, [((0, 0.5), (1, 0.5)), ("diag", (0, 0), (1, 1))], u),
     "sigma1": lambda one, two, u: pl.plot_principal_stress(one, two, u),
-    "difference": lambda one, two, u: pl.plot_difference(one, two, u, zones=np.zeros((7, 7), dtype=int)),
+    "difference": lambda one, two, u: pl.plot_difference(one, two, u, zones=np.zeros(len(one.model.grid.nodes), dtype=int)),
     "reactions": lambda one, two, u: pl.plot_reactions(one, two, u),
 }
 

@@ -13,7 +13,7 @@ import pytest
 
 import plateqp as pq
 from plateqp.assembly import build_model
-from plateqp.post import TriNodalOperator, moments
+from plateqp.post import NodalOperator, moments
 
 pytest.importorskip("gmsh")
 
@@ -73,7 +73,7 @@ def test_constant_curvature_patch_gives_exact_nodal_moments():
     u[0::3] = 0.5 * (A * x**2 + B * y**2) + C * x * y
     u[1::3] = A * x + C * y
     u[2::3] = B * y + C * x
-    op = TriNodalOperator(model)
+    op = NodalOperator(model)
     for q, want in zip(("Mx", "My", "Mxy"), moments(sc.plate, A, B, C)):
         np.testing.assert_allclose(op(u, sc.plate, q), want, rtol=1e-9, atol=1e-12)
 

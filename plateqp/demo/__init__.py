@@ -45,8 +45,8 @@ solution, and the relative difference (σ1_one −
 nodal σ1 within max(half the support spacing, two mesh cells) of the load) but is not compared.
 
 Scenes on a triangle mesh (``mesh.element = "dkt"``, a shaped plate such as the built-in
-"tank") get the one-sided and two-sided solves and every figure (drawn by
-:mod:`plateqp.plotting.tri`); the parts measured on the structured grid are skipped, each with
+"tank") get the one-sided and two-sided solves and every figure (the field maps and the zones are
+the same for every mesh); the parts measured on the structured grid are skipped, each with
 its reason in :attr:`SceneRun.skipped` (printed, in the JSON file and in the report): the
 paper's statements (:func:`compare`: zones, sections 2 and 4 and the ring around the load
 read the grid's rows of nodes) and the convergence study by mesh halving (the studies halve
@@ -107,29 +107,29 @@ def scene_notes(name: str) -> tuple[str, tuple[str, str] | None]:
 
 # -- the paper's statements ---------------------------------------------------------------------
 def zones(result) -> np.ndarray:
-    """Per plate node, (ny+1, nx+1): +1 contact zone, −1 lift-off zone, 0 neither (see module doc)."""
+    """Per node of the plate (``mesh.nodes`` order, on every mesh): +1 contact zone, −1 lift-off
+    zone, 0 neither (see module doc)."""
     sc = result.scene
-    g = result.model.grid
+    nodes = result.model.grid.nodes
     n = len(sc.supports)
-    out = np.zeros((g.ny + 1, g.nx + 1), dtype=int)
+    out = np.zeros(len(nodes), dtype=int)
     if n == 0 or result.active.size < n:
         return out
     xy = np.array([[s.x, s.y] for s in sc.supports], dtype=float)
     active = np.asarray(result.active[:n], dtype=bool)
+    span = float(np.ptp(nodes, axis=0).max())
     spacing = support_spacing(xy)
     if not math.isfinite(spacing):
-        spacing = max(g.a, g.b)
-    nodes = g.node_xy()
+        spacing = span
     d = np.hypot(nodes[:, None, 0] - xy[None, :, 0], nodes[:, None, 1] - xy[None, :, 1])
     dmin = d.min(axis=1)
-    tol = 1e-9 * max(g.a, g.b)
+    tol = 1e-9 * span
     nearest = d <= dmin[:, None] + tol
     all_on = np.all(~nearest | active[None, :], axis=1)
     all_off = np.all(~nearest | ~active[None, :], axis=1)
     z = np.where(all_on, 1, np.where(all_off, -1, 0))
     z[dmin > spacing + tol] = 0
-    z[~g.node_mask()] = 0
-    return z.reshape(g.ny + 1, g.nx + 1)
+    return z
 
 
 @dataclass
@@ -216,14 +216,13 @@ def compare(one, two, radius: float | None = None) -> Comparison:
     n = len(sc.supports)
     xy = np.array([[s.x, s.y] for s in sc.supports], dtype=float).reshape(n, 2)
     spacing = support_spacing(xy)
-    w1, w2 = one.w_nodes(), two.w_nodes()
-    on_plate = np.isfinite(w1) & np.isfinite(w2)
-    dw = np.where(on_plate, np.abs(w1 - w2), 0.0)
-    w_ref = float(max(np.abs(w1[on_plate]).max(initial=0.0), np.abs(w2[on_plate]).max(initial=0.0)))
+    w1, w2 = one.w_nodes(), two.w_nodes()  # one value per node of the plate
+    dw = np.abs(w1 - w2)
+    w_ref = float(max(np.abs(w1).max(initial=0.0), np.abs(w2).max(initial=0.0)))
     z = zones(one)
 
     def zone(val):
-        sel = (z == val) & on_plate
+        sel = z == val
         if not sel.any():
             return 0, float("nan"), float("nan")
         m = float(dw[sel].max())
@@ -238,14 +237,13 @@ def compare(one, two, radius: float | None = None) -> Comparison:
     s1_one = s1_two = s1_rel = float("nan")
     if pl:
         ld = max(pl, key=lambda p: abs(p.P))
-        nodes = g.node_xy()
-        near = (np.hypot(nodes[:, 0] - ld.x, nodes[:, 1] - ld.y) <= r * (1 + 1e-9)).reshape(g.ny + 1, g.nx + 1)
+        nodes = g.nodes
+        near = np.hypot(nodes[:, 0] - ld.x, nodes[:, 1] - ld.y) <= r * (1 + 1e-9)
         S1, S2 = one.nodal("s1"), two.nodal("s1")
-        near &= np.isfinite(S1) & np.isfinite(S2)
         if near.any():
             s1_one, s1_two = float(S1[near].max()), float(S2[near].max())
             s1_rel = (s1_one - s1_two) / abs(s1_two) if s1_two != 0 else (0.0 if s1_one == 0 else float("inf"))
-    sec = _sections_24(one, w1, w2, z, on_plate, w_ref)
+    sec = _sections_24(one, w1, w2, z, w_ref)
     ring = {}
     if pl:
         r_ring = 0.5 * spacing if math.isfinite(spacing) else 2.0 * h
@@ -263,16 +261,15 @@ def compare(one, two, radius: float | None = None) -> Comparison:
         min_R_two=float(R2.min()) if R2.size else float("nan"), **sec, **ring)
 
 
-def _sections_24(one, w1, w2, z, on_plate, w_ref) -> dict:
+def _sections_24(one, w1, w2, z, w_ref) -> dict:
     """Contact-zone nodes on the figures' sections 2 and 4 and their deflection differences."""
     from ..plotting.plan import default_sections
 
     secs = default_sections(one)
     if len(secs) < 4:
         return {}
-    g = one.model.grid
-    nodes = g.node_xy()
-    tol = 1e-9 * max(g.a, g.b)
+    nodes = one.model.grid.nodes
+    tol = 1e-9 * float(np.ptp(nodes, axis=0).max())
     on_line = np.zeros(nodes.shape[0], dtype=bool)
     for _lab, p0, p1 in (secs[1], secs[3]):
         d = np.array(p1) - np.array(p0)
@@ -281,7 +278,6 @@ def _sections_24(one, w1, w2, z, on_plate, w_ref) -> dict:
         t = rel @ d / length**2
         off = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0]) / length
         on_line |= (off <= tol) & (t >= -1e-9) & (t <= 1 + 1e-9)
-    on_line = on_line.reshape(z.shape) & on_plate
     sel = on_line & (z == 1)
     if not sel.any():
         return {}
@@ -302,7 +298,7 @@ def _ring_mean(res, x0: float, y0: float, r: float, k: int = 4) -> float:
     from scipy.interpolate import RegularGridInterpolator
 
     g = res.model.grid
-    S = res.nodal("s1")
+    S = g.to_grid(res.nodal("s1"))  # the structured grid's view, NaN off the plate
     f = RegularGridInterpolator((np.linspace(0.0, g.b, g.ny + 1), np.linspace(0.0, g.a, g.nx + 1)), S,
                                 bounds_error=False, fill_value=np.nan)
     t = 2 * np.pi * np.arange(k) / k
@@ -387,7 +383,7 @@ def run_scene(name: str, figures: bool = True) -> SceneRun:
             put("mesh", f"The {mesh} and the supports: filled where in contact, hollow where lifted off; "
                 "heaved ▲ / settled ▼; reactions of the supports in contact; the numbered section lines.",
                 lambda: pl.plot_mesh(one, units, sections=secs))
-            put("surface", "Axonometric view of the deflection: one-sided coloured, two-sided wire frame "
+            put("surface", "Axonometric view of the deflection: one-sided coloured, two-sided the cells' edges "
                 "(w positive down, drawn downward).", lambda: pl.plot_deflection_surface(one, two, units))
             put("contours", "Contour lines of w: one-sided (left) and two-sided (right), on the same levels.",
                 lambda: pl.plot_deflection_contours(one, two, units))
@@ -401,12 +397,9 @@ def run_scene(name: str, figures: bool = True) -> SceneRun:
             put("contours", "Contour lines of w.", lambda: pl.plot_deflection_contours(one, None, units))
             put("sections", "Deflection along the sections drawn on the mesh.",
                 lambda: pl.plot_sections(one, None, secs, units))
-        if two is not None and triangles:
-            put("difference", "One-sided minus two-sided deflection at the mesh's nodes.",
-                lambda: pl.plot_difference(one, two, units))
-        elif two is not None:
+        if two is not None:
             put("difference", "One-sided minus two-sided deflection, with the nodes of the contact zone (green) "
-                "and of the lift-off zone (orange) used in the statements above.",
+                "and of the lift-off zone (orange)" + (" used in the statements above." if comp is not None else "."),
                 lambda: pl.plot_difference(one, two, units, zones=zones(one)))
         put("sigma1", "Principal stress σ1 on the bottom face" + (": one-sided (left) and two-sided (right), "
             "same colour scale." if two is not None else "."), lambda: pl.plot_principal_stress(one, two, units))

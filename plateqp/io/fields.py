@@ -1,19 +1,20 @@
 """A solved plate as the tables and arrays users already work with: xarray and pandas.
 
 :func:`node_fields` gives every named field (:data:`plateqp.post.QUANTITIES`) at the plate's
-nodes; :func:`to_xarray` wraps them in an :class:`xarray.Dataset` on the node coordinates
-(``y``, ``x``), NaN off the plate; :func:`supports_frame` is one row per one-sided contact
+nodes, (n,) arrays in ``mesh.nodes`` order on every mesh; :func:`to_xarray` wraps them in an
+:class:`xarray.Dataset`; :func:`supports_frame` is one row per one-sided contact
 point (discrete supports in scene order, 1-based as in the figures, then bed nodes) as a
 :class:`pandas.DataFrame`. The library imports neither package until one of these is called.
 
 Units are the scene's own consistent units (plateqp has no unit system): a length L, a force
 F; the attributes of each variable say which.
 
-On a triangle mesh (``mesh.element = "dkt"``) the fields are (n_nodes,) arrays on the mesh's
-nodes (every node on the plate; moments averaged over the triangles around a node,
-:class:`plateqp.post.TriNodalOperator`), and :func:`to_xarray` puts them on a ``node``
-dimension with ``x`` and ``y`` coordinates and the triangles as the variable ``triangles``
-(``triangle`` × ``vertex``, 0-based node indices, counter-clockwise).
+The dataset's layout: on the structured grid the grid view, dimensions ``y`` and ``x`` (the
+node coordinates), NaN at nodes off the plate, so that ``ds["w"].sel(x=..., y=...)`` reads a
+node; on a triangle mesh (``mesh.element = "dkt"``), or on any mesh with ``nodes=True``, a
+``node`` dimension (one entry per node of the plate, ``mesh.nodes`` order) with ``x`` and ``y``
+coordinates and the cells as the variable ``triangles`` (``triangle`` × ``vertex``) or
+``quads`` (``quad`` × ``vertex``): 0-based node indices, counter-clockwise.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import PlateQPError
-from ..post import QUANTITIES, NodalOperator, TriNodalOperator, nodal_w
+from ..post import QUANTITIES, NodalOperator, nodal_w
 
 #: (long name, units in the scene's length L and force F) of each nodal field.
 FIELD_ATTRS = {
@@ -44,60 +45,44 @@ def _optional(name: str, extra: str = "results"):
         raise PlateQPError(f"{name} is not installed: pip install 'plateqp[{extra}]'") from None
 
 
-def _grid(result):
-    grid = getattr(result.model, "grid", None)
-    if grid is None or not hasattr(grid, "node_xy"):
-        raise PlateQPError("nodal fields are available on the structured grid only (not yet on triangle meshes)")
-    return grid
-
-
-def on_triangles(result) -> bool:
-    """Whether ``result`` is on a triangle mesh (a :class:`~plateqp.triassembly.TriModel`)."""
-    from ..trimesh import TriMesh
-
-    return isinstance(getattr(result.model, "grid", None), TriMesh)
-
-
 def node_fields(result, quantities=QUANTITIES) -> dict[str, np.ndarray]:
-    """Each field of ``quantities`` at the nodes: (ny+1, nx+1) arrays, NaN off the plate; w is
-    the nodal dof itself, the others are averaged over the kept cells around a node
-    (:class:`plateqp.post.NodalOperator`). On a triangle mesh (n_nodes,) arrays
-    (:class:`plateqp.post.TriNodalOperator`)."""
-    if on_triangles(result):
-        top = TriNodalOperator(result.model)
-        return {q: top(result.u, result.scene.plate, q) for q in quantities}
-    _grid(result)
+    """Each field of ``quantities`` at the plate's nodes: (n,) arrays in ``mesh.nodes`` order
+    on every mesh; w is the nodal dof itself, the others are averaged over the cells around a
+    node (:class:`plateqp.post.NodalOperator`)."""
     op = NodalOperator(result.model)
     return {q: nodal_w(result.model, result.u) if q == "w" else op(result.u, result.scene.plate, q)
             for q in quantities}
 
 
-def to_xarray(result, quantities=QUANTITIES):
+def to_xarray(result, quantities=QUANTITIES, *, nodes: bool = False):
     """The nodal fields of a result as an :class:`xarray.Dataset`.
 
-    Dimensions ``y`` and ``x`` (the node coordinates), one variable per field of
-    ``quantities`` with ``long_name`` and ``units`` attributes; the dataset's attributes name
-    the scene, backend, formulation, status and the plate's E, ν, h. NaN off the plate.
-    On a triangle mesh: dimension ``node`` with coordinates ``x``, ``y``, and ``triangles``
-    (``triangle`` × ``vertex``) among the variables (see the module docstring).
+    One variable per field of ``quantities`` with ``long_name`` and ``units`` attributes; the
+    dataset's attributes name the scene, backend, formulation, status and the plate's E, ν, h.
+    On the structured grid: dimensions ``y`` and ``x`` (the grid view, NaN off the plate, equal
+    to ``model.grid.to_grid`` of each nodal field). On a triangle mesh, or with ``nodes=True``
+    on any mesh: dimension ``node`` (``mesh.nodes`` order, the values of
+    :meth:`~plateqp.results.Result.nodal`) with coordinates ``x``, ``y``, and the cells among
+    the variables (see the module docstring).
     """
     xr = _optional("xarray")
     fields = node_fields(result, quantities)
-    if on_triangles(result):
-        mesh = result.model.grid
+    mesh = result.model.grid
+    if nodes or mesh.grid_shape is None:
         dims = ("node",)
         coords = {"x": ("node", mesh.nodes[:, 0].copy(), {"units": "L"}),
                   "y": ("node", mesh.nodes[:, 1].copy(), {"units": "L"})}
     else:
-        g = _grid(result)
         dims = ("y", "x")
-        coords = {"x": ("x", np.arange(g.nx + 1) * g.hx, {"units": "L"}),
-                  "y": ("y", np.arange(g.ny + 1) * g.hy, {"units": "L"})}
+        coords = {"x": ("x", np.arange(mesh.nx + 1) * mesh.hx, {"units": "L"}),
+                  "y": ("y", np.arange(mesh.ny + 1) * mesh.hy, {"units": "L"})}
+        fields = {q: mesh.to_grid(v) for q, v in fields.items()}
     data = {q: (dims, v, {"long_name": FIELD_ATTRS[q][0], "units": FIELD_ATTRS[q][1]})
             for q, v in fields.items()}
-    if on_triangles(result):
-        data["triangles"] = (("triangle", "vertex"), result.model.grid.triangles.astype(np.int64),
-                             {"long_name": "the mesh's triangles: 0-based node indices, counter-clockwise"})
+    if dims == ("node",):
+        kind = mesh.cell_type
+        data[f"{kind}s"] = ((kind, "vertex"), mesh.cells.astype(np.int64),
+                            {"long_name": f"the mesh's {kind}s: 0-based node indices, counter-clockwise"})
     plate = result.scene.plate
     attrs = {"scene": str(result.scene.name), "backend": str(result.backend),
              "formulation": str(result.formulation), "status": result.status.value,

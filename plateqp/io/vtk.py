@@ -2,7 +2,8 @@
 
 :func:`write_vtu` writes two VTK unstructured-grid files:
 
-- ``<stem>.vtu``: the plate's kept cells (quads; on a triangle mesh its triangles) on its nodes, z = 0, with the nodal fields
+- ``<stem>.vtu``: the plate's cells (``mesh.cells``: the kept quads of the structured grid, or the
+  triangles of a triangle mesh) on its nodes (``mesh.nodes``), z = 0, with the nodal fields
   (:data:`plateqp.post.QUANTITIES`: w, moments, surface stresses, σ1, σ2; averaged over the
   cells around a node) and ``displacement`` = (0, 0, −w) for ParaView's "Warp By Vector" (w is
   positive downward, z up); for a tensionless bed also the bed's ``reaction`` and ``contact``
@@ -22,7 +23,7 @@ import numpy as np
 
 from ..errors import ExportError
 from .files import safe_filename
-from .fields import _grid, _optional, node_fields, on_triangles, supports_columns
+from .fields import _optional, node_fields, supports_columns
 
 
 def vtu_files(stem: str, result=None) -> list[str]:
@@ -43,31 +44,22 @@ def plate_mesh(result):
     """The meshio Mesh of the plate (see the module docstring)."""
     meshio = _optional("meshio")
     model = result.model
-    if on_triangles(result):
-        g = model.grid
-        keep = np.ones(g.n_nodes, dtype=bool)
-        cells = ("triangle", g.triangles.astype(np.int64))
-    else:
-        g = _grid(result)
-        keep = g.node_mask()
-    new = np.full(g.n_nodes, -1, dtype=np.int64)
-    new[keep] = np.arange(int(keep.sum()))
-    xy = g.node_xy()[keep]
+    mesh = model.grid
+    xy = mesh.nodes
     points = np.column_stack([xy, np.zeros(len(xy))])
-    if not on_triangles(result):
-        cells = ("quad", new[g.cell_nodes()[model.cells]])
-    data = {q: v.ravel()[keep] for q, v in node_fields(result).items()}
+    cells = (mesh.cell_type, mesh.cells.astype(np.int64))
+    data = node_fields(result)
     data["displacement"] = np.column_stack([np.zeros(len(xy)), np.zeros(len(xy)), -data["w"]])
     c = model.contacts
     if c is not None and np.any(np.asarray(c.source) == "bed"):
         bed = np.asarray(c.source) == "bed"
-        nodes = np.asarray(c.index)[bed].astype(np.int64)
-        react = np.full(g.n_nodes, np.nan)
-        contact = np.full(g.n_nodes, np.nan)
+        nodes = np.asarray(c.index)[bed].astype(np.int64)  # the bed's nodes, numbered as the dofs
+        react = np.full(mesh.n_nodes, np.nan)
+        contact = np.full(mesh.n_nodes, np.nan)
         react[nodes] = np.asarray(result.reactions, dtype=float)[bed]
         contact[nodes] = np.asarray(result.active, dtype=float)[bed]
-        data["reaction"] = react[keep]
-        data["contact"] = contact[keep]
+        data["reaction"] = react[mesh.plate_node_ids]
+        data["contact"] = contact[mesh.plate_node_ids]
     return meshio.Mesh(points, [cells], point_data=data)
 
 

@@ -18,13 +18,16 @@ carry the units (stresses in force/length², reactions in force).
 
 Modules, by job: :mod:`.style` (figure creation, labels and units, colours, :func:`save`,
 :func:`png_bytes`), :mod:`.data` (what a figure reads from a result), :mod:`.marks` (the
-support markers and legend entries every plan-view map shares), :mod:`.plan` (the plan
+support markers, legend entries, axes and outline every plan-view map shares), :mod:`.plan` (the plan
 view: mesh, supports, contact state, section lines), :mod:`.fields` (deflection surface,
 contours, principal stresses, difference map), :mod:`.charts` (sections, reactions,
 convergence as line and bar charts), :mod:`.studies` (the source paper's figures 5 and 6:
 working schemes, w along sections per scheme, contact pressure along a contour, uniformity
-against κ), :mod:`.tri` (the same figures on a triangle mesh: the true outline and holes,
-``tricontourf``, ``plot_trisurf``; the public functions hand such results to it).
+against κ), :mod:`.tri` (the plan view and section lines of a shaped plate on a triangle
+mesh: the true outline and holes; :func:`plot_mesh` and :func:`default_sections` hand such
+results to it). The field maps are one path for every mesh: the nodal values (one per node of
+the plate) on a matplotlib ``Triangulation`` of ``mesh.nodes`` and ``mesh.triangulation()``
+(a grid's quads split in two for drawing only).
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .data import _supports, _w_at, support_spacing
+from .data import _bbox, _supports, _w_at, support_spacing
 from .plan import _norm_sections, default_sections
 from .style import (HEAVE_COLOR, LEVEL_BAR, ONE_SIDED, SETTLE_COLOR, TWO_SIDED, _fig_legend, _figure,
                     _gap_style, _lab, _name, _units)
@@ -34,13 +34,8 @@ def plot_sections(result: Result, two_sided: Result | None = None, sections=None
     fig = _figure((8.6, 1.0 + 2.15 * k))
     axs = fig.subplots(k, 1, squeeze=False)[:, 0]
     sup = _supports(result)
-    from .tri import _bbox, on_triangles
-
-    if on_triangles(result):
-        x0, x1, y0, y1 = _bbox(result)
-        span = max(x1 - x0, y1 - y0)
-    else:
-        span = max(result.scene.plate.a, result.scene.plate.b)
+    x0, x1, y0, y1 = _bbox(result)
+    span = max(x1 - x0, y1 - y0)
     for j, (ax, (lab, p0, p1)) in enumerate(zip(axs, secs), 1):
         t = np.linspace(0.0, 1.0, n)
         px, py = p0[0] + t * (p1[0] - p0[0]), p0[1] + t * (p1[1] - p0[1])

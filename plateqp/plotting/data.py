@@ -1,5 +1,6 @@
 """What a figure reads from a result: the supports as arrays, the bed's contact nodes, the
-nodes of the mesh, w sampled at points and on a refined grid, the spacing of the supports."""
+mesh's nodes as a matplotlib Triangulation and its cells' sides, the plate's bounding box, w
+sampled at points, the spacing of the supports."""
 
 from __future__ import annotations
 
@@ -55,11 +56,31 @@ def _bed(result: Result):
     return m.xy[bed], np.asarray(result.active, dtype=bool)[bed]
 
 
-def _nodes(result: Result):
-    g = result.model.grid
-    x = np.linspace(0.0, g.a, g.nx + 1)
-    y = np.linspace(0.0, g.b, g.ny + 1)
-    return np.meshgrid(x, y)
+def _triangulation(result: Result):
+    """The matplotlib Triangulation of the plate's nodes (``mesh.nodes``) on every mesh: the
+    triangles of a triangle mesh, or a grid's kept quads each split in two for drawing."""
+    from matplotlib.tri import Triangulation
+
+    mesh = result.model.grid
+    return Triangulation(mesh.nodes[:, 0], mesh.nodes[:, 1], mesh.triangulation())
+
+
+def _cell_edges(mesh) -> np.ndarray:
+    """(m, 2) the cells' sides as pairs of indices into ``mesh.nodes``, each once (a quad's
+    four sides, no diagonal)."""
+    c = mesh.cells
+    e = np.vstack([c[:, [k, (k + 1) % c.shape[1]]] for k in range(c.shape[1])])
+    return np.unique(np.sort(e, axis=1), axis=0)
+
+
+def _bbox(result: Result) -> tuple[float, float, float, float]:
+    """(x0, x1, y0, y1) of the plate: the rectangle a × b of a grid, the outer boundary's box
+    of a shaped plate."""
+    mesh = result.model.grid
+    if mesh.grid_shape is not None:
+        return 0.0, float(mesh.a), 0.0, float(mesh.b)
+    x0, x1, y0, y1 = mesh.domain.outer.bbox
+    return x0, x1, y0, y1
 
 
 def _point_loads(scene):
@@ -75,13 +96,6 @@ def _w_at(result: Result, x, y) -> np.ndarray:
     if ok.any():
         out[ok] = np.atleast_1d(result.deflection(x.ravel()[ok], y.ravel()[ok]))
     return out.reshape(x.shape)
-
-
-def _w_grid(result: Result, refine: int = 4):
-    """(X, Y, W) on the mesh refined ``refine`` times per cell (the element's own interpolation)."""
-    g = result.model.grid
-    X, Y = np.meshgrid(np.linspace(0.0, g.a, refine * g.nx + 1), np.linspace(0.0, g.b, refine * g.ny + 1))
-    return X, Y, _w_at(result, X, Y)
 
 
 def support_spacing(xy: np.ndarray) -> float:

@@ -1,6 +1,7 @@
-"""Markers every plan-view map shares (grid or triangles): the supports (filled in contact, hollow
-lifted off, shaped and coloured by the sign of their gap), the bed's contact nodes, point loads,
-their legend entries, and the normalised section lines."""
+"""What every plan-view map shares (grid or triangles): the supports' markers (filled in contact,
+hollow lifted off, shaped and coloured by the sign of their gap), the bed's contact nodes, point
+loads, their legend entries, the normalised section lines, the axes over the plate and the
+plate's outline."""
 
 from __future__ import annotations
 
@@ -8,8 +9,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .data import _bed, _point_loads, _supports
-from .style import _gap_style
+from .data import _bbox, _bed, _point_loads, _supports
+from .style import _frame, _gap_style
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..results import Result
@@ -93,3 +94,53 @@ def _supports_on_surface(ax, result: Result, handles: list) -> None:
     handles.append(Line2D([], [], ls="none", marker="o", mec="k", mfc="k", label="support in contact"))
     if not on.all():
         handles.append(Line2D([], [], ls="none", marker="o", mec="k", mfc="white", label="support lifted off"))
+
+
+# -- axes and outline shared by the plan-view maps ---------------------------------------------
+def _plan_axes(ax, result: Result, units, title: str | None = None, margin: float = 0.04):
+    """Equal-aspect axes over the plate's bounding box with a margin, labelled with ``units``."""
+    x0, x1, y0, y1 = _bbox(result)
+    m = margin * max(x1 - x0, y1 - y0)
+    _frame(ax, (x0 - m, x1 + m), (y0 - m, y1 + m), units, title)
+
+
+def _boundary_edges(mesh) -> np.ndarray:
+    """(m, 2) the sides of the cells that belong to one cell only: the plate's boundary, holes
+    and openings included, as pairs of indices into ``mesh.nodes``."""
+    c = mesh.cells
+    e = np.sort(np.vstack([c[:, [k, (k + 1) % c.shape[1]]] for k in range(c.shape[1])]), axis=1)
+    uniq, count = np.unique(e, axis=0, return_counts=True)
+    return uniq[count == 1]
+
+
+def _draw_outline(ax, result: Result, lw: float = 1.2):
+    """The plate's outline. A shaped plate: the outer boundary and the holes as polygons on its
+    own boundary points (gid "outline" and "hole", holes filled white); a grid: the boundary
+    sides of its kept cells (gid "outline"), openings included."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.patches import Polygon
+
+    mesh = result.model.grid
+    if mesh.grid_shape is None:  # the boundary loops of the geometry
+        for k, pts in outline_loops(mesh):
+            ax.add_patch(Polygon(pts, closed=True, fill=(k > 0), facecolor="white", edgecolor="k", lw=lw,
+                                 zorder=2, gid="outline" if k == 0 else "hole"))
+        return
+    ax.add_collection(LineCollection(mesh.nodes[_boundary_edges(mesh)], colors="k", linewidths=lw, zorder=2,
+                                     gid="outline"))
+
+
+def outline_loops(mesh) -> list[tuple[int, np.ndarray]]:
+    """The boundary as closed loops of node coordinates: [(boundary, (n, 2) points)], 0 the outer
+    boundary, k ≥ 1 hole k − 1 (the mesh's boundary nodes in order along each loop)."""
+    out = []
+    for k in np.unique(mesh.boundary):
+        e = mesh.edges[mesh.boundary == k]
+        nxt = {int(i): int(j) for i, j in e}
+        start = int(e[0, 0])
+        seq, n = [start], nxt[start]
+        while n != start and len(seq) <= len(e):
+            seq.append(n)
+            n = nxt.get(n, start)
+        out.append((int(k), mesh.nodes[seq]))
+    return out

@@ -2,8 +2,8 @@
 contact, hollow lifted off, shaped and coloured by the sign of their gap), the bed's contact
 nodes, point loads, reactions and the section lines drawn on the plate.
 
-Also the axes every plan-view map shares (:func:`_plan_axes`; the markers are in :mod:`.marks`)
-and the choice of section lines (:func:`default_sections`). A result on a triangle mesh is
+The axes, outline and markers every plan-view map shares are in :mod:`.marks`; here also the
+choice of section lines (:func:`default_sections`). A result on a triangle mesh is
 drawn by :mod:`.tri`.
 """
 
@@ -15,22 +15,12 @@ import numpy as np
 
 from .data import _point_loads, _supports, support_spacing
 from .marks import _draw_supports, _legend_handles, _norm_sections  # noqa: F401  (shared by the maps)
-from .style import _figure, _fmt, _frame, _lab, _units
+from .style import _figure, _fmt, _lab, _units
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
     from ..results import Result
-
-
-# -- axes shared by the plan-view maps (the markers: .marks) ------------------------------------
-def _plan_axes(ax, result: Result, units, title: str | None = None):
-    from .tri import on_triangles, tri_plan_axes
-
-    if on_triangles(result):
-        return tri_plan_axes(ax, result, units, title)
-    g = result.model.grid
-    _frame(ax, (0.0, g.a), (0.0, g.b), units, title)
 
 
 # -- the mesh, the supports, their reactions --------------------------------------------------

@@ -22,7 +22,7 @@ from ..assembly import Model, build_model
 from ..contact.routing import repeated_solves
 from ..errors import NoEquilibriumError, PlateQPWarning
 from ..paths import set_param
-from ..post import NodalOperator, TriNodalOperator, nodal_operator
+from ..post import NodalOperator, nodal_operator
 from ..scene import Scene
 from ..solving import solve
 from .reuse import adapt_model
@@ -52,7 +52,7 @@ class Base:
     of the rows' nodal fields on its mesh (:class:`plateqp.post.NodalOperator`)."""
 
     model: Model
-    nodal: NodalOperator | TriNodalOperator | None = None
+    nodal: NodalOperator | None = None
 
 
 _MODELS: OrderedDict[str, Base] = OrderedDict()  # per process: the base of a sweep
