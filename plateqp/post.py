@@ -95,7 +95,7 @@ class NodalOperator:
 
     Parameters
     ----------
-    model : :class:`~plateqp.assembly.Model` or :class:`~plateqp.triassembly.TriModel`
+    model : :class:`~plateqp.assembly.Model` (on any mesh)
     """
 
     def __init__(self, model) -> None:
@@ -171,10 +171,6 @@ def _triangle_vertex_curvatures(model) -> sp.csr_matrix:
     return sp.csr_matrix((B.ravel(), (rows.ravel(), cols.ravel())), shape=(9 * nt, model.n_full))
 
 
-#: The former name of :class:`NodalOperator` on a triangle mesh (the same class).
-TriNodalOperator = NodalOperator
-
-
 def nodal_operator(model) -> NodalOperator:
     """The nodal-average operator of ``model`` (any mesh): :class:`NodalOperator`."""
     return NodalOperator(model)
@@ -186,5 +182,5 @@ def nodal_w(model, u: np.ndarray) -> np.ndarray:
     return np.asarray(u, dtype=float)[ids * model.element.ndof_node].copy()
 
 
-__all__ = ["CURVATURE_QUANTITIES", "NodalOperator", "QUANTITIES", "TriNodalOperator", "check_quantity",
+__all__ = ["CURVATURE_QUANTITIES", "NodalOperator", "QUANTITIES", "check_quantity",
            "from_curvatures", "moments", "nodal_operator", "nodal_w", "principal", "stresses"]

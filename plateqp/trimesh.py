@@ -189,15 +189,6 @@ class TriMesh:
     def node_xy(self) -> np.ndarray:
         return self.nodes
 
-    def __getattr__(self, name: str):
-        """A rectangular grid's attribute (nx, ny, node_mask, cell_nodes, …), asked of a triangle
-        mesh by code that only works on grids (the studies by mesh halving, the demo's zone
-        comparison): a one-line SceneError."""
-        if name.startswith("_"):
-            raise AttributeError(name)
-        raise SceneError(f"this grid-based output is not yet available on triangle meshes "
-                         f"(mesh.element = \"dkt\"; the grid's {name!r} was asked for)")
-
     # -- queries ------------------------------------------------------------------------
     def areas(self) -> np.ndarray:
         p = self.nodes[self.triangles]
