@@ -12,6 +12,7 @@ element's interpolation) with the gaps g0 shifted by the prescribed dofs' contri
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import os
 from collections.abc import Callable
@@ -244,6 +245,27 @@ GENERATORS = {"quad": Grid, "triangle": TriMesh}
 
 def _generator(scene: Scene):
     return GENERATORS[ELEMENTS[scene.mesh.element].cell_type]
+
+
+def mesh_cells(scene: Scene) -> tuple[int, int]:
+    """The mesh of a scene as the studies by mesh halving count it, in cells a side: (nx, ny) of
+    a grid; on triangles (n, n), n = L / h rounded (halving h doubles n)."""
+    return _generator(scene).cells_a_side(scene)
+
+
+def with_cells(scene: Scene, nx: int, ny: int) -> Scene:
+    """A validated copy of ``scene`` meshed nx × ny cells a side (:func:`mesh_cells`; on
+    triangles the element size L / nx)."""
+    sc = copy.deepcopy(scene)
+    _generator(scene).set_cells(sc, nx, ny)
+    sc.validate()
+    return sc
+
+
+def start_cells(scene: Scene, cells: int = 4) -> tuple[int, int]:
+    """The first mesh of a refinement ladder: ``cells`` on the shorter side, the other in
+    proportion to the scene's own grid (on triangles (cells, cells))."""
+    return _generator(scene).start_cells(scene, cells)
 
 
 def build_model(scene: Scene) -> Model:

@@ -19,7 +19,7 @@ and uses it two ways:
   estimated error of max |w| and of the reactions is below REL, solving each mesh at a solver
   tolerance of a tenth of REL: the coarsest mesh and the loosest setting that reach it.
 
-On triangles a mesh of n cells a side has element size L / n (:func:`plateqp.geometry.mesh_cells`);
+On triangles a mesh of n cells a side has element size L / n (:func:`plateqp.assembly.mesh_cells`);
 the meshes are not nested, so the change of w is read from max |w| alone.
 
 The quantities are the ones engineers read: the largest deflection max |w|, and the
@@ -31,7 +31,6 @@ ACM under a point load, tests/test_plate.py), so the estimate errs on the safe s
 
 from __future__ import annotations
 
-import copy
 import warnings
 from dataclasses import dataclass, field
 
@@ -39,7 +38,7 @@ import numpy as np
 
 from collections.abc import Callable
 
-from .geometry import mesh_cells, size_for_cells
+from .assembly import mesh_cells, with_cells
 from .errors import MechanismError, PlateQPWarning, ProblemError, SceneError, SolverError
 from .results import Result
 from .scene import Scene
@@ -172,15 +171,9 @@ def confirm(est: ErrorEstimate, final: Result, order: float = ORDER) -> ErrorEst
 
 
 def with_mesh(scene: Scene, nx: int, ny: int) -> Scene:
-    """A validated copy of ``scene`` on an nx × ny grid; on triangles, of element size
-    h = L / nx (:func:`plateqp.geometry.size_for_cells`; ``mesh.nx`` and ``mesh.ny`` then say n)."""
-    sc = copy.deepcopy(scene)
-    if scene.triangles:
-        sc.mesh.size = size_for_cells(scene, int(nx))
-        nx = ny = nx
-    sc.mesh.nx, sc.mesh.ny = int(nx), int(ny)
-    sc.validate()
-    return sc
+    """A validated copy of ``scene`` meshed nx × ny cells a side: on a grid nx × ny cells, on
+    triangles of element size h = L / nx (:func:`plateqp.assembly.with_cells`)."""
+    return with_cells(scene, nx, ny)
 
 
 def quiet_solve(solve: Callable[..., Result], scene: Scene, backend: str, formulation: str, tol: float) -> Result:

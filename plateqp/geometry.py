@@ -505,22 +505,6 @@ def inner_segments(domain: Domain, outline: np.ndarray) -> list[tuple[tuple[floa
     return out
 
 
-def mesh_cells(scene) -> tuple[int, int]:
-    """The mesh of a scene as the studies by mesh halving count it: (nx, ny) of a grid; on
-    triangles (n, n) with n = L / h rounded, L the plate's larger bounding-box side and h the
-    element size (halving h doubles n)."""
-    if not scene.triangles:
-        return scene.mesh.nx, scene.mesh.ny
-    n = max(1, round(scene_domain(scene).size / mesh_size(scene)))
-    return n, n
-
-
-def size_for_cells(scene, n: int) -> float:
-    """The element size h = L / n of a triangle-meshed scene's mesh of ``n`` cells a side
-    (:func:`mesh_cells`)."""
-    return scene_domain(scene).size / n
-
-
 def tidy_dict(scene, d: dict) -> None:
     """The TOML dict of a scene (:meth:`Scene.to_dict`) without the shape fields it does not use:
     no ``shape`` or ``size`` when unset, no ``a``, ``b`` on a shaped plate (they follow from the

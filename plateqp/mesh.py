@@ -69,6 +69,25 @@ class Grid:
         m = scene.mesh
         return "mesh", f"{m.nx} x {m.ny} {m.element} mesh", "use a coarser mesh"
 
+    # the meshes of a refinement ladder, counted in cells a side (plateqp.studies.refinement)
+    @staticmethod
+    def cells_a_side(scene) -> tuple[int, int]:
+        """(nx, ny): the grid's cells."""
+        return scene.mesh.nx, scene.mesh.ny
+
+    @staticmethod
+    def set_cells(scene, nx: int, ny: int) -> None:
+        """Make ``scene`` (a copy) an nx × ny grid."""
+        scene.mesh.nx, scene.mesh.ny = int(nx), int(ny)
+
+    @staticmethod
+    def start_cells(scene, cells: int) -> tuple[int, int]:
+        """``cells`` on the shorter side, the other in proportion to the scene's own grid."""
+        nx, ny = scene.mesh.nx, scene.mesh.ny
+        if nx <= ny:
+            return cells, max(cells, round(cells * ny / nx))
+        return max(cells, round(cells * nx / ny)), cells
+
     @cached_property
     def cell_ids(self) -> np.ndarray:
         """(n_kept,) the grid index (j·nx + i) of each cell of :attr:`cells`."""

@@ -16,19 +16,14 @@ import math
 
 def _load_force_log(scene, ld) -> float:
     """log10 of the load's total force (bounded above for a patch: its overlap with the plate's box)."""
-    p = scene.plate
     kind = getattr(ld, "type", None)
     if kind == "point":
         return math.log10(abs(ld.P))
-    if scene.triangles:
-        from .geometry import scene_domain
+    from .geometry import scene_domain
 
-        dom = scene_domain(scene)
-        X0, X1, Y0, Y1 = dom.outer.bbox
-        area = dom.area
-    else:
-        X0, X1, Y0, Y1 = 0.0, p.a, 0.0, p.b
-        area = p.a * p.b
+    outer = scene_domain(scene).outer  # the plate's outline, its cut-outs not taken off: a bound
+    X0, X1, Y0, Y1 = outer.bbox
+    area = outer.area
     if kind == "patch":
         area = max(min(ld.x1, X1) - max(ld.x0, X0), 1e-300) * max(min(ld.y1, Y1) - max(ld.y0, Y0), 1e-300)
     return math.log10(abs(ld.q)) + math.log10(area)
@@ -36,14 +31,9 @@ def _load_force_log(scene, ld) -> float:
 
 def bed_spring(scene) -> float:
     """About the largest node spring of the scene's bed: k × h², h the element size."""
-    p, m = scene.plate, scene.mesh
-    if scene.triangles:
-        from .geometry import mesh_size
+    from .geometry import mesh_size
 
-        h = mesh_size(scene)
-    else:
-        h = max(p.a, p.b) / max(m.nx, m.ny)
-    return scene.foundation.k * h**2
+    return scene.foundation.k * mesh_size(scene) ** 2
 
 
 def check_scales(scene, derived: tuple[float, float]) -> None:

@@ -123,6 +123,30 @@ class TriMesh:
             domain, region_outline(scene.foundation.region))
         return mesh_domain(domain, mesh_size(scene), points, lines)
 
+    # the meshes of a refinement ladder, counted in cells a side (plateqp.studies.refinement)
+    @staticmethod
+    def cells_a_side(scene) -> tuple[int, int]:
+        """(n, n), n = L / h rounded, L the plate's larger bounding-box side and h the element
+        size (halving h doubles n)."""
+        from .geometry import mesh_size, scene_domain
+
+        n = max(1, round(scene_domain(scene).size / mesh_size(scene)))
+        return n, n
+
+    @staticmethod
+    def set_cells(scene, nx: int, ny: int) -> None:
+        """Make ``scene`` (a copy) a mesh of element size h = L / nx (``mesh.nx`` and ``mesh.ny``
+        then say nx)."""
+        from .geometry import scene_domain
+
+        scene.mesh.size = scene_domain(scene).size / int(nx)
+        scene.mesh.nx = scene.mesh.ny = int(nx)
+
+    @staticmethod
+    def start_cells(scene, cells: int) -> tuple[int, int]:
+        """(cells, cells): element size L / cells."""
+        return cells, cells
+
     @staticmethod
     def describe(scene) -> tuple[str, str, str]:
         """(field, the mesh in words, what makes it smaller) for a message about its size."""

@@ -23,7 +23,7 @@ Triangle meshes
 ---------------
 On a triangle-meshed scene (``mesh.element = "dkt"``) a mesh of n "cells a side" is the gmsh
 mesh of element size h = L / n, L the plate's larger bounding-box side
-(:func:`plateqp.geometry.mesh_cells`): halving the mesh halves h. The meshes are not nested,
+(:func:`plateqp.assembly.mesh_cells`): halving the mesh halves h. The meshes are not nested,
 so the change on halving is read from max |w| (and the reactions), not from the field at the
 coarse mesh's nodes.
 """
@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from ..accuracy import TOL_RANGE
+from ..assembly import mesh_cells, start_cells
 from ..errors import PlateQPError, PlateQPWarning, ProblemError, SceneError
 from ..progress import track
 from ..estimate import (COARSE_FAILURES, FRACTION, LOOSEST, ORDER, ErrorEstimate, Quantities, changes, quiet_solve,
@@ -190,7 +191,8 @@ def convergence(scene: Scene, meshes: Sequence = (2, 4, 8, 16, 32),
     Supports off the nodes of a coarse mesh act through the element's interpolation; pins
     must lie on the nodes of every mesh (else that mesh's row records the SceneError).
     """
-    ratio = 1.0 if scene.triangles else scene.mesh.ny / scene.mesh.nx
+    cx, cy = mesh_cells(scene)
+    ratio = cy / cx
     mesh_list = [(int(m[0]), int(m[1])) if isinstance(m, (tuple, list)) else (int(m), max(1, round(m * ratio)))
                  for m in meshes]
     names, funcs = [], []
@@ -267,13 +269,8 @@ class TargetResult:
 
 def start_mesh(scene: Scene, cells: int = 4) -> tuple[int, int]:
     """``cells`` on the shorter side, the other in proportion to the scene's own mesh (on
-    triangles: (cells, cells), element size L / cells)."""
-    if scene.triangles:
-        return cells, cells
-    nx, ny = scene.mesh.nx, scene.mesh.ny
-    if nx <= ny:
-        return cells, max(cells, round(cells * ny / nx))
-    return max(cells, round(cells * nx / ny)), cells
+    triangles: (cells, cells), element size L / cells): :func:`plateqp.assembly.start_cells`."""
+    return start_cells(scene, cells)
 
 
 def _estimate(prev: list[Quantities], q: Quantities, order: float) -> ErrorEstimate | None:
