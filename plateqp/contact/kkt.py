@@ -75,7 +75,12 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     tol = Accuracy.parse(accuracy).tol
     BtR = data.B.T @ R
     r = data.K @ u - data.f + BtR
-    force = max(np.linalg.norm(data.f), np.linalg.norm(BtR), 1e-300)
+    k = local_stiffness(data)
+    force = max(np.linalg.norm(data.f), np.linalg.norm(BtR))
+    # no load and no reaction to the accuracy asked (a plate lifted as a body onto heaved posts):
+    # the force scale is what the data can do, the force that closes the largest heave
+    heave = heave_force(data, k)
+    force = max(heave if force <= tol * heave else force, 1e-300)
     st = np.linalg.norm(r) / force
     w = data.B @ u
     delta = deflection_scale(data, u, w)
@@ -92,8 +97,7 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     delta = max(delta, min(floor / tol, 1.0) * data.w_load)
     st = max(st, (st - 10.0 * floor) * data.w_load / delta)
     gap = data.g0 + s - w
-    rscale = reaction_scale(R, data.f, tol)
-    k = local_stiffness(data)
+    rscale = reaction_scale(R, data.f, tol, heave)
     natural = np.abs(np.minimum(R, k * gap)).max(initial=0.0) / rscale
     # the same natural residual in deflection units: a support in contact whose gap is left open
     # by ε (its reaction off by about k ε) changes the deflections by ε, which the force scale of
@@ -145,15 +149,25 @@ def defect_residual(data: Scaled, c: ContactSolution, e: np.ndarray, M: np.ndarr
     return float(size)
 
 
-def reaction_scale(R: np.ndarray, f: np.ndarray, tol: float) -> float:
+def heave_force(data: Scaled, k: np.ndarray | None = None) -> float:
+    """The largest force a heave can press into the plate: max k_i · max(−g0_i, 0) (k the
+    :func:`local_stiffness`, an upper bound). With no load it is the scale of every force there
+    can be: the reactions of a plate lifted as a body onto heaved posts are zero to rounding of
+    it, and rounding of nothing at all where the load sets the scale."""
+    k = local_stiffness(data) if k is None else k
+    return float((k * np.maximum(-data.g0, 0.0)).max(initial=0.0))
+
+
+def reaction_scale(R: np.ndarray, f: np.ndarray, tol: float, heave: float = 0.0) -> float:
     """The force scale ρ_R of the force residuals: the largest reaction; but where every reaction
-    is at most ``tol`` of the load (‖f‖₁), the supports carry nothing to the accuracy asked and
-    their reactions are measured against the load itself. (Against the largest of them, an
-    interior-point solver's 1e-13 of the load at open supports read as a 100 % error: every
-    scene where nothing touches came back INACCURATE. The deflections those forces cause are
-    still measured, in deflection units, by the natural residual.)"""
+    is at most ``tol`` of the load (‖f‖₁, plus ``heave``: :func:`heave_force`), the supports
+    carry nothing to the accuracy asked and their reactions are measured against that. (Against
+    the largest of them, an interior-point solver's 1e-13 of the load at open supports read as a
+    100 % error: every scene where nothing touches came back INACCURATE; with no load, a rigid
+    lift's reactions of 1e-16 read as 100 % errors of themselves. The deflections those forces
+    cause are still measured, in deflection units, by the natural residual.)"""
     rmax = np.abs(R).max(initial=0.0)
-    load = np.abs(f).sum()
+    load = np.abs(f).sum() + heave
     if rmax <= tol * load:
         return max(load, 1e-300)
     return max(rmax, 1e-12 * load, 1e-300)

@@ -203,8 +203,8 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         return RawSolution(status=out.status, iterations=out.it, solve_time=time.perf_counter() - t0,
                            solver_status=out.message, extras=extras)
     lam = out.lam.copy()
-    lam[(lam < 0) & (lam >= -tol["feas_tol"] * force_scale(pb, lam))] = 0.0
-    nat, st = natural_residuals(pb, out.u, lam)
+    lam[(lam < 0) & (lam >= -tol["feas_tol"] * force_scale(pb, lam, tol["feas_tol"]))] = 0.0
+    nat, st = natural_residuals(pb, out.u, lam, tol["accept_tol"])
     extras.update(natural_residual=nat, stationarity=st)
     status = out.status
     if status is Status.OPTIMAL and max(nat, st) > tol["accept_tol"]:
