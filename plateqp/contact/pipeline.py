@@ -74,6 +74,12 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         backend, formulation = choose(data, asked_backend, "primal")
         b = get_backend(backend)
         form = formulate(data, formulation)
+    if getattr(b, "definite", False) and data.floating:  # a SolverError, as the solver's own refusal was
+        raise SolverError(
+            f"backend {backend!r} needs a positive definite Hessian, and a plate its two-sided supports do not hold "
+            f"(free to move as a body) has only a semidefinite one in the primal and condensed formulations; "
+            f"formulation='dual' needs two-sided supports (edges, pins) that hold it: add them, or use a backend "
+            f"that takes a semidefinite Hessian: pdas (primal), lemke or bpp (condensed), clarabel or osqp")
     route = f"{backend}/{formulation}"
     if asked_backend != "auto":
         return _solve_route(model, data, reach, form, backend, acc, options, predict, t0)
