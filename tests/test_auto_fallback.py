@@ -212,3 +212,32 @@ def test_a_named_backend_is_never_swapped(monkeypatch):
     use(monkeypatch, pdas=Failing(get_backend("pdas")))
     res = quiet_solve(held_scene(), backend="pdas")
     assert res.status == pq.Status.MAX_ITER and res.backend == "pdas"
+
+
+def heave_dominated_scene() -> pq.Scene:
+    """A floating concrete slab on four posts, heaved 10⁵ times the deflection its load causes."""
+    return pq.Scene(name="heave-dominated", plate=pq.Plate(1.0, 1.0, 0.2, 3e10, 0.3), mesh=pq.MeshSpec(6, 6),
+                    loads=[pq.UniformLoad(1.0), pq.PointLoad(100.0, 0.43, 0.6)],
+                    supports=[pq.Support(x, y, gap=g) for (x, y), g in
+                              zip(((0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)),
+                                  (-0.017, 0.0, -0.01, -0.005, -0.012))])
+
+
+@pytest.mark.parametrize("accuracy", ["low", "default"])
+def test_a_small_load_beside_large_heaves_keeps_its_own_force_scale(monkeypatch, accuracy):
+    """The heaves' force is the scale only where the load does no work: reactions 1 % off a load
+    10⁻⁵ of that force are caught at every accuracy."""
+    scene = heave_dominated_scene()
+    ref = quiet_solve(scene, backend="lemke", formulation="condensed", accuracy=accuracy)
+    assert ref.status == pq.Status.OPTIMAL
+    np.testing.assert_allclose(ref.reactions.sum(), 101.0, rtol=1e-6)
+
+    class Off(Failing):
+        def solve(self, problem, accuracy="default", options=None):
+            raw = self.b.solve(problem, accuracy=accuracy, options=options)
+            raw.x = raw.x + 0.01 * np.abs(raw.x).max()  # every gap opened by 1 % of the largest
+            return raw
+
+    use(monkeypatch, lemke=Off(get_backend("lemke")))
+    res = quiet_solve(scene, backend="lemke", formulation="condensed", accuracy=accuracy)
+    assert res.status != pq.Status.OPTIMAL and not res.kkt.ok

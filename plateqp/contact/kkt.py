@@ -77,10 +77,10 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     r = data.K @ u - data.f + BtR
     k = local_stiffness(data)
     force = max(np.linalg.norm(data.f), np.linalg.norm(BtR))
-    # no load and no reaction to the accuracy asked (a plate lifted as a body onto heaved posts):
-    # the force scale is what the data can do, the force that closes the largest heave
+    # no load and no reaction beyond rounding of the heaves' forces (a plate lifted as a body onto
+    # heaved posts): the force scale is what the data can do, the force that closes the largest heave
     heave = heave_force(data, k)
-    force = max(heave if force <= tol * heave else force, 1e-300)
+    force = max(heave if force <= NO_WORK * heave else force, 1e-300)
     st = np.linalg.norm(r) / force
     w = data.B @ u
     delta = deflection_scale(data, u, w)
@@ -149,6 +149,14 @@ def defect_residual(data: Scaled, c: ContactSolution, e: np.ndarray, M: np.ndarr
     return float(size)
 
 
+#: A load (or reactions) below this fraction of :func:`heave_force` does no work that double
+#: precision can show beside the heaves: a plate lifted as a body onto heaved posts carries
+#: reactions of 1e-16 … 1e-15 of it. Only then are forces measured against the heaves' force;
+#: any larger load keeps its own scale (measured against the heaves, a load 1e-5 of them, the
+#: whole of a floating plate's reactions, would pass with any error below tol × 1e5 of itself).
+NO_WORK = 1e-10
+
+
 def heave_force(data: Scaled, k: np.ndarray | None = None) -> float:
     """The largest force a heave can press into the plate: max k_i · max(−g0_i, 0) (k the
     :func:`local_stiffness`, an upper bound). With no load it is the scale of every force there
@@ -160,14 +168,17 @@ def heave_force(data: Scaled, k: np.ndarray | None = None) -> float:
 
 def reaction_scale(R: np.ndarray, f: np.ndarray, tol: float, heave: float = 0.0) -> float:
     """The force scale ρ_R of the force residuals: the largest reaction; but where every reaction
-    is at most ``tol`` of the load (‖f‖₁, plus ``heave``: :func:`heave_force`), the supports
-    carry nothing to the accuracy asked and their reactions are measured against that. (Against
+    is at most ``tol`` of the load (‖f‖₁; where the load and the reactions are below
+    ``NO_WORK`` × ``heave``, :func:`heave_force`, that force), the supports carry nothing to the
+    accuracy asked and their reactions are measured against that. (Against
     the largest of them, an interior-point solver's 1e-13 of the load at open supports read as a
     100 % error: every scene where nothing touches came back INACCURATE; with no load, a rigid
     lift's reactions of 1e-16 read as 100 % errors of themselves. The deflections those forces
     cause are still measured, in deflection units, by the natural residual.)"""
     rmax = np.abs(R).max(initial=0.0)
-    load = np.abs(f).sum() + heave
+    load = np.abs(f).sum()
+    if max(load, rmax) <= NO_WORK * heave:  # no load that does work beside the heaves
+        load = heave
     if rmax <= tol * load:
         return max(load, 1e-300)
     return max(rmax, 1e-12 * load, 1e-300)

@@ -181,13 +181,22 @@ def heave_force(pb: ReducedQP) -> float:
     return float((pb.c * np.maximum(-pb.g, 0.0)).max(initial=0.0))
 
 
+#: Load and reactions below this fraction of :func:`heave_force` do no work beside the negative
+#: gaps (plateqp.contact.kkt.NO_WORK): forces are then measured against that force.
+NO_WORK = 1e-10
+
+
 def force_scale(pb: ReducedQP, lam: np.ndarray, tol: float = 0.0) -> float:
-    """The force scale of the reactions: the largest, at least 1e-12 of the forces the data can
-    make (‖f‖₁ and :func:`heave_force`); where every reaction is at most ``tol`` of those, that
-    force itself (with no load, the reactions of a plate lifted as a body onto negative gaps are
-    rounding of it, not of themselves: measured against themselves they never settled)."""
-    load = np.abs(pb.f).sum() + heave_force(pb)
+    """The force scale of the reactions: the largest, at least 1e-12 of the load ‖f‖₁; where
+    every reaction is at most ``tol`` of the load, the load itself; where the load and the
+    reactions are below NO_WORK of :func:`heave_force`, that force takes the load's place (with
+    no load, the reactions of a plate lifted as a body onto negative gaps are rounding of it,
+    not of themselves: measured against themselves they never settled)."""
+    load = np.abs(pb.f).sum()
     rmax = np.abs(lam).max(initial=0.0)
+    heave = heave_force(pb)
+    if max(load, rmax) <= NO_WORK * heave:
+        load = heave
     if rmax <= tol * load:
         return max(load, np.finfo(float).tiny)
     return max(rmax, 1e-12 * load, np.finfo(float).tiny)
@@ -206,11 +215,11 @@ class Outcome:
 
 def natural_residuals(pb: ReducedQP, u: np.ndarray, lam: np.ndarray, tol: float = 0.0) -> tuple[float, float]:
     """Relative natural residual and relative stationarity residual of ``(u, λ)``; where the
-    load and the reactions are at most ``tol`` of :func:`heave_force`, forces are measured
+    load and the reactions are below NO_WORK of :func:`heave_force`, forces are measured
     against that."""
     gap = pb.g + pb.rho * lam - pb.B @ u
     nat = float(np.abs(np.minimum(lam, pb.c * gap)).max(initial=0.0) / force_scale(pb, lam, tol))
     BtL = pb.B.T @ lam
     force, heave = max(np.linalg.norm(pb.f), np.linalg.norm(BtL)), heave_force(pb)
-    st = float(np.linalg.norm(pb.K @ u - pb.f + BtL) / max(heave if force <= tol * heave else force, 1e-300))
+    st = float(np.linalg.norm(pb.K @ u - pb.f + BtL) / max(heave if force <= NO_WORK * heave else force, 1e-300))
     return nat, st
