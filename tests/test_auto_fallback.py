@@ -241,3 +241,22 @@ def test_a_small_load_beside_large_heaves_keeps_its_own_force_scale(monkeypatch,
     use(monkeypatch, lemke=Off(get_backend("lemke")))
     res = quiet_solve(scene, backend="lemke", formulation="condensed", accuracy=accuracy)
     assert res.status != pq.Status.OPTIMAL and not res.kkt.ok
+
+
+def lifted_on_one_post_scene() -> pq.Scene:
+    """A floating 4² BFS slab, no load, rigid and elastic posts, two heaved by 8e-6 and 1.4e-6."""
+    posts = [(0.3577, 0.3117, 0.0, "rigid"), (0.999, 0.8126, 0.0, "rigid"), (0.6573, 0.6192, 0.0, 5380.17),
+             (0.5419, 0.8728, -8.0286e-06, "rigid"), (0.9486, 0.9336, -1.4495e-06, 1644.88)]
+    return pq.Scene(name="lifted", plate=pq.Plate(1.0, 1.0, 0.2, 3e10, 0.3), mesh=pq.MeshSpec(4, 4, "bfs"),
+                    supports=[pq.Support(x, y, gap=g, stiffness=c) for x, y, g, c in posts])
+
+
+def test_pdas_lifts_a_plate_its_anchored_set_leaves_free():
+    """The anchored plate's first set is the one heaved rigid post: its penalty factor with the
+    plate free to turn about that post was not definite ("the active-set matrix is not positive
+    definite"); pdas now starts again from every row, and the plate rises as a body, R = 0."""
+    scene = lifted_on_one_post_scene()
+    res = quiet_solve(scene, backend="pdas")
+    assert res.status == pq.Status.OPTIMAL and res.kkt.ok
+    assert np.abs(res.reactions).max() <= 1e-9 * scene.plate.D * 8.0286e-06
+    assert res.gaps.min() >= -1e-9 * 8.0286e-06
