@@ -79,7 +79,7 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     force = max(np.linalg.norm(data.f), np.linalg.norm(BtR))
     # no load and no reaction beyond rounding of the heaves' forces (a plate lifted as a body onto
     # heaved posts): the force scale is what the data can do, the force that closes the largest heave
-    heave = heave_force(data, k)
+    heave = heave_force(data)
     force = max(heave if force <= NO_WORK * heave else force, 1e-300)
     st = np.linalg.norm(r) / force
     w = data.B @ u
@@ -157,13 +157,14 @@ def defect_residual(data: Scaled, c: ContactSolution, e: np.ndarray, M: np.ndarr
 NO_WORK = 1e-10
 
 
-def heave_force(data: Scaled, k: np.ndarray | None = None) -> float:
-    """The largest force a heave can press into the plate: max k_i · max(−g0_i, 0) (k the
-    :func:`local_stiffness`, an upper bound). With no load it is the scale of every force there
-    can be: the reactions of a plate lifted as a body onto heaved posts are zero to rounding of
-    it, and rounding of nothing at all where the load sets the scale."""
-    k = local_stiffness(data) if k is None else k
-    return float((k * np.maximum(-data.g0, 0.0)).max(initial=0.0))
+def heave_force(data: Scaled) -> float:
+    """The force that bends the plate by its largest heave where that post stands:
+    max k_i · max(−g0_i, 0), k the plate's own stiffness there (:func:`plate_stiffness`, an
+    upper bound; a soft post's spring left out, as a plate turned as a body about its hinge moves
+    every dof by about the heave, whatever the springs). With no load it is the scale of every
+    force there can be: the reactions of a plate lifted as a body onto heaved posts, and its
+    internal forces K u, are zero to rounding of it."""
+    return float((plate_stiffness(data) * np.maximum(-data.g0, 0.0)).max(initial=0.0))
 
 
 def reaction_scale(R: np.ndarray, f: np.ndarray, tol: float, heave: float = 0.0) -> float:
@@ -238,7 +239,13 @@ def local_stiffness(data: Scaled) -> np.ndarray:
     # 1/(b K⁻¹ bᵀ) from above, whatever K is. Σ b_j² K_jj is no bound where most of a support's
     # interpolation weight sits on prescribed dofs (a support beside a clamped edge: it said 11.9
     # where the plate's stiffness is about 8e4, and wrong reactions passed; issue 10).
+    kb = plate_stiffness(data)
+    return kb / (1.0 + data.rho * kb)
+
+
+def plate_stiffness(data: Scaled) -> np.ndarray:
+    """The plate's own part of :func:`local_stiffness` (without the supports' springs)."""
     kb = row_stiffness(data.K, data.B, "rayleigh")
     if data.spacing is not None:
         kb = np.minimum(kb, CIRCLE / np.maximum(data.spacing, 1e-300) ** 2)
-    return kb / (1.0 + data.rho * kb)
+    return kb

@@ -177,8 +177,9 @@ def at_rounding(pb: ReducedQP, u: np.ndarray, idx: np.ndarray, BA, lamA: np.ndar
 
 
 def heave_force(pb: ReducedQP) -> float:
-    """The largest force a negative gap can press into its row: max c_i · max(−g_i, 0)."""
-    return float((pb.c * np.maximum(-pb.g, 0.0)).max(initial=0.0))
+    """The force that closes the largest negative gap at its row's own stiffness (the row's
+    spring left out): max k_i · max(−g_i, 0)."""
+    return float((pb.k * np.maximum(-pb.g, 0.0)).max(initial=0.0))
 
 
 #: Load and reactions below this fraction of :func:`heave_force` do no work beside the negative
