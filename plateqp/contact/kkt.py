@@ -75,11 +75,12 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     tol = Accuracy.parse(accuracy).tol
     BtR = data.B.T @ R
     r = data.K @ u - data.f + BtR
-    k = local_stiffness(data)
+    kb = plate_stiffness(data)
+    k = kb / (1.0 + data.rho * kb)  # local_stiffness
     force = max(np.linalg.norm(data.f), np.linalg.norm(BtR))
     # no load and no reaction beyond rounding of the heaves' forces (a plate lifted as a body onto
     # heaved posts): the force scale is what the data can do, the force that closes the largest heave
-    heave = heave_force(data)
+    heave = heave_force(data, kb)
     force = max(heave if force <= NO_WORK * heave else force, 1e-300)
     st = np.linalg.norm(r) / force
     w = data.B @ u
@@ -157,14 +158,30 @@ def defect_residual(data: Scaled, c: ContactSolution, e: np.ndarray, M: np.ndarr
 NO_WORK = 1e-10
 
 
-def heave_force(data: Scaled) -> float:
+def heave_force(data: Scaled, kb: np.ndarray | None = None) -> float:
     """The force that bends the plate by its largest heave where that post stands:
     max k_i · max(−g0_i, 0), k the plate's own stiffness there (:func:`plate_stiffness`, an
     upper bound; a soft post's spring left out, as a plate turned as a body about its hinge moves
     every dof by about the heave, whatever the springs). With no load it is the scale of every
     force there can be: the reactions of a plate lifted as a body onto heaved posts, and its
-    internal forces K u, are zero to rounding of it."""
-    return float((plate_stiffness(data) * np.maximum(-data.g0, 0.0)).max(initial=0.0))
+    internal forces K u, are zero to rounding of it. ``kb``: :func:`plate_stiffness`, where
+    the caller has it."""
+    heave = np.maximum(-data.g0, 0.0)
+    if not heave.any():
+        return 0.0
+    kb = plate_stiffness(data) if kb is None else kb
+    return float((kb * heave).max(initial=0.0))
+
+
+def heave_bound(data: Scaled) -> float:
+    """An upper bound of :func:`heave_force` without the Rayleigh quotients (CIRCLE / s² for the
+    plate's stiffness; infinite where the spacings are not known)."""
+    heave = np.maximum(-data.g0, 0.0)
+    if not heave.any():
+        return 0.0
+    if data.spacing is None:
+        return float("inf")
+    return float((CIRCLE / np.maximum(data.spacing, 1e-300) ** 2 * heave).max())
 
 
 def reaction_scale(R: np.ndarray, f: np.ndarray, tol: float, heave: float = 0.0) -> float:
