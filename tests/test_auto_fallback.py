@@ -291,3 +291,10 @@ def test_an_optimal_answer_on_a_hinged_plate_balances_the_moment_about_the_hinge
     x = np.array([s.x for s in scene.supports])
     moment_error = abs(res.reactions @ x - 20.0) / 20.0
     assert res.status != pq.Status.OPTIMAL or moment_error <= 10 * res.kkt.tol
+
+
+def test_the_options_given_go_to_the_first_route_only(monkeypatch):
+    """pdas's own options are not handed to bpp or lemke (which would refuse them)."""
+    use(monkeypatch, pdas=Failing(get_backend("pdas")))
+    res = quiet_solve(held_scene(), options={"method": "sparse"})
+    assert res.status == pq.Status.OPTIMAL and res.extras["route"]["answered"] == "bpp/condensed"

@@ -105,7 +105,8 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", PlateQPWarning)  # one warning, for the answer kept
-                nxt = _solve_route(model, data, reach, formulate(data, nf), nb, acc, options, "auto", t1)
+                # the options given were for the first route; another backend takes its defaults
+                nxt = _solve_route(model, data, reach, formulate(data, nf), nb, acc, {}, predict, t1)
         except (SolverError, ProblemError, MechanismError) as exn:
             tried.append({"route": f"{nb}/{nf}", "status": "error", "why": str(exn)})
             continue
