@@ -187,7 +187,8 @@ class Result:
         accuracy, status, w_max and its x, y, ``probes`` (w at each (x, y) given), reactions,
         active, gaps, residual, ``deflection_unique`` (False: reactions unique, deflection not
         unique; see the class), kkt, iterations, times (build, solve, total); with
-        ``accuracy="auto"`` also the discretisation error estimate."""
+        ``accuracy="auto"`` also the discretisation error estimate; where the status is not
+        OPTIMAL, ``why`` (the solver's own words and the KKT residual, ``extras["why"]``)."""
         w, x, y = self.w_max()
         d = {
             "scene": self.scene.name,
@@ -210,6 +211,8 @@ class Result:
         }
         if self.extras.get("accuracy") == "auto":
             d["discretisation_error"] = self.extras.get("discretisation_error")
+        if self.status != Status.OPTIMAL and self.extras.get("why"):
+            d["why"] = self.extras["why"]  # why the solver stopped short, in words
         return d
 
     # -- in the tools users already use (plateqp.io.fields, plateqp.io.vtk) -----------------------

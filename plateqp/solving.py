@@ -52,7 +52,8 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     backend : a name from :func:`plateqp.available_backends` ("auto": pdas on the sparse
         primal; bpp on the condensed problem in a sweep (which re-uses the condensation) with
         at most 100 contact points; the rule and its measurements:
-        :mod:`plateqp.contact.routing`, benchmarks/README.md)
+        :mod:`plateqp.contact.routing`, benchmarks/README.md; where that route stops short, the
+        next exact one, and ``extras["route"]`` says which answered and why the others stopped)
     formulation : "primal", "condensed", "dual" or "auto" (with a named backend: the form it
         takes; with a QP backend that takes all, condensed while m ≤ 10 % of the dofs and ≤ 1000)
     accuracy : "low", "default" or "high" (KKT tolerance 1e-3, 1e-6, 1e-9), or a tolerance

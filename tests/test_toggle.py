@@ -64,11 +64,44 @@ def test_toggle_on_a_held_plate_agrees_with_lemke(formulation):
 
 
 def test_toggle_says_when_the_contact_set_does_not_hold_the_plate():
+    """A singular round leaves no answer: a SolverError that says why, not a Result of zeros."""
     scene = pq.Scene.from_toml(scenes.path("heave"))  # a floating slab: all supports at once are singular
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        res = pq.solve(scene, backend="toggle")
-    assert res.status == pq.Status.ERROR and "do not hold the plate" in res.extras["solver_status"]
+    with pytest.raises(pq.SolverError, match="round 1: the supports in contact do not hold the plate"):
+        pq.solve(scene, backend="toggle")
+
+
+def cluster_scene():
+    """Eight posts in a tight cluster under a simply supported slab, mixed heave and settlement:
+    toggling cycles through three contact sets (notebooks/10_toggle_the_springs)."""
+    posts = [(0.48, 0.52), (0.48, 0.55), (0.50, 0.55), (0.51, 0.62),
+             (0.54, 0.52), (0.56, 0.58), (0.57, 0.52), (0.57, 0.61)]
+    gap0 = 1e-4 * np.array([1, 2, 1, -1, 1, 1, -2, 0])
+    return pq.Scene(name="cluster", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(10, 10),
+                    edges={e: "simple" for e in ("left", "right", "bottom", "top")},
+                    loads=[pq.UniformLoad(10.0), pq.PointLoad(100.0, 0.7, 0.7), pq.PointLoad(100.0, 0.2, 0.1)],
+                    supports=[pq.Support(x, y, gap=float(g)) for (x, y), g in zip(posts, gap0)])
+
+
+def test_a_toggle_that_cycles_says_so_in_the_result_and_its_json():
+    with pytest.warns(pq.PlateQPWarning, match="cycled"):
+        res = pq.solve(cluster_scene(), backend="toggle", formulation="dual")
+    assert res.status == pq.Status.MAX_ITER
+    assert "cycled" in res.extras["why"] and "cycled" in res.to_dict()["why"]
+    assert "why" not in pq.solve(held_scene(), backend="lemke").to_dict()  # an OPTIMAL answer has no why
+
+
+def test_toggle_failures_say_why_on_the_command_line(tmp_path, capsys):
+    import json
+
+    from plateqp.cli import main
+
+    f = tmp_path / "cluster.toml"
+    cluster_scene().to_toml(f)
+    assert main(["solve", str(f), "--backend", "toggle", "--formulation", "dual", "--json"]) == 5
+    assert "cycled" in json.loads(capsys.readouterr().out)["why"]
+    assert main(["solve", "heave", "--backend", "toggle", "--json"]) == 4
+    out = capsys.readouterr()
+    assert "do not hold the plate" in out.err and "\n" not in out.err.strip()
 
 
 def test_penalty_error_is_first_order_in_the_compliance():

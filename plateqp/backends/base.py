@@ -201,6 +201,9 @@ class Backend:
     ``warm_start``
         takes ``options["active"]``, a bool array, as its first active set, and returns its
         final one in ``extras["active"]`` (in the problem's own terms) for the next solve.
+    ``definite``
+        needs ``P`` positive definite (it factorises ``P``): a QP whose ``P`` is only
+        semidefinite (``QP.singular``) is refused.
 
     Methods: ``available()`` (importable here), ``version()``, and
     ``solve(problem, accuracy, options) → RawSolution``. Options are the solver's own and
@@ -213,6 +216,7 @@ class Backend:
     formulations: tuple[str, ...] | None = None
     exact: bool = False
     warm_start: bool = False
+    definite: bool = False
 
     def available(self) -> bool:
         return True

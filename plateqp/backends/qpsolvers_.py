@@ -315,7 +315,10 @@ def solve_qp(qp: QP, solver: str, accuracy: str = "default", options: dict | Non
                 extras={"preset": preset if table else "defaults", "options": opts},
             )
         except qpsolvers.ProblemError as exn:  # e.g. quadprog and ecos need P positive definite
-            raise SolverError(f"qpsolvers/{solver} rejected the problem: {exn}") from exn
+            why = (f" ({solver} needs P positive definite; this P is only semidefinite: a form of the problem "
+                   "whose P is definite, or a solver that takes a semidefinite P)"
+                   if solver in DEFINITE_ONLY and "definite" in str(exn) else "")
+            raise SolverError(f"qpsolvers/{solver} rejected the problem: {exn}{why}") from exn
         except (qpsolvers.ParamError, TypeError, ValueError, AttributeError) as exn:
             raise rejected_option(f"{PREFIX}:{solver}", options, exn) or SolverError(
                 f"qpsolvers/{solver} failed: {one_line(exn)}") from exn
@@ -371,14 +374,21 @@ def solve(
     return via_qp(problem, lambda qp: solve_qp(qp, solver, accuracy, options))
 
 
+#: Solvers that factorise P and so need it positive definite: quadprog (Goldfarb–Idnani's dual
+#: method starts from P's Cholesky factor) and ecos (qpsolvers writes the QP as a cone program
+#: through P's Cholesky factor). qpsolvers refuses a semidefinite P for both.
+DEFINITE_ONLY = frozenset({"quadprog", "ecos"})
+
+
 class QpsolversBackend(Backend):
-    """``qpsolvers:NAME``."""
+    """``qpsolvers:NAME``; ``definite`` for the solvers of :data:`DEFINITE_ONLY`."""
 
     accepts = frozenset({"qp", "lcp"})
 
     def __init__(self, solver: str):
         self.solver = solver
         self.name = f"{PREFIX}:{solver}"
+        self.definite = solver in DEFINITE_ONLY
 
     def __repr__(self) -> str:
         return f"QpsolversBackend({self.name!r})"

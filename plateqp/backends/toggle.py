@@ -16,7 +16,7 @@ sign change flips at once, and even for a symmetric positive definite ``M`` the 
 **cycle** (a 4 × 4 example in tests/test_toggle.py). A set seen before ends the iteration
 with status ``MAX_ITER`` and "cycled" in ``solver_status`` (``extras["cycle"]`` its length);
 so does ``max_iter``. A singular ``M_AA`` (a floating plate held by too few supports) is
-status ``ERROR``. :mod:`~plateqp.backends.pdas` is this method with the safeguards that make
+status ``ERROR`` with no answer (:func:`plateqp.solve` raises a SolverError that says which round). :mod:`~plateqp.backends.pdas` is this method with the safeguards that make
 it finish.
 
 ``penalty``: stiff springs instead of one-sided constraints
@@ -69,7 +69,8 @@ def toggle(M, q, max_iter=None, *, accuracy="default", tol=None) -> RawSolution:
     RawSolution
         ``OPTIMAL`` (the set settled and the natural residual is within ``tol``), ``MAX_ITER``
         (a set repeated: "cycled", ``extras["cycle"]`` its length; or ``max_iter`` rounds),
-        ``ERROR`` (a singular ``M_AA``); ``x = z``, ``w`` of the last round, ``extras``:
+        ``ERROR`` (a singular ``M_AA``: no ``x``, ``solver_status`` says which round); ``x = z``, ``w``
+        of the last round, ``extras``:
         ``sets`` (the contact sets tried, in order), ``natural_residual``.
     """
     t0 = time.perf_counter()
@@ -92,10 +93,11 @@ def toggle(M, q, max_iter=None, *, accuracy="default", tol=None) -> RawSolution:
         if A.any():
             MAA = M[np.ix_(A, A)]
             cond = np.linalg.cond(MAA)
-            if not cond < COND_MAX:
-                return answer(q, z, M @ z + q, Status.ERROR, t0, it,
-                              f"round {it}: the supports in contact do not hold the plate (M_AA singular to "
-                              f"working precision, condition {cond:.1e})", {"sets": sets})
+            if not cond < COND_MAX:  # no answer: x None (the caller says why, never shows zeros)
+                return RawSolution(status=Status.ERROR, iterations=it, solve_time=time.perf_counter() - t0,
+                                   solver_status=f"round {it}: the supports in contact do not hold the plate "
+                                                 f"(M_AA singular to working precision, condition {cond:.1e})",
+                                   extras={"sets": sets})
             z[A] = np.linalg.solve(MAA, -q[A])
         w = M @ z + q
         new = (A & (z > 0)) | (~A & (w < 0))

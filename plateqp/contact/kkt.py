@@ -75,7 +75,13 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     tol = Accuracy.parse(accuracy).tol
     BtR = data.B.T @ R
     r = data.K @ u - data.f + BtR
-    force = max(np.linalg.norm(data.f), np.linalg.norm(BtR), 1e-300)
+    kb = plate_stiffness(data)
+    k = kb / (1.0 + data.rho * kb)  # local_stiffness
+    force = max(np.linalg.norm(data.f), np.linalg.norm(BtR))
+    # no load and no reaction beyond rounding of the heaves' forces (a plate lifted as a body onto
+    # heaved posts): the force scale is what the data can do, the force that closes the largest heave
+    heave = heave_force(data, kb)
+    force = max(heave if force <= NO_WORK * heave else force, 1e-300)
     st = np.linalg.norm(r) / force
     w = data.B @ u
     delta = deflection_scale(data, u, w)
@@ -92,8 +98,7 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     delta = max(delta, min(floor / tol, 1.0) * data.w_load)
     st = max(st, (st - 10.0 * floor) * data.w_load / delta)
     gap = data.g0 + s - w
-    rscale = reaction_scale(R, data.f, tol)
-    k = local_stiffness(data)
+    rscale = reaction_scale(R, data.f, tol, heave)
     natural = np.abs(np.minimum(R, k * gap)).max(initial=0.0) / rscale
     # the same natural residual in deflection units: a support in contact whose gap is left open
     # by ε (its reaction off by about k ε) changes the deflections by ε, which the force scale of
@@ -145,15 +150,53 @@ def defect_residual(data: Scaled, c: ContactSolution, e: np.ndarray, M: np.ndarr
     return float(size)
 
 
-def reaction_scale(R: np.ndarray, f: np.ndarray, tol: float) -> float:
+#: A load (or reactions) below this fraction of :func:`heave_force` does no work that double
+#: precision can show beside the heaves: a plate lifted as a body onto heaved posts carries
+#: reactions of 1e-16 … 1e-15 of it. Only then are forces measured against the heaves' force;
+#: any larger load keeps its own scale (measured against the heaves, a load 1e-5 of them, the
+#: whole of a floating plate's reactions, would pass with any error below tol × 1e5 of itself).
+NO_WORK = 1e-10
+
+
+def heave_force(data: Scaled, kb: np.ndarray | None = None) -> float:
+    """The force that bends the plate by its largest heave where that post stands:
+    max k_i · max(−g0_i, 0), k the plate's own stiffness there (:func:`plate_stiffness`, an
+    upper bound; a soft post's spring left out, as a plate turned as a body about its hinge moves
+    every dof by about the heave, whatever the springs). With no load it is the scale of every
+    force there can be: the reactions of a plate lifted as a body onto heaved posts, and its
+    internal forces K u, are zero to rounding of it. ``kb``: :func:`plate_stiffness`, where
+    the caller has it."""
+    heave = np.maximum(-data.g0, 0.0)
+    if not heave.any():
+        return 0.0
+    kb = plate_stiffness(data) if kb is None else kb
+    return float((kb * heave).max(initial=0.0))
+
+
+def heave_bound(data: Scaled) -> float:
+    """An upper bound of :func:`heave_force` without the Rayleigh quotients (CIRCLE / s² for the
+    plate's stiffness; infinite where the spacings are not known)."""
+    heave = np.maximum(-data.g0, 0.0)
+    if not heave.any():
+        return 0.0
+    if data.spacing is None:
+        return float("inf")
+    return float((CIRCLE / np.maximum(data.spacing, 1e-300) ** 2 * heave).max())
+
+
+def reaction_scale(R: np.ndarray, f: np.ndarray, tol: float, heave: float = 0.0) -> float:
     """The force scale ρ_R of the force residuals: the largest reaction; but where every reaction
-    is at most ``tol`` of the load (‖f‖₁), the supports carry nothing to the accuracy asked and
-    their reactions are measured against the load itself. (Against the largest of them, an
-    interior-point solver's 1e-13 of the load at open supports read as a 100 % error: every
-    scene where nothing touches came back INACCURATE. The deflections those forces cause are
-    still measured, in deflection units, by the natural residual.)"""
+    is at most ``tol`` of the load (‖f‖₁; where the load and the reactions are below
+    ``NO_WORK`` × ``heave``, :func:`heave_force`, that force), the supports carry nothing to the
+    accuracy asked and their reactions are measured against that. (Against
+    the largest of them, an interior-point solver's 1e-13 of the load at open supports read as a
+    100 % error: every scene where nothing touches came back INACCURATE; with no load, a rigid
+    lift's reactions of 1e-16 read as 100 % errors of themselves. The deflections those forces
+    cause are still measured, in deflection units, by the natural residual.)"""
     rmax = np.abs(R).max(initial=0.0)
     load = np.abs(f).sum()
+    if max(load, rmax) <= NO_WORK * heave:  # no load that does work beside the heaves
+        load = heave
     if rmax <= tol * load:
         return max(load, 1e-300)
     return max(rmax, 1e-12 * load, 1e-300)
@@ -213,7 +256,13 @@ def local_stiffness(data: Scaled) -> np.ndarray:
     # 1/(b K⁻¹ bᵀ) from above, whatever K is. Σ b_j² K_jj is no bound where most of a support's
     # interpolation weight sits on prescribed dofs (a support beside a clamped edge: it said 11.9
     # where the plate's stiffness is about 8e4, and wrong reactions passed; issue 10).
+    kb = plate_stiffness(data)
+    return kb / (1.0 + data.rho * kb)
+
+
+def plate_stiffness(data: Scaled) -> np.ndarray:
+    """The plate's own part of :func:`local_stiffness` (without the supports' springs)."""
     kb = row_stiffness(data.K, data.B, "rayleigh")
     if data.spacing is not None:
         kb = np.minimum(kb, CIRCLE / np.maximum(data.spacing, 1e-300) ** 2)
-    return kb / (1.0 + data.rho * kb)
+    return kb

@@ -6,6 +6,7 @@ support made two-sided (each support holds the plate at its gap, in both directi
 
 from __future__ import annotations
 
+import logging
 import time
 import warnings
 
@@ -19,11 +20,13 @@ from ..errors import MechanismError, NoEquilibriumError, PlateQPWarning, Problem
 from ..linalg import solve_saddle
 from ..results import Result
 from .formulations import ContactSolution, Formulation, formulate
-from .kkt import defect_residual, kkt_report, reaction_scale
+from .kkt import NO_WORK, defect_residual, heave_bound, heave_force, kkt_report, reaction_scale
 from .predict import check_predict, predicted_set, wanted
-from .routing import choose, formulations_for
+from .routing import choose, fallback_routes, formulations_for
 from .scaling import Scaled
 from .statics import NO_EQUILIBRIUM, settle, supports_reach
+
+log = logging.getLogger(__name__)
 
 
 def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto",
@@ -37,6 +40,11 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     UNBOUNDED, with its certificate) is checked against the same statics, and a false claim is a
     SolverError, never a NoEquilibriumError. Within the asked accuracy of the edge of the
     supports' reach statics cannot tell, and the backend's verdict stands either way.
+
+    With ``backend="auto"``, a first route that stops short (a SolverError, or an answer that
+    is not OPTIMAL and not merely at the rounding floor) hands over to the next exact route
+    (:func:`plateqp.contact.routing.fallback_routes`); ``extras["route"]`` says which route
+    answered and why each one before it stopped. The first route runs exactly as without it.
     """
     acc = Accuracy.parse(accuracy)  # ProblemError for a bad one, before any work
     options = dict(options or {})
@@ -49,7 +57,6 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({reach.why}; found by statics, before any solve)")
     # within the band of the asked accuracy around the edge of the supports' reach, statics cannot
     # tell, and a solver's own verdict stands: "no equilibrium" there is no solver failure
-    possible, why = reach.certain, reach.why
     asked_backend, asked_formulation = backend, formulation
     backend, formulation = choose(data, backend, formulation)
     b = get_backend(backend)
@@ -67,6 +74,77 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         backend, formulation = choose(data, asked_backend, "primal")
         b = get_backend(backend)
         form = formulate(data, formulation)
+    if getattr(b, "definite", False) and data.floating:  # a SolverError, as the solver's own refusal was
+        raise SolverError(
+            f"backend {backend!r} needs a positive definite Hessian, and a plate its two-sided supports do not hold "
+            f"(free to move as a body) has only a semidefinite one in the primal and condensed formulations; "
+            f"formulation='dual' needs two-sided supports (edges, pins) that hold it: add them, or use a backend "
+            f"that takes a semidefinite Hessian: pdas (primal), lemke or bpp (condensed), clarabel or osqp")
+    route = f"{backend}/{formulation}"
+    if asked_backend != "auto":
+        return _solve_route(model, data, reach, form, backend, acc, options, predict, t0)
+    tried: list[dict] = []
+    first_error = None
+    with warnings.catch_warnings(record=True) as said:  # said again below if this answer is kept
+        warnings.simplefilter("always", PlateQPWarning)
+        try:
+            res = _solve_route(model, data, reach, form, backend, acc, options, predict, t0)
+        except SolverError as exn:
+            res, first_error = None, exn
+            tried.append({"route": route, "status": "error", "why": str(exn)})
+        else:
+            tried.append(_attempt(route, res))
+    if res is not None and (res.status == Status.OPTIMAL or res.kkt.at_floor):
+        for w in said:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        res.extras["route"] = {"answered": route, "tried": tried}
+        return res
+    best = res
+    for nb, nf in fallback_routes(data, route):
+        t1 = time.perf_counter()
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", PlateQPWarning)  # one warning, for the answer kept
+                # the options given were for the first route; another backend takes its defaults
+                nxt = _solve_route(model, data, reach, formulate(data, nf), nb, acc, {}, predict, t1)
+        except (SolverError, ProblemError, MechanismError) as exn:
+            tried.append({"route": f"{nb}/{nf}", "status": "error", "why": str(exn)})
+            continue
+        tried.append(_attempt(f"{nb}/{nf}", nxt))
+        if best is None or (nxt.kkt is not None and best.kkt is not None and nxt.kkt.worst < best.kkt.worst):
+            best = nxt
+        if nxt.status == Status.OPTIMAL:
+            break
+    if best is None:
+        raise SolverError("backend auto: no route answered: "
+                          + "; ".join(f"{t['route']}: {t['why']}" for t in tried)) from first_error
+    best.extras["route"] = {"answered": f"{best.backend}/{best.formulation}", "tried": tried}
+    best.times["total_routes"] = time.perf_counter() - t0
+    if best.status == Status.OPTIMAL:
+        log.info("backend auto: %s answered after %s", tried[-1]["route"],
+                 "; ".join(f"{t['route']} {t['why']}" for t in tried[:-1]))
+    else:
+        warnings.warn(f"backend auto: no route answered to the accuracy asked; kept {best.backend} on the "
+                      f"{best.formulation} problem ({best.extras['why']}); tried "
+                      + "; ".join(f"{t['route']}: {t.get('why', t['status'])}" for t in tried), PlateQPWarning,
+                      stacklevel=3)
+    return best
+
+
+def _attempt(route: str, res: Result) -> dict:
+    """What one route of backend="auto" did: its status, and why it stopped short if it did."""
+    out = {"route": route, "status": res.status.value}
+    if res.status != Status.OPTIMAL:
+        out["why"] = res.extras.get("why") or res.status.value
+    return out
+
+
+def _solve_route(model: Model, data: Scaled, reach, form: Formulation, backend: str, acc: Accuracy,
+                 options: dict, predict, t0: float) -> Result:
+    """One route: a formulated problem solved by one backend, recovered and checked."""
+    b = get_backend(backend)
+    formulation = form.name
+    possible, why = reach.certain, reach.why
     problem = form.problem(b.accepts)
     t1 = time.perf_counter()
     first = options
@@ -129,11 +207,14 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
             why = (f"; the stationarity residual is at its rounding floor ({res.kkt.floor:.1e}) on this plate: "
                    "no answer in double precision can show the accuracy asked, ask "
                    f"{10.0 ** np.ceil(np.log10(res.kkt.floor)):.0e} or more")
-        warnings.warn(f"{backend} on the {formulation} problem: {res.status.value} "
-                      f"(worst KKT residual {res.kkt.worst:.2e}, asked {res.kkt.tol:.0e}){why}", PlateQPWarning,
-                      stacklevel=3)
+        said = f"{raw.solver_status}; " if raw.solver_status and raw.status != Status.OPTIMAL else ""
+        res_why = f"{said}worst KKT residual {res.kkt.worst:.2e}, asked {res.kkt.tol:.0e}{why}"
+        warnings.warn(f"{backend} on the {formulation} problem: {res.status.value} ({res_why})", PlateQPWarning,
+                      stacklevel=4)
     res.iterations = iterations
     res.extras = {"solver_status": raw.solver_status, **raw.extras, "predicted": predicted}
+    if res.status != Status.OPTIMAL:  # why it stopped short, in words (Result.to_dict: "why")
+        res.extras["why"] = f"{res.status.value}: {res_why}"
     if form.max_corrections:
         res.extras["corrections"] = corrections
         if failed is not None:
@@ -189,7 +270,10 @@ def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, ba
     local = np.maximum.reduce([np.full(R.shape, data.w_load * data.W), np.abs(model.contacts.g0), np.abs(w),
                                np.abs(s)]) if R.size else np.zeros(0)
     # (reactions all below tol of the load are zero to the asked accuracy: kkt.reaction_scale)
-    active = (c.R > tol * reaction_scale(c.R, data.f, tol)) | (np.abs(gaps) <= tol * np.maximum(local, 1e-300))
+    # the heaves' force counts only where the load does no work beside it (kkt.NO_WORK): its
+    # Rayleigh quotients are not computed where a cheap bound says the load does
+    heave = heave_force(data) if np.abs(data.f).sum() <= NO_WORK * heave_bound(data) else 0.0
+    active = (c.R > tol * reaction_scale(c.R, data.f, tol, heave)) | (np.abs(gaps) <= tol * np.maximum(local, 1e-300))
     return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
                   accuracy=acc.asked, reactions=R, gaps=gaps, compressions=s, active=active, residual=res,
                   deflection_unique=unique)

@@ -119,6 +119,18 @@ def choose(data: Scaled, backend: str, formulation: str) -> tuple[str, str]:
     return backend, formulation
 
 
+def fallback_routes(data: Scaled, first: str) -> list[tuple[str, str]]:
+    """The exact routes backend="auto" tries, in order, after its first route (``first``,
+    "backend/formulation") stopped short: pdas on the primal problem, then the exact LCP
+    solvers (bpp, lemke) on the condensed problem and, where two-sided supports hold the plate,
+    on the dual one. The condensed and dual problems are dense (m² numbers, m³ work), so they
+    are offered while m ≤ AUTO_CONDENSED_MAX."""
+    forms = ["primal"]
+    if data.m <= AUTO_CONDENSED_MAX:
+        forms += ["condensed"] + ([] if data.floating else ["dual"])
+    return [(b, f) for f in forms for b in exact_backends(f, data) if f"{b}/{f}" != first]
+
+
 def formulations_for(backend) -> list[str]:
     """The formulations a backend can solve: every one for a QP backend, condensed and dual for
     an LCP backend, restricted further by the backend's optional ``formulations`` attribute

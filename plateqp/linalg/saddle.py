@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import structural_rank
 
 from ..errors import SingularMatrixError
 
@@ -22,6 +23,11 @@ def solve_saddle(K, B, rho, f, g, refine: int = 2) -> tuple[np.ndarray, np.ndarr
     n = K.shape[0]
     A = sp.bmat([[K, B.T], [B, -sp.diags(np.asarray(rho, dtype=float))]], format="csc")
     rhs = np.concatenate([np.asarray(f, dtype=float), np.asarray(g, dtype=float)])
+    if structural_rank(A) < A.shape[0]:
+        # more held rows than the dofs they act on (many rigid supports in one element): SuperLU
+        # would factorise it and its solve call BLAS with negative sizes ("On entry to DTRSV
+        # parameter number 6 had an illegal value", printed by BLAS itself)
+        raise SingularMatrixError("the saddle-point system is singular: more rows than the dofs they act on")
     try:
         lu = spla.splu(A)
         x = lu.solve(rhs)

@@ -86,7 +86,9 @@ the rows act on held by a spring of ``ANCHOR·K_jj`` (``10⁻⁸``: the contacts
 that shift on its trailing diagonal, definite where the rows, held, hold the plate), found
 by the dense steps on its LCP without exact steps (:func:`.dense.anchored_set`); the sparse
 method's exact steps then solve the plate itself from that set (``extras["first_phase"] ==
-"anchored"``, option ``anchor_start``), on the anchored factorisation itself where the rows'
+"anchored"``, option ``anchor_start``; where that set leaves the plate free to move, as one
+heaved post under a plate with no load does, and its factor with the rows' penalty is not
+definite to working precision, they start again from every row: ``extras["anchored_dropped"]``), on the anchored factorisation itself where the rows'
 dofs are few enough (its trailing block replaced by the dense Cholesky of ``S + B_cᵀ W_A B_c``,
 :class:`.factor.TrailingFactor`; ``extras["factor"] == "trailing"``, its dense factorisations in
 ``trailing_factorisations``; no second sparse factorisation: a floating 128² slab on 9 posts

@@ -16,7 +16,7 @@ from ..base import QP
 #: rigid motions from its coordinates: about 1e-15 at 128²).
 NULL_ROUNDING = 1e-10
 
-__all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "infeasible", "natural_residuals"]
+__all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "heave_force", "infeasible", "natural_residuals"]
 
 #: A step is exact when its residuals are within this many ε of the terms that make them
 #: (:func:`at_rounding`).
@@ -176,13 +176,36 @@ def at_rounding(pb: ReducedQP, u: np.ndarray, idx: np.ndarray, BA, lamA: np.ndar
     return bool(np.all(np.abs(r_A) <= eps * sA.max(initial=0.0)))
 
 
-def force_scale(pb: ReducedQP, lam: np.ndarray) -> float:
-    return max(np.abs(lam).max(initial=0.0), 1e-12 * np.abs(pb.f).sum(), np.finfo(float).tiny)
+def heave_force(pb: ReducedQP) -> float:
+    """The force that closes the largest negative gap at its row's own stiffness (the row's
+    spring left out): max k_i · max(−g_i, 0)."""
+    return float((pb.k * np.maximum(-pb.g, 0.0)).max(initial=0.0))
+
+
+#: Load and reactions below this fraction of :func:`heave_force` do no work beside the negative
+#: gaps (plateqp.contact.kkt.NO_WORK): forces are then measured against that force.
+NO_WORK = 1e-10
+
+
+def force_scale(pb: ReducedQP, lam: np.ndarray, tol: float = 0.0) -> float:
+    """The force scale of the reactions: the largest, at least 1e-12 of the load ‖f‖₁; where
+    every reaction is at most ``tol`` of the load, the load itself; where the load and the
+    reactions are below NO_WORK of :func:`heave_force`, that force takes the load's place (with
+    no load, the reactions of a plate lifted as a body onto negative gaps are rounding of it,
+    not of themselves: measured against themselves they never settled)."""
+    load = np.abs(pb.f).sum()
+    rmax = np.abs(lam).max(initial=0.0)
+    heave = heave_force(pb)
+    if max(load, rmax) <= NO_WORK * heave:
+        load = heave
+    if rmax <= tol * load:
+        return max(load, np.finfo(float).tiny)
+    return max(rmax, 1e-12 * load, np.finfo(float).tiny)
 
 
 def infeasible(pb: ReducedQP, A: np.ndarray, lam: np.ndarray, gap: np.ndarray, feas_tol: float) -> np.ndarray:
     """Rows to exchange: active with a negative reaction, inactive with a negative gap."""
-    F = feas_tol * force_scale(pb, lam)
+    F = feas_tol * force_scale(pb, lam, feas_tol)
     return (A & (lam < -F)) | (~A & (pb.c * gap < -F))
 
 
@@ -191,10 +214,13 @@ class Outcome:
         self.status, self.message, self.A, self.u, self.lam, self.it, self.ray = status, message, A, u, lam, it, ray
 
 
-def natural_residuals(pb: ReducedQP, u: np.ndarray, lam: np.ndarray) -> tuple[float, float]:
-    """Relative natural residual and relative stationarity residual of ``(u, λ)``."""
+def natural_residuals(pb: ReducedQP, u: np.ndarray, lam: np.ndarray, tol: float = 0.0) -> tuple[float, float]:
+    """Relative natural residual and relative stationarity residual of ``(u, λ)``; where the
+    load and the reactions are below NO_WORK of :func:`heave_force`, forces are measured
+    against that."""
     gap = pb.g + pb.rho * lam - pb.B @ u
-    nat = float(np.abs(np.minimum(lam, pb.c * gap)).max(initial=0.0) / force_scale(pb, lam))
+    nat = float(np.abs(np.minimum(lam, pb.c * gap)).max(initial=0.0) / force_scale(pb, lam, tol))
     BtL = pb.B.T @ lam
-    st = float(np.linalg.norm(pb.K @ u - pb.f + BtL) / max(np.linalg.norm(pb.f), np.linalg.norm(BtL), 1e-300))
+    force, heave = max(np.linalg.norm(pb.f), np.linalg.norm(BtL)), heave_force(pb)
+    st = float(np.linalg.norm(pb.K @ u - pb.f + BtL) / max(heave if force <= NO_WORK * heave else force, 1e-300))
     return nat, st
