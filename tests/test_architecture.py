@@ -42,7 +42,7 @@ MAX_DOCSTRING_LINES = 60
 FLOORS = ("plateqp.scene", "plateqp.geometry", "plateqp.paths", "plateqp.mesh", "plateqp.trimesh",
           "plateqp.elements", "plateqp.constraints", "plateqp.assembly",
           "plateqp.contact")
-KNOWN_LONG_FUNCTIONS: set[str] = {"plateqp.scene:validate", "plateqp.contact.pipeline:solve_contact"}
+KNOWN_LONG_FUNCTIONS: set[str] = {"plateqp.scene:validate"}
 KNOWN_LONG_DOCSTRINGS: set[str] = {"plateqp.backends.pdas", "plateqp.backends.bpp", "plateqp.backends.lemke",
                                    "plateqp.backends.pgs"}
 

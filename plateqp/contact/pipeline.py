@@ -9,6 +9,7 @@ from __future__ import annotations
 import logging
 import time
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -57,6 +58,16 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({reach.why}; found by statics, before any solve)")
     # within the band of the asked accuracy around the edge of the supports' reach, statics cannot
     # tell, and a solver's own verdict stands: "no equilibrium" there is no solver failure
+    chosen, form = _route(data, backend, formulation)
+    step = _Step(model, data, reach, acc, predict)
+    if backend != "auto":
+        return step.solve(form, chosen, options, t0)
+    return _auto(step, form, chosen, options, t0)
+
+
+def _route(data: Scaled, backend: str, formulation: str) -> tuple[str, Formulation]:
+    """The backend and formulated problem asked for ("auto": chosen), checked: the backend takes
+    the formulation; one that needs a positive definite Hessian is not given a floating plate."""
     asked_backend, asked_formulation = backend, formulation
     backend, formulation = choose(data, backend, formulation)
     b = get_backend(backend)
@@ -80,15 +91,20 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
             f"(free to move as a body) has only a semidefinite one in the primal and condensed formulations; "
             f"formulation='dual' needs two-sided supports (edges, pins) that hold it: add them, or use a backend "
             f"that takes a semidefinite Hessian: pdas (primal), lemke or bpp (condensed), clarabel or osqp")
-    route = f"{backend}/{formulation}"
-    if asked_backend != "auto":
-        return _solve_route(model, data, reach, form, backend, acc, options, predict, t0)
+    return backend, form
+
+
+def _auto(step: _Step, form: Formulation, backend: str, options: dict, t0: float) -> Result:
+    """backend="auto": the chosen route, and where it stops short the next exact routes
+    (:func:`plateqp.contact.routing.fallback_routes`), keeping the first OPTIMAL answer, else
+    the one with the smallest KKT residual."""
+    route = f"{backend}/{form.name}"
     tried: list[dict] = []
     first_error = None
     with warnings.catch_warnings(record=True) as said:  # said again below if this answer is kept
         warnings.simplefilter("always", PlateQPWarning)
         try:
-            res = _solve_route(model, data, reach, form, backend, acc, options, predict, t0)
+            res = step.solve(form, backend, options, t0, depth=5)
         except SolverError as exn:
             res, first_error = None, exn
             tried.append({"route": route, "status": "error", "why": str(exn)})
@@ -100,13 +116,13 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         res.extras["route"] = {"answered": route, "tried": tried}
         return res
     best = res
-    for nb, nf in fallback_routes(data, route):
+    for nb, nf in fallback_routes(step.data, route):
         t1 = time.perf_counter()
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", PlateQPWarning)  # one warning, for the answer kept
                 # the options given were for the first route; another backend takes its defaults
-                nxt = _solve_route(model, data, reach, formulate(data, nf), nb, acc, {}, predict, t1)
+                nxt = step.solve(formulate(step.data, nf), nb, {}, t1, depth=5)
         except (SolverError, ProblemError, MechanismError) as exn:
             tried.append({"route": f"{nb}/{nf}", "status": "error", "why": str(exn)})
             continue
@@ -127,7 +143,7 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
         warnings.warn(f"backend auto: no route answered to the accuracy asked; kept {best.backend} on the "
                       f"{best.formulation} problem ({best.extras['why']}); tried "
                       + "; ".join(f"{t['route']}: {t.get('why', t['status'])}" for t in tried), PlateQPWarning,
-                      stacklevel=3)
+                      stacklevel=4)
     return best
 
 
@@ -139,41 +155,87 @@ def _attempt(route: str, res: Result) -> dict:
     return out
 
 
-def _solve_route(model: Model, data: Scaled, reach, form: Formulation, backend: str, acc: Accuracy,
-                 options: dict, predict, t0: float) -> Result:
-    """One route: a formulated problem solved by one backend, recovered and checked."""
-    b = get_backend(backend)
-    formulation = form.name
-    possible, why = reach.certain, reach.why
-    problem = form.problem(b.accepts)
-    t1 = time.perf_counter()
-    first = options
-    predicted = {"why": wanted(model, data, backend, formulation, options, predict)}
-    if predicted["why"] is None:  # the coarse mesh's contact set starts the solve
-        A0, predicted = predicted_set(model, solve_contact)
-        if A0 is not None:
-            first = dict(options, active=A0)
-    t_predict = time.perf_counter() - t1
-    t1 = time.perf_counter()
-    raw = b.solve(problem, accuracy=acc, options=first)
-    t2 = time.perf_counter()
-    if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED):  # the backend's certificate, in QP/LCP terms
-        verdict = f"{backend} on the {formulation} problem ended {raw.status.value} ({raw.solver_status})"
-        if possible:
-            raise SolverError(f"{verdict}, but statics says the supports can carry the load: the solver failed")
-        raise NoEquilibriumError(f"{verdict}: {NO_EQUILIBRIUM} ({why})")
-    if raw.x is None:
-        raise SolverError(f"{backend} on the {formulation} problem returned no solution: "
-                          f"{raw.status.value} ({raw.solver_status})")
-    res = finish(model, form, raw, acc, backend)
-    iterations, corrections, solve_s = raw.iterations, 0, t2 - t1
-    # a formulation whose own data explain a failing answer (the dual's G from the trailing
-    # block: Dual.defect) hands the backend a corrected problem; the backend's own error is
-    # never corrected. Not worth a re-solve: a change below a tenth of the tolerance, or below a
-    # quarter of the worst residual (the rest is the backend's, which another round keeps).
-    # The answer kept is always the best one checked: a round that fails, or ends worse, is
-    # dropped (and said in extras["correction_failed"]), never raised over an answer in hand.
-    failed = None
+@dataclass
+class _Step:
+    """What every route of one solve shares: the model, its scaled data, the statics of the
+    supports' reach, the accuracy asked and the prediction option."""
+
+    model: Model
+    data: Scaled
+    reach: object
+    acc: Accuracy
+    predict: object
+
+    def solve(self, form: Formulation, backend: str, options: dict, t0: float, depth: int = 4) -> Result:
+        """One route: a formulated problem solved by one backend, recovered and checked (and
+        corrected where the formulation's own data explain a failing answer). ``depth``: the
+        stack level of the user's call, for the warning."""
+        b = get_backend(backend)
+        raw, t_predict, predicted, solve_s, t1 = self._first(form, b, backend, options)
+        res = finish(self.model, form, raw, self.acc, backend)
+        form, raw, res, corrections, iterations, failed, more = _corrections(
+            self.model, form, raw, res, b, backend, options, self.acc)
+        solve_s += more
+        if res.status != Status.OPTIMAL:
+            why = ""
+            if res.kkt.at_floor:
+                why = (f"; the stationarity residual is at its rounding floor ({res.kkt.floor:.1e}) on this plate: "
+                       "no answer in double precision can show the accuracy asked, ask "
+                       f"{10.0 ** np.ceil(np.log10(res.kkt.floor)):.0e} or more")
+            said = f"{raw.solver_status}; " if raw.solver_status and raw.status != Status.OPTIMAL else ""
+            res_why = f"{said}worst KKT residual {res.kkt.worst:.2e}, asked {res.kkt.tol:.0e}{why}"
+            warnings.warn(f"{backend} on the {form.name} problem: {res.status.value} ({res_why})", PlateQPWarning,
+                          stacklevel=depth)
+        res.iterations = iterations
+        res.extras = {"solver_status": raw.solver_status, **raw.extras, "predicted": predicted}
+        if res.status != Status.OPTIMAL:  # why it stopped short, in words (Result.to_dict: "why")
+            res.extras["why"] = f"{res.status.value}: {res_why}"
+        if form.max_corrections:
+            res.extras["corrections"] = corrections
+            if failed is not None:
+                res.extras["correction_failed"] = failed
+        res.times.update(formulate=t1 - t0 - t_predict, predict=t_predict, solve=solve_s,
+                         recover=time.perf_counter() - t1 - solve_s)
+        return res
+
+    def _first(self, form: Formulation, b, backend: str, options: dict):
+        """The backend's first answer (started from the coarse mesh's contact set where that is
+        wanted): (raw, predict time, what the prediction did, solve time, its start). A backend's
+        claim of no equilibrium is checked against statics."""
+        formulation = form.name
+        problem = form.problem(b.accepts)
+        t1 = time.perf_counter()
+        first = options
+        predicted = {"why": wanted(self.model, self.data, backend, formulation, options, self.predict)}
+        if predicted["why"] is None:  # the coarse mesh's contact set starts the solve
+            A0, predicted = predicted_set(self.model, solve_contact)
+            if A0 is not None:
+                first = dict(options, active=A0)
+        t_predict = time.perf_counter() - t1
+        t1 = time.perf_counter()
+        raw = b.solve(problem, accuracy=self.acc, options=first)
+        t2 = time.perf_counter()
+        if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED):  # the backend's certificate, in QP/LCP terms
+            verdict = f"{backend} on the {formulation} problem ended {raw.status.value} ({raw.solver_status})"
+            if self.reach.certain:
+                raise SolverError(f"{verdict}, but statics says the supports can carry the load: the solver failed")
+            raise NoEquilibriumError(f"{verdict}: {NO_EQUILIBRIUM} ({self.reach.why})")
+        if raw.x is None:
+            raise SolverError(f"{backend} on the {formulation} problem returned no solution: "
+                              f"{raw.status.value} ({raw.solver_status})")
+        return raw, t_predict, predicted, t2 - t1, t1
+
+
+def _corrections(model: Model, form: Formulation, raw: RawSolution, res: Result, b, backend: str, options: dict,
+                 acc: Accuracy):
+    """Re-solves where the formulation's own data explain a failing answer (the dual's G from the
+    trailing block: Dual.defect); the backend's own error is never corrected. Not worth a
+    re-solve: a change below a tenth of the tolerance, or below a quarter of the worst residual
+    (the rest is the backend's, which another round keeps). The answer kept is always the best
+    one checked: a round that fails, or ends worse, is dropped (and said as ``failed``), never
+    raised over an answer in hand. Returns (form, raw, res, corrections, iterations, failed,
+    solve time)."""
+    iterations, corrections, solve_s, failed = raw.iterations, 0, 0.0, None
     while corrections < form.max_corrections and raw.status.solved and not res.kkt.ok:
         e = form.defect(raw)
         size = defect_residual(form.data, form.recover(raw), e, form.lcp.M, acc.tol)
@@ -201,27 +263,7 @@ def _solve_route(model: Model, data: Scaled, reach, form: Formulation, backend: 
         form, raw, res, corrections = nxt, again, checked, corrections + 1
         if raw.iterations is not None:
             iterations = (iterations or 0) + raw.iterations
-    if res.status != Status.OPTIMAL:
-        why = ""
-        if res.kkt.at_floor:
-            why = (f"; the stationarity residual is at its rounding floor ({res.kkt.floor:.1e}) on this plate: "
-                   "no answer in double precision can show the accuracy asked, ask "
-                   f"{10.0 ** np.ceil(np.log10(res.kkt.floor)):.0e} or more")
-        said = f"{raw.solver_status}; " if raw.solver_status and raw.status != Status.OPTIMAL else ""
-        res_why = f"{said}worst KKT residual {res.kkt.worst:.2e}, asked {res.kkt.tol:.0e}{why}"
-        warnings.warn(f"{backend} on the {formulation} problem: {res.status.value} ({res_why})", PlateQPWarning,
-                      stacklevel=4)
-    res.iterations = iterations
-    res.extras = {"solver_status": raw.solver_status, **raw.extras, "predicted": predicted}
-    if res.status != Status.OPTIMAL:  # why it stopped short, in words (Result.to_dict: "why")
-        res.extras["why"] = f"{res.status.value}: {res_why}"
-    if form.max_corrections:
-        res.extras["corrections"] = corrections
-        if failed is not None:
-            res.extras["correction_failed"] = failed
-    res.times.update(formulate=t1 - t0 - t_predict, predict=t_predict, solve=solve_s,
-                     recover=time.perf_counter() - t1 - solve_s)
-    return res
+    return form, raw, res, corrections, iterations, failed, solve_s
 
 
 def finish(model: Model, form: Formulation, raw: RawSolution, accuracy: str | float | Accuracy,
