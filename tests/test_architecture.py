@@ -43,8 +43,7 @@ FLOORS = ("plateqp.scene", "plateqp.geometry", "plateqp.paths", "plateqp.mesh", 
           "plateqp.elements", "plateqp.constraints", "plateqp.assembly",
           "plateqp.contact")
 KNOWN_LONG_FUNCTIONS: set[str] = {"plateqp.scene:validate"}
-KNOWN_LONG_DOCSTRINGS: set[str] = {"plateqp.backends.pdas", "plateqp.backends.bpp", "plateqp.backends.lemke",
-                                   "plateqp.backends.pgs"}
+KNOWN_LONG_DOCSTRINGS: set[str] = set()
 
 
 def module_name(path: Path) -> str:

@@ -1,125 +1,34 @@
 r"""Block principal pivoting (Júdice & Pires 1994) for LCP(M, q), in NumPy/SciPy.
 
-The problem
------------
-Find ``z ≥ 0`` such that ``w = M z + q ≥ 0`` and ``zᵀ w = 0``; here ``M`` is
-symmetric positive (semi)definite, or any P-matrix. (On a plate on one-sided
-supports ``M`` is the condensed stiffness, or the flexibility for the dual
-formulation: symmetric, and only semidefinite for a floating plate.)
+Finds ``z ≥ 0`` with ``w = M z + q ≥ 0`` and ``zᵀ w = 0`` for ``M`` symmetric positive
+(semi)definite or any P-matrix (a plate's condensed stiffness or flexibility). The unknowns are
+split into ``F`` (``z_F`` free, ``w_F = 0``) and ``T`` (``z_T = 0``); each split is one solve
+``M_FF z_F = −q_F``; all infeasible indices are exchanged at once, and where the count of
+infeasibilities has not fallen for ``p`` steps (default 6) Murty's least-index rule exchanges
+one at a time until it does (finite for every P-matrix).
 
-The method
-----------
-J. J. Júdice and F. M. Pires, *A block principal pivoting algorithm for
-large-scale strictly monotone linear complementarity problems*, Computers &
-Operations Research 21(5) (1994). The unknowns are split into a
-complementary pair of sets: ``F`` (``z_F`` free, ``w_F = 0``) and its
-complement ``T`` (``z_T = 0``, ``w_T`` free). For a given split, the
-complementary basic solution is one linear solve::
+Contract:
 
-    M_FF z_F = −q_F,    z_T = 0,    w_T = q_T + M_TF z_F.
+- **Start and warm start.** Default ``F = {i : q_i < −feas_tol ‖q‖∞}``. Option ``active``: a
+  boolean array, ``True`` where ``z_i = 0`` is held (the set ``T``); the final split comes back
+  in ``extras["active"]`` in the same form. On a plate's condensed form (z = gaps) that is "in
+  contact", on its dual (z = reactions) "not in contact".
+- **Singular blocks** (PSD ``M``, a floating plate): detected by a small pivot of the
+  equilibrated block, then solved through its eigendecomposition: a consistent block takes the
+  minimum-norm solution (made nonnegative by a small LP where it can), an inconsistent one
+  either yields a Farkas certificate ``y ≥ 0``, ``M y = 0``, ``qᵀy < 0`` (status ``INFEASIBLE``,
+  ``y`` in ``extras["certificate"]``, checked on the full ``M``) or sends the indices the steepest
+  descent drives to zero into ``T``. A split seen twice ends the pivoting; then the whole LCP is
+  tested for solvability and proximal-point steps (``PROX_EPS``) finish it.
+- **Answer and status.** One clean solve on the final split (with one step of refinement),
+  negatives down to ``feas_tol`` of its scale set to zero, ``w = M z + q`` from the full ``M``;
+  ``OPTIMAL`` only if the relative natural residual (:func:`plateqp.backends.lcp.natural_residual`)
+  is at most ``accept_tol``, else ``INACCURATE``: a wrong ``OPTIMAL`` cannot come out of the
+  pivoting. ``ERROR`` (no ``x``) or ``MAX_ITER`` (the best split's ``x``) otherwise.
+- **Accuracy.** A direct method, exact to about ``cond(M_FF) · ε``; the presets of
+  :data:`ACCURACY` set ``feas_tol`` and ``accept_tol`` only.
 
-The split is optimal when it is feasible, ``z_F ≥ 0`` and ``w_T ≥ 0``. Otherwise
-the infeasible indices ``H1 = {i ∈ F : z_i < 0}`` and
-``H2 = {i ∈ T : w_i < 0}`` are all exchanged at once (a *block* principal
-pivot): ``F ← (F − H1) ∪ H2``. Block pivoting alone can cycle, so the number
-of infeasibilities ``|H1 ∪ H2|`` is watched: when it has not decreased for
-``p`` consecutive steps (``p = 6`` by default; the paper's 3 measured slower, see ``p`` below) the method
-falls back on Murty's single principal pivoting rule — exchange only the
-*least* index of ``H1 ∪ H2`` — until the count drops below its best value, and
-then block pivoting resumes. Murty's rule alone terminates for every
-P-matrix (K. G. Murty, *Note on a Bard-type scheme for solving the
-complementarity problem*, Opsearch 11, 1974), hence so does the whole method.
-(Kim & Park's statement of the same safeguard for NNLS, SIAM J. Sci. Comput.
-33, 2011, takes the *largest* index: any fixed order of the indices is
-Murty's rule.)
-
-Default start: ``F = {i : q_i < −feas_tol ‖q‖∞}``, i.e. ``z_i = 0`` is held where
-``q_i ≥ 0`` up to rounding (``w_i ≥ 0`` at ``z = 0``, by the test that judges every
-``w``). Option ``active`` gives another start: a boolean
-array, ``True`` where ``z_i = 0`` is held (the set ``T``). The final split is
-returned in ``extras["active"]`` in the same form, so that a sequence of
-neighbouring problems can warm start each solve from the previous one. **What
-``active`` means is the LCP's**: ``z_i = 0``. (On a plate's condensed form, z =
-gaps, that is "support in contact"; on its dual, z = reactions, "*not* in
-contact".)
-
-Each step factorises the principal block afresh (Cholesky, ``O(|F|³/3)``
-flops; LU when ``M`` is not symmetric); there are no updates, so rounding
-errors do not accumulate from step to step. ``w`` is then one product
-``M z + q`` (``O(n²)``).
-
-Singular blocks (positive semidefinite M)
------------------------------------------
-For symmetric PSD ``M`` a principal block ``M_FF`` can be singular (on a
-floating plate: when the supports in ``T`` leave a rigid motion free). Such a
-block is detected by a squared pivot below ``1000 · sing_tol`` in the Cholesky factor of
-the equilibrated block ``D M_FF D``, ``D = diag(M_FF)^-½`` (or a failed Cholesky),
-and then decomposed ``M_FF = V Λ Vᵀ``; eigenvalues at most
-``sing_tol · λ_max`` count as zero, ``N`` spans their eigenvectors and
-``P = N Nᵀ``. With ``b = −q_F``:
-
-* ``P b ≈ 0`` (at the feasibility tolerance, in the units of ``w``): the system is
-  consistent and every ``z_F + N c`` solves it (with the same ``w``: ``M`` is
-  PSD, so ``M [N c; 0] = 0``). ``z_F`` is the minimum-norm solution
-  ``V Λ⁺ Vᵀ b``; if it has negative entries, a small LP looks for a ``c``
-  that makes ``z_F + N c ≥ 0`` (or, failing that, least negative), and the
-  step goes on as usual with that ``z_F``;
-* otherwise the objective ``½ zᵀMz + qᵀz`` falls without bound along the null
-  space of ``M_FF``. An LP on that null space (``k`` unknowns, ``k ≤ 3`` on a
-  plate) looks for ``y = N c ≥ 0`` with ``qᵀy < 0``: a Farkas certificate that
-  the LCP has no solution (:mod:`~plateqp.backends.lcp`); checked on the full
-  ``M``, it ends the solve with status ``INFEASIBLE`` and ``y`` in
-  ``extras["certificate"]``. Without one, along the steepest descent
-  ``y = P b`` the ``z_i`` with ``y_i < 0`` would reach zero first: they are the
-  infeasible indices of ``F`` (they go to ``T``), with ``z_F`` the
-  least-squares solution.
-
-For PSD ``M`` the finite-termination theorem does not apply, and Murty's rule
-can cycle (measured: a quarter of random rank-deficient ``M = AᵀA``; never on
-the rigid-motion null spaces of floating plates, of dimension ≤ 3). A split seen twice in the
-single-pivot phase, which cannot happen for a P-matrix in exact arithmetic,
-ends the pivoting. Then (also after ``max_iter`` splits if a singular block
-was met):
-
-1. the whole LCP is tested for solvability: for symmetric PSD ``M`` it has no
-   solution iff some ``y ≥ 0`` has ``M y = 0`` and ``qᵀy < 0``; an eigen-
-   decomposition of ``M`` and the LP above on its null space decide it
-   (→ ``INFEASIBLE`` with the certificate);
-2. if it has a solution, proximal-point steps (Rockafellar 1976)
-   ``z ← solution of LCP(M + ε D, q − ε D z)`` with ``D = diag(M)`` and
-   ``ε = PROX_EPS``, each a positive definite problem that the pivoting
-   solves finitely, warm started one from the other; after each, its split is
-   tried once on the original problem. In the measurements 1–3 steps sufficed.
-
-Otherwise the status is ``ERROR`` (no ``x``; ``extras`` holds the best split's
-``z`` and ``w``), or ``MAX_ITER`` (with ``x`` the best split seen) when the
-iteration limit ended it. A failed Cholesky whose eigenvalues show ``M`` is
-not PSD, or a singular block of a non-symmetric ``M``, is an ``ERROR`` at once.
-
-The answer
-----------
-After termination, one clean solve on the final split (the factor of the last
-step, one step of iterative refinement) gives ``z``; negatives down to
-``feas_tol`` of its scale are set to zero and ``w = M z + q`` is computed from
-the full ``M``. The status comes from an independent check of that answer, the
-relative natural residual (:func:`~plateqp.backends.lcp.natural_residual`)
-
-.. math::
-
-    r = \frac{\max_i |\min(M_{ii} z_i,\ w_i)|}{\max(\|w\|_\infty, \|q\|_\infty)},
-
-which covers the signs of ``z`` and ``w`` and complementarity at once (``z_i``
-counted as the ``w_i`` it would take to bring it to zero, ``M_ii z_i``):
-``OPTIMAL`` if ``r ≤ accept_tol``, else ``INACCURATE``. A wrong ``OPTIMAL`` is therefore impossible whatever
-happened inside the pivoting.
-
-Accuracy
---------
-A direct (finite) method: at every preset the answer is exact up to rounding,
-about ``cond(M_FF) · ε`` relative. The presets in :data:`ACCURACY` only set the
-tolerance under which a negative ``z_i`` or ``w_i`` counts as zero
-(``feas_tol``) and the residual above which the answer is flagged
-``INACCURATE`` (``accept_tol``).
+The method, its singular cases and their measurements in detail: docs/design/bpp.md.
 
 Examples
 --------

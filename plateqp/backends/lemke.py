@@ -1,96 +1,30 @@
 r"""Lemke's complementary pivoting method for LCP(M, q), in pure NumPy.
 
-The problem
------------
-Find ``z ≥ 0`` such that ``w = M z + q ≥ 0`` and ``zᵀ w = 0``.
+Finds ``z ≥ 0`` with ``w = M z + q ≥ 0`` and ``zᵀ w = 0``. ``q ≥ 0`` returns ``z = 0`` at once;
+otherwise one artificial variable ``z0`` and a covering vector ``d > 0`` (default all ones: the
+source paper's uniform *pre-compression* of every support) start the pivoting on the tableau
+``B⁻¹ [I | −M | −d | q]``: the initial pivot lets ``z0`` enter, each next entering variable is
+the complement of the one that left, the ratio test picks the leaving row, and the method stops
+when ``z0`` leaves (a complementary solution) or no row blocks (a secondary ray).
 
-If ``q ≥ 0`` then ``z = 0`` is a solution and is returned at once. Otherwise
-Lemke's method adds one artificial variable ``z0 ≥ 0`` and a *covering vector*
-``d > 0`` (default: all ones) and works on
+Contract:
 
-    w − M z − d z0 = q,    w, z, z0 ≥ 0,    w_i z_i = 0  (i = 1 … n).
+- **Termination.** Ties in the ratio test are broken lexicographically over ``[q̄ | B⁻¹] / a``
+  (Lemke on ``q + (ε, ε², …)``; Cottle, Pang & Stone §4.9), and ``z0`` leaves first among tied
+  rows: every basis is visited at most once. ``max_iter`` bounds the pivots (``MAX_ITER``).
+- **No solution.** For copositive-plus ``M`` (any positive semidefinite ``M``) a secondary ray's
+  ``z`` part ``y`` is a certificate, ``y ≥ 0``, ``Mᵀy ≤ 0``, ``qᵀy < 0`` (Cottle, Pang & Stone
+  Thm 4.4.13), checked on ``M``: status ``INFEASIBLE`` with ``y`` in ``extras["certificate"]``;
+  a ray whose ``y`` fails the check is an ``ERROR``. ``M`` is never regularised.
+- **Accuracy.** A direct method: ``z`` is recomputed from the final basis (``B x_B = q``,
+  :func:`numpy.linalg.solve`), negatives down to ``1e-12`` of its scale clipped, ``w = M z + q``
+  from that ``z``. The presets of :data:`ACCURACY` set the pivoting tolerances, how often the
+  tableau is recomputed from the basis, and the residual above which the answer is
+  ``INACCURATE``.
+- **Output.** A :class:`~plateqp.backends.base.RawSolution` (``x = z``, status, pivots in
+  ``iterations``); ``trace=True`` records every pivot in ``extras["trace"]`` (teaching).
 
-The source paper of plateqp calls the covering vector a *pre-compression
-parameter*: ``d z0`` is added to ``q`` so that every support starts in
-compression, ``w = q + d z0 ≥ 0``, and the method then releases ``z0`` until it
-is zero. A uniform covering vector ``d = 1`` amounts to a uniform
-pre-compression of all supports.
-
-The tableau
------------
-The algorithm keeps the tableau of that system, ``n`` rows and ``2n + 2``
-columns. At the start the basis is ``w`` (``B = I``)::
-
-              w_1 … w_n │ z_1 … z_n │  z0   │ rhs
-            ┌───────────┼───────────┼───────┼─────┐
-      w_1   │           │           │ −d_1  │ q_1 │
-       ⋮    │     I     │    −M     │   ⋮   │  ⋮  │
-      w_n   │           │           │ −d_n  │ q_n │
-            └───────────┴───────────┴───────┴─────┘
-
-After any sequence of pivots the tableau is ``B⁻¹ [I | −M | −d | q]``, where
-``B`` holds the columns of the ``n`` basic variables. Hence its first ``n``
-columns *are* ``B⁻¹`` and its last column is ``q̄ = B⁻¹ q``, the current values
-of the basic variables (the non-basic ones are zero). A pivot on row ``r`` and
-column ``j`` is one Gauss–Jordan step: divide row ``r`` by ``T[r, j]`` and
-subtract multiples of it from every other row, a rank-one update costing
-``O(n²)`` flops.
-
-The steps
----------
-1. *Initial pivot.* ``z0`` enters. The row ``r`` that leaves is the one
-   with the most negative ``q_r / d_r``; after the pivot
-   ``z0 = −q_r / d_r`` and ``w = q + d z0 ≥ 0`` with ``w_r = 0``.
-2. *Complementary rule.* The next entering variable is the complement of the
-   one that just left (``w_i`` left → ``z_i`` enters, and vice versa).
-3. *Ratio test.* With ``a = T[:, j]`` the entering column, the basic
-   variables decrease as ``q̄ − a t`` while the entering one grows to ``t``.
-   Rows with ``a_i > 0`` block; the leaving row is the minimiser of
-   ``q̄_i / a_i``, ties broken by the lexicographic rule below. If ``z0`` is
-   among the tied rows it leaves.
-4. *Termination.* When ``z0`` leaves the basis, ``z0 = 0`` and the basic
-   solution is a complementary solution of LCP(M, q). If no row blocks (the
-   entering column has no positive entry) the method has found a *secondary
-   ray*. For a copositive-plus ``M`` — in particular any positive
-   semidefinite ``M`` — the ``z`` part ``y`` of the ray's direction is then
-   a certificate that the LCP has no solution: ``y ≥ 0``, ``Mᵀy ≤ 0``,
-   ``qᵀy < 0`` (Cottle, Pang & Stone, Thm 4.4.13; see
-   :mod:`~plateqp.backends.lcp`). It is checked on ``M``, and the status is
-   ``INFEASIBLE`` with ``y`` in ``extras["certificate"]``; a ray whose ``y``
-   fails the check proves nothing (``M`` is not copositive-plus) and the
-   status is ``ERROR``. ``M`` is never regularised. (On a plate on one-sided
-   supports, whose condensed stiffness or flexibility is positive
-   semidefinite, a ray means the supports cannot carry the load: net uplift,
-   or a load outside their reach.)
-
-Lexicographic rule
-------------------
-Under degeneracy (``q̄_i = 0`` for some basic variable, ties in the ratio
-test) a plain minimum-ratio rule may cycle. The leaving row is therefore the
-lexicographic minimum of the rows of ``[q̄ | B⁻¹]`` divided by ``a_i``, over the
-blocking rows: compare the ``q̄`` ratios first, then, among the tied rows,
-the first column of ``B⁻¹`` divided by ``a_i``, and so on. This is Lemke's
-method applied to the perturbed ``q(ε) = q + (ε, ε², …, εⁿ)`` for an
-infinitesimal ``ε > 0`` (Cottle, Pang & Stone, *The Linear Complementarity
-Problem*, §4.9; Murty, *Linear Complementarity, Linear and Nonlinear
-Programming*, §2.2). The rows of ``B⁻¹`` are linearly independent, so the rule
-always designates a single row, every basis is visited at most once and the
-method terminates. Ties between floating-point numbers are detected with a
-relative tolerance (``zero_tol``). The initial pivot uses the same rule, on
-the rows of ``[q | I] / d``.
-
-Accuracy
---------
-Lemke's method is a direct (finite) method: at every preset the answer is
-exact up to rounding. After termination ``z`` is recomputed from the final
-basis by solving the basic system ``B x_B = q`` directly
-(:func:`numpy.linalg.solve`), negatives not larger than ``1e-12 · scale`` are
-clipped to zero and ``w = M z + q`` is computed from the clipped ``z``. This
-final clean-up solve is what gives machine-precision KKT residuals. The
-presets in :data:`ACCURACY` only change the pivoting tolerances, how often the
-tableau is recomputed from the basis (to stop rounding errors from
-accumulating over many pivots), and the residual above which the result is
-flagged :attr:`~plateqp.backends.base.Status.INACCURATE`.
+The design, the tableau drawn out and the lexicographic rule in detail: docs/design/lemke.md.
 
 Examples
 --------

@@ -1,67 +1,26 @@
 r"""Projected Gauss–Seidel (PGS, with over-relaxation: PSOR) for LCP(M, q), in NumPy.
 
-The problem
------------
-Find ``z ≥ 0`` such that ``w = M z + q ≥ 0`` and ``zᵀ w = 0``; ``M`` symmetric
-positive semidefinite, with a positive diagonal, so that the LCP is the
-optimality condition of  min ½ zᵀMz + qᵀz,  z ≥ 0. (On a plate on one-sided
-supports, ``M`` is the condensed stiffness or the flexibility.)
+Finds ``z ≥ 0`` with ``w = M z + q ≥ 0`` and ``zᵀ w = 0`` for symmetric positive semidefinite
+``M`` with a positive diagonal (the optimality condition of min ½ zᵀMz + qᵀz, z ≥ 0): the
+baseline iterative method, for teaching and comparison (Cryer 1971; Cottle, Pang & Stone §5.2).
+One sweep updates every component in turn from the latest values of the others,
+``z_i ← max(0, z_i − ω (q_i + M_i z) / M_ii)`` (``ω = 1``: PGS; ``0 < ω < 2``: PSOR), with
+``w`` kept up to date by one ``daxpy`` per component that moves and recomputed as ``M z + q``
+every ``RESYNC`` sweeps and before stopping (so the returned ``w`` and residual are exact).
 
-The method
-----------
-The baseline iterative method, for teaching and comparison (Cryer 1971, *The
-solution of a quadratic programming problem using systematic overrelaxation*,
-SIAM J. Control 9; Cottle, Pang & Stone, *The Linear Complementarity Problem*,
-§5.2). One *sweep* updates every component in turn, each from the latest values
-of the others::
+Contract:
 
-    for i = 1 … n:   z_i ← max(0, z_i − ω (q_i + M_i z) / M_ii)
+- **Convergence.** For symmetric PSD ``M`` with a positive diagonal and ``0 < ω < 2`` the
+  objective falls monotonically and, when the LCP has a solution, ``w`` converges linearly, at
+  a rate set by the conditioning of ``M`` (slow for a plate's 10⁴–10⁶).
+- **Stopping.** After every sweep, on the relative natural residual
+  ``r = max |min(M_ii z_i, w_i)| / max(‖w‖∞, ‖q‖∞)`` (:func:`plateqp.backends.lcp.natural_residual`):
+  ``OPTIMAL`` once ``r ≤ tol`` of the preset in :data:`ACCURACY`. If ``max_iter`` sweeps or
+  ``time_limit`` seconds run out first, the status is ``MAX_ITER`` with the last iterate in
+  ``x`` and ``w`` and the limit in ``solver_status``. An LCP without a solution makes ``z``
+  grow without bound: it ends on a limit, never ``OPTIMAL``.
 
-i.e. exact minimisation of the QP objective along coordinate ``i`` followed by
-projection onto ``z_i ≥ 0`` (``ω = 1``: projected Gauss–Seidel), or a step
-``ω ∈ (0, 2)`` times as long (projected SOR). For symmetric PSD ``M`` with a
-positive diagonal and ``0 < ω < 2`` the objective decreases monotonically and,
-when the LCP has a solution, ``w`` converges to its (unique) value; the rate
-is linear and governed by the conditioning of ``M``: slow for condition numbers
-of 10⁴–10⁶ (those of a plate's condensed stiffness).
-
-Cost and implementation
------------------------
-The sweep is inherently sequential (each update uses the one before), so it is a
-Python loop over ``i``; what can be precomputed is. ``w = M z + q`` is kept
-up to date instead of recomputing ``M_i z`` (``O(n)``) for every ``i``: a change
-``δ`` of ``z_i`` is one BLAS ``daxpy``, ``w ← w + δ M_{:,i}`` (row ``i`` of ``M``,
-as ``M`` is symmetric, so the access is contiguous). A component that does not
-change — ``z_i = 0`` that stays there with ``w_i ≥ 0``, the majority on a
-plate (supports that stay in contact) — costs a few scalar operations and no
-``daxpy``. A sweep thus costs ``O(n)`` interpreter work plus ``O(n · k)`` flops,
-``k`` the number of components that moved (at most ``n``: ``O(n²)``). The
-stopping test after each sweep is ``O(n)`` on the running ``w``; every
-``RESYNC`` sweeps, and before the sweeps stop, ``w`` is recomputed as one
-product ``M z + q`` (``O(n²)``, BLAS), which clears the drift of the updates, so
-the returned ``w`` and residual are exact. Measured on one core: about 0.6 ms
-per sweep at ``n = 900`` with about 730 moving components (a pure-Python inner
-product per component would cost ~100 ms per sweep).
-
-Stopping test: the relative natural residual
-(:func:`plateqp.backends.lcp.natural_residual`)
-
-.. math::
-
-    r = \frac{\max_i |\min(M_{ii} z_i,\ w_i)|}{\max(\|w\|_\infty, \|q\|_\infty)}
-
-(``z`` weighted by the diagonal so that both terms are in the units of ``w``;
-scaled by ``w`` and ``q`` only, so that a runaway ``z`` cannot shrink it), checked
-after every sweep.
-
-Accuracy
---------
-``tol`` of each preset in :data:`ACCURACY`: the sweeps stop as soon as
-``r ≤ tol`` (status ``OPTIMAL``). If ``max_iter`` sweeps or ``time_limit``
-seconds run out first, the status is ``MAX_ITER`` and the last iterate is
-returned in ``x``, ``w`` so that the caller's own check can show how far it is;
-``solver_status`` says which limit ended it. An LCP without a solution makes
-``z`` grow without bound: it ends on a limit, never ``OPTIMAL``.
+The design and the cost of a sweep: docs/design/pgs.md.
 
 Examples
 --------
