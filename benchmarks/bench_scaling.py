@@ -83,7 +83,6 @@ def _case(args, q):
     warnings.simplefilter("ignore")
     import resource
 
-    from plateqp.contact import formulations
     from plateqp.assembly import build_model
     from plateqp.contact import solve_contact
 
@@ -102,7 +101,7 @@ def _case(args, q):
     fs, ss, mem = [], [], []
     try:
         for i in range(repeat):
-            formulations._CACHE.clear()
+            model.derived.clear()
             peak_ok = _reset_peak()
             before = _status_kb()
             r = solve_contact(model, backend=backend, formulation=formulation, accuracy=accuracy)

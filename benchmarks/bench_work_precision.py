@@ -96,7 +96,6 @@ def _ladder(args, q):
     """Child: build the scene once, then solve it at every rung; one message per rung."""
     fam, n, k, backend, formulation, tols = args
     warnings.simplefilter("ignore")
-    from plateqp.contact import formulations
     from plateqp.assembly import build_model
     from plateqp.backends import get_backend
     from plateqp.contact import solve_contact
@@ -121,7 +120,7 @@ def _ladder(args, q):
         pass
     q.put({"ready": True, "build_s": t_build, "ndof": model.n_free, "m": model.contacts.m})
     for tol in tols:
-        formulations._CACHE.clear()  # a fresh formulation per rung
+        model.derived.clear()  # a fresh formulation per rung
         raw.clear()
         try:
             r = solve_contact(model, backend=backend, formulation=formulation, accuracy=tol)

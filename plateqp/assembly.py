@@ -102,6 +102,10 @@ class Model:
     #: :meth:`plateqp.mesh.Grid.assemble`), so its CSR arrays are its CSC arrays
     #: (:func:`plateqp.linalg.pattern.csc_of_symmetric`)
     symmetric: bool = False
+    #: what the contact formulations derive from K and B alone (the condensed stiffness, the
+    #: flexibility), kept for the next solve on this model or a copy of it that shares K and B
+    #: (``dataclasses.replace`` shares this list: a sweep condenses once): [(K, B, kind, value)]
+    derived: list = field(default_factory=list, repr=False, compare=False)
 
     @property
     def K_full(self) -> sp.csr_matrix:

@@ -22,7 +22,6 @@ k − 1; a polygon's segment i runs from vertex i to vertex i + 1.
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 from typing import Callable
 

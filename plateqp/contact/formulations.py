@@ -266,19 +266,22 @@ class Dual(Formulation):
 # The condensed stiffness and the flexibility depend only on the model's K and B (not on the
 # gaps, springs, loads or the deflection scale: K̃ and B̃ are independent of W), so a sweep over
 # gaps, stiffnesses or loads that shares K and B (plateqp.studies.adapt_model) condenses once.
-_CACHE: list[tuple] = []  # (K_src, B_src, kind, value), most recent last
+#: how many derived matrices a model keeps (Model.derived), most recent last
 _CACHE_SIZE = 2
 
 
 def _cached(data: Scaled, kind: str, build):
-    if data.K_src is not None:
-        for K, B, k, value in _CACHE:
+    """``build()``, or what it gave before for this model's K and B (``data.derived``, the
+    model's own list; none where the data came from no model)."""
+    keep = data.derived
+    if keep is not None and data.K_src is not None:
+        for K, B, k, value in keep:
             if K is data.K_src and B is data.B_src and k == kind:
                 return value
     value = build()
-    if data.K_src is not None:
-        _CACHE.append((data.K_src, data.B_src, kind, value))
-        del _CACHE[:-_CACHE_SIZE]
+    if keep is not None and data.K_src is not None:
+        keep.append((data.K_src, data.B_src, kind, value))
+        del keep[:-_CACHE_SIZE]
     return value
 
 

@@ -47,9 +47,11 @@ class Scaled:
     F0: float
     modes: np.ndarray  # rigid modes of K (n, k), scaled dofs
     is_w: np.ndarray  # (n,) bool: the dof is a deflection (not a slope or twist)
-    # the model's own K and B: the key of the condensation cache (see _cached)
+    # the model's own K and B, the key of what the formulations derive from them, and the model's
+    # list that keeps it (Model.derived; plateqp.contact.formulations._cached)
     K_src: sp.csr_matrix | None = field(default=None, repr=False, compare=False)
     B_src: sp.csr_matrix | None = field(default=None, repr=False, compare=False)
+    derived: list | None = field(default=None, repr=False, compare=False)
     # the deflection the load alone would cause (0.01 F L²/D), in units of W (≤ 1)
     w_load: float = 1.0
     # each contact point's distance to the nearest other held point (another contact point, or
@@ -82,7 +84,7 @@ class Scaled:
         if modes.shape[1]:
             modes = modes / np.linalg.norm(modes, axis=0)
         data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, kind == 0, model.K, c.B,
-                   w_load=W_load / W, spacing=contact_spacing(model) / L)
+                   w_load=W_load / W, spacing=contact_spacing(model) / L, derived=model.derived)
         check_distinct_contacts(data, model)
         return data
 
