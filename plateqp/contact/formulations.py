@@ -127,8 +127,8 @@ class Primal(Formulation):
         # joined column by column (block_diag went through COO and sorted every entry: 0.12 s at
         # 256²), K's stored zeros kept (the ordering reads them: plateqp.linalg.pattern)
         P = _with_identity(data.K.tocsc(), ne) if ne else data.K.tocsc()
-        if ne:  # K is P's leading block: share its arrays (one copy of K alive, not two: 16 MB at 128²)
-            data.K = pattern.leading(P, data.K.shape[0])
+        if ne:
+            data.share_K(P)
         q = np.concatenate([-data.f, np.zeros(ne)])
         T = sp.csr_matrix((-np.sqrt(data.rho[el]), (el, np.arange(ne))), shape=(m, ne))
         G = sp.hstack([data.B, T], format="csc")
