@@ -33,32 +33,6 @@ from .errors import PlateQPWarning, SceneError
 W, WX, WY, WXY = (0, 0), (1, 0), (0, 1), (1, 1)
 
 
-class _Prescribed:
-    """dof → (value, who) with the conflict check."""
-
-    def __init__(self, element):
-        self.kinds = list(element.node_dofs)
-        self.nd = len(self.kinds)
-        self.names = element.dof_names
-        self.values: dict[int, tuple[float, str]] = {}
-
-    def put(self, node: int, order, value: float, who: str) -> None:
-        if order not in self.kinds:
-            return
-        k = self.kinds.index(order)
-        dof = int(node) * self.nd + k
-        old = self.values.get(dof)
-        if old is not None and abs(old[0] - value) > 1e-12 * max(1.0, abs(value), abs(old[0])):
-            raise SceneError(f"{who} and {old[1]} prescribe different values of {self.names[k]} at their "
-                             "common node; make them agree")
-        self.values[dof] = (value, who)
-
-    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
-        fixed = np.array(sorted(self.values), dtype=int)
-        return fixed, np.array([self.values[d][0] for d in fixed], dtype=float)
-
-
-# -- edges of a plate, by name (every mesh) ------------------------------------------------------
 #: ``outer`` / ``holeK`` a whole boundary; ``outer_I`` / ``holeK_I`` segment I of a polygon (from
 #: vertex I to I + 1); ``outer_I-J`` / ``holeK_I-J`` segments I to J. Bare TOML keys, no quoting.
 EDGE_KEY = re.compile(r"^(outer|hole(\d+))(?:_(\d+)(?:-(\d+))?)?$")
@@ -130,36 +104,86 @@ def warn_changed_all(scene, domain) -> None:
 
 def prescribed(scene, mesh, element) -> tuple[np.ndarray, np.ndarray]:
     """(fixed, values): the full dof indices the two-sided supports prescribe and their values
-    (sorted by dof), on any mesh that gives ``boundary_edges()`` and ``node_at``."""
+    (sorted by dof), on any mesh that gives ``boundary_edges()`` and ``node_at``. A dof two
+    supports prescribe differently (beyond 1e-12 relative) is a SceneError naming both."""
     from .geometry import scene_domain
 
-    out = _Prescribed(element)
     table = edge_table(scene, getattr(mesh, "domain", None) or scene_domain(scene))
     edges, normals, boundary, segment = mesh.boundary_edges()
-    tangent = getattr(element, "holds_tangent_slope", False)
-    clamped: dict[int, list] = {}  # node -> [(outward normal, slope, who)] of its clamped edges
-    for (i, j), k, s, normal in zip(edges, boundary, segment, normals):
-        name, e = table.get((int(k), int(s)), (None, None))
-        if e is None or e.kind == "free":
-            continue
-        who = f"edges.{name}"
-        for n in (i, j):
-            out.put(n, W, e.w, who)
-            if e.kind == "clamped":
-                clamped.setdefault(int(n), []).append((normal, e.slope, who))
-                out.put(n, WXY, 0.0, who)
-            elif tangent:  # w constant along a straight edge: its tangential slope is zero
-                out.put(n, WY if abs(normal[0]) > abs(normal[1]) else WX, 0.0, who)
-    for n, held in clamped.items():
-        gx, gy = gradient(held)
-        out.put(n, WX, gx, held[0][2])
-        out.put(n, WY, gy, held[0][2])
+    held = [(key, name, e) for key, (name, e) in table.items() if e.kind != "free"]
+    who = [f"edges.{name}" for _, name, _ in held] + [f"pins.{i}" for i in range(len(scene.pins))]
+    # each boundary edge's held edge (index into ``held``); both ends of each, edge by edge
+    code = np.asarray(boundary, dtype=np.int64) << 32 | np.asarray(segment, dtype=np.int64)
+    keys = np.array([k << 32 | s for (k, s), _, _ in held], dtype=np.int64)
+    order = np.argsort(keys)
+    pos = np.minimum(np.searchsorted(keys[order], code), max(len(keys) - 1, 0))
+    hit = np.flatnonzero(keys[order][pos] == code) if len(keys) else np.zeros(0, dtype=int)
+    idx = np.full(len(code), -1)
+    idx[hit] = order[pos[hit]]
+    ends, h = edges[hit].ravel(), np.repeat(idx[hit], 2)
+    n2 = np.repeat(normals[hit], 2, axis=0)
+    kind = np.array([e.kind for _, _, e in held] or [""])[h]
+    w, slope = (np.array([getattr(e, a) for _, _, e in held] or [0.0])[h] for a in ("w", "slope"))
+    clamp = kind == "clamped"
+    rows = [(ends, W, w, h), (ends[clamp], WXY, np.zeros(clamp.sum()), h[clamp])]
+    if getattr(element, "holds_tangent_slope", False):  # w constant along a straight edge
+        simple = ~clamp
+        along_y = np.abs(n2[:, 0]) > np.abs(n2[:, 1])  # a normal along x: the edge runs along y
+        for order, mask in ((WY, simple & along_y), (WX, simple & ~along_y)):
+            rows.append((ends[mask], order, np.zeros(mask.sum()), h[mask]))
+    rows += _gradients(ends[clamp], n2[clamp], slope[clamp], h[clamp], who)
     for i, pin in enumerate(scene.pins):
         n = mesh.node_at(pin.x, pin.y)
         if n is None:  # pragma: no cover - validation puts every pin on a node
             raise SceneError(f"pins.{i}: no mesh node at ({pin.x}, {pin.y})")
-        out.put(n, W, pin.w, f"pins.{i}")
-    return out.arrays()
+        rows.append((np.array([n]), W, np.array([float(pin.w)]), np.array([len(held) + i])))
+    return _settle(rows, element, who)
+
+
+def _gradients(nodes, normals, slopes, who_idx, who) -> list:
+    """∇w = (∂w/∂n) n at every node of clamped edges (:func:`gradient`): the nodes along a smooth
+    boundary at once, the corners one by one."""
+    if not len(nodes):
+        return []
+    order = np.argsort(nodes, kind="stable")
+    nodes, normals, slopes, who_idx = nodes[order], normals[order], slopes[order], who_idx[order]
+    uniq, start, count = np.unique(nodes, return_index=True, return_counts=True)
+    mean = np.add.reduceat(normals, start, axis=0)
+    norm = np.hypot(mean[:, 0], mean[:, 1])
+    unit = mean / np.where(norm > 0, norm, 1.0)[:, None]
+    cos = np.einsum("ij,ij->i", normals, np.repeat(unit, count, axis=0))
+    smooth = (norm > 0) & (np.minimum.reduceat(cos, start) >= np.cos(np.radians(10.0)))
+    g = (np.add.reduceat(slopes, start) / count)[:, None] * unit
+    for k in np.flatnonzero(~smooth):
+        sl = slice(start[k], start[k] + count[k])
+        g[k] = gradient([(nm, sv, who[wi]) for nm, sv, wi in zip(normals[sl], slopes[sl], who_idx[sl])])
+    first = who_idx[start]
+    return [(uniq, WX, g[:, 0], first), (uniq, WY, g[:, 1], first)]
+
+
+def _settle(rows, element, who) -> tuple[np.ndarray, np.ndarray]:
+    """(fixed, values) from the prescriptions [(nodes, order, values, who index)], those of dof
+    kinds the element does not have dropped; a SceneError where a dof's values differ by more
+    than 1e-12 relative, naming the two supports."""
+    kinds = list(element.node_dofs)
+    nd = len(kinds)
+    parts = [(nodes * nd + kinds.index(order), values, wi) for nodes, order, values, wi in rows
+             if order in kinds and len(nodes)]
+    if not parts:
+        return np.zeros(0, dtype=int), np.zeros(0)
+    dof, val, wi = (np.concatenate(v) for v in zip(*parts))
+    by = np.argsort(dof, kind="stable")
+    dof, val, wi = dof[by].astype(int), val[by].astype(float), wi[by]
+    first = np.r_[True, dof[1:] != dof[:-1]]
+    lead = np.maximum.accumulate(np.where(first, np.arange(len(dof)), 0))
+    ref = val[lead]
+    tol = 1e-12 * np.maximum(1.0, np.maximum(np.abs(val), np.abs(ref)))
+    bad = np.flatnonzero(np.abs(val - ref) > tol)
+    if bad.size:
+        b = bad[0]
+        raise SceneError(f"{who[wi[b]]} and {who[wi[lead[b]]]} prescribe different values of "
+                         f"{element.dof_names[dof[b] % nd]} at their common node; make them agree")
+    return dof[first], val[first]
 
 
 def gradient(held) -> np.ndarray:

@@ -113,7 +113,12 @@ class Grid:
     def boundary_edges(self):
         """The plate's boundary as every mesh gives it: (edges (ne, 2) node pairs, outward unit
         normals (ne, 2), boundary (ne,) 0 outer or K + 1 for cut-out K, segment (ne,) of that
-        boundary's shape). See the module docstring."""
+        boundary's shape), computed once (the arrays are shared: read them, do not change them).
+        See the module docstring."""
+        return self._boundary_edges
+
+    @cached_property
+    def _boundary_edges(self):
         from .geometry import nearest_segment
 
         nx, ny = self.nx, self.ny
