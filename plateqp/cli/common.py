@@ -116,20 +116,15 @@ def _backend_name(name: str) -> str:
 
 
 def _out_dir(text: str, files: list[str], force: bool) -> Path:
-    """Check ``--out`` before any work: a folder (made if missing) that is writable and holds none
-    of ``files`` (unless ``force``)."""
-    out = Path(text)
-    if out.exists() and not out.is_dir():
-        raise ProblemError(f"--out {out}: exists and is not a folder")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exn:
-        raise ProblemError(f"--out {out}: cannot be made ({exn.strerror or exn})") from None
-    if not os.access(out, os.W_OK | os.X_OK):
-        raise ProblemError(f"--out {out}: is not writable")
-    there = [f for f in files if (out / f).exists()]
-    if there and not force:
-        raise ProblemError(f"--out {out}: {there[0]} exists; use --force to overwrite")
+    """Check ``--out`` before any work (:mod:`plateqp.io.safe`): a folder, not a link, made if
+    missing, writable, where none of ``files`` exists (unless ``force``) and nothing on the way
+    to them is a link."""
+    from ..io.safe import check_target, out_folder
+
+    label = f"--out {text}"
+    out = out_folder(text, label=label)
+    for f in files:
+        check_target(out / f, force=force, label=label, root=out)
     return out
 
 

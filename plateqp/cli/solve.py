@@ -142,8 +142,13 @@ def cmd_solve(args) -> int:
         if args.sensitivity:
             print(_sensitivity(result, False))
     if out is not None:
-        (out / f"{stem}.json").write_text(json.dumps(result.to_dict(args.probe), indent=1))
-        np.save(out / f"{stem}-w.npy", result.w_nodes())
+        from ..io.safe import write
+
+        label = f"--out {args.out}"
+        write(out / f"{stem}.json", json.dumps(result.to_dict(args.probe), indent=1), force=args.force,
+              label=label, root=out)
+        w = result.w_nodes()
+        write(out / f"{stem}-w.npy", lambda tmp: np.save(tmp, w), force=args.force, label=label, root=out)
         if vtu:
-            write_vtu(result, out, stem, force=True)  # the folder was checked before any work
+            write_vtu(result, out, stem, force=args.force)
     return 0 if result.status in (Status.OPTIMAL,) and reached else 5
