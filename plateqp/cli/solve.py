@@ -80,7 +80,7 @@ def _sensitivity(result, as_json: bool):
     if sens.smooth:
         sides = [("dR_i/dg0_j", sens.increasing)]
     else:
-        at = ", ".join(str(int(i)) for i in sens.degenerate)
+        at = ", ".join(str(int(i) + 1) for i in sens.degenerate)  # numbered from 1, as in the table
         sides = [(f"dR_i/dg0_j as the gap increases (support(s) {at} at lift-off)", sens.increasing),
                  (f"dR_i/dg0_j as the gap decreases (support(s) {at} at lift-off)", sens.decreasing)]
     lines = []
