@@ -10,6 +10,7 @@ import contextlib
 import json
 import logging
 import os
+import stat
 import sys
 import warnings
 from pathlib import Path
@@ -168,6 +169,9 @@ def _scene_or_builtin(text: str) -> Scene:
         if text in scenes.names():
             return scenes.load(text)
         raise SceneError(f"{text}: no such file, nor a built-in scene ({', '.join(scenes.names())})")
+    # a FIFO, a device or a folder: refused before it is opened (reading a FIFO blocks)
+    if not stat.S_ISREG(path.stat().st_mode):
+        raise SceneError(f"{text}: is not a regular file (a FIFO, a device or a folder); name a scene file")
     return Scene.from_toml(path)
 
 

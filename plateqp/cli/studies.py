@@ -16,7 +16,7 @@ from ..accuracy import Status
 from ..solving import solve
 from ..errors import PlateQPError, ProblemError
 from ..progress import Progress
-from .common import _options, _backend_name, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, _numbers
+from .common import _options, _backend_name, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, _numbers, log
 
 
 def cmd_regulate(args) -> int:
@@ -138,8 +138,21 @@ def _executor(args, stack: contextlib.ExitStack) -> tuple:
 
         client = stack.enter_context(connect(args.scheduler, timeout=args.scheduler_timeout))
         return client, 1
-    workers = 2 if args.workers is None else args.workers
-    return ("serial" if workers <= 1 else None), max(workers, 1)
+    from ..studies.parallel import available_cores
+
+    if args.workers is not None and args.workers < 1:
+        raise ProblemError(f"--workers: at least 1 (1: solve in this process; got {args.workers})")
+    cores = available_cores()
+    workers = min(2, cores) if args.workers is None else args.workers
+    if workers > cores:
+        if args.force_workers:
+            log.warning("--workers %d --force-workers: %d processes share the %d core(s) this process may use",
+                        workers, workers, cores)
+        else:
+            log.warning("--workers %d: capped at the %d core(s) this process may use "
+                        "(add --force-workers to start %d)", workers, cores, workers)
+            workers = cores
+    return ("serial" if workers <= 1 else None), workers
 
 
 def _sweep_exact(scene, values, opts, args, executor, workers):
