@@ -160,10 +160,8 @@ def main(argv=None) -> int:
     b.add_argument("--json", action="store_true")
     for p in sub.choices.values():
         _output_flags(p, False)
-    try:
-        args = ap.parse_args(_negative_values_joined(sys.argv[1:] if argv is None else list(argv)))
-    except SystemExit as exn:  # a bad flag (one line, 2), or --help (0)
-        return exn.code if isinstance(exn.code, int) else 2
+    # a bad flag: one line and SystemExit(2) (_Parser.error); --help: SystemExit(0)
+    args = ap.parse_args(_negative_values_joined(sys.argv[1:] if argv is None else list(argv)))
     if args.quiet and args.verbose:
         ap.error("--quiet and --verbose: choose one")
     saved_limit = os.environ.get("PLATEQP_MAX_MEMORY")  # --max-memory holds for this command only
