@@ -418,7 +418,7 @@ def sweep_row(n: int, k: int, values: int) -> dict:
         for backend in ("auto", "pdas"):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                dt, _ = cpu(lambda: sweep(scene, "supports.0.gap", vals, backend=backend, accuracy=ACCURACY,
+                dt, _ = cpu(lambda: sweep(scene, "supports.1.gap", vals, backend=backend, accuracy=ACCURACY,
                                           executor="serial", progress=False, refine_breakpoints=False))
             if keep:
                 out[f"{backend}_s"] = dt

@@ -270,7 +270,7 @@ Settle support 3 further: its reaction falls linearly until it reaches zero at
 piecewise-linear solution by parametric pivoting and reports the breakpoint exactly (to
 rounding), with no bisection."""),
 code("""delta_star = q * a**4 / (8 * D * (1 - nu))
-path = exact_path(scene, "supports.2.gap", 0.0, 2 * delta_star)
+path = exact_path(scene, "supports.3.gap", 0.0, 2 * delta_star)
 print(path)
 b = path.breakpoints[0]
 print(f"lift-off at {b['at']:.12g}; closed form q a^4 / (8 D (1 - nu)) = {delta_star:.12g}")

@@ -351,6 +351,6 @@ def _contacts(scene: Scene, model: Model) -> ContactOperator | None:
     empty = np.flatnonzero(np.diff(B.indptr) == 0)
     if empty.size:
         i = empty[0]
-        raise SceneError(f"supports.{i}: lies on a two-sided support (w is prescribed there), "
+        raise SceneError(f"supports.{i + 1}: lies on a two-sided support (w is prescribed there), "
                          "so it can never act; remove it or the two-sided support")
     return ContactOperator(B, g0, np.concatenate(rho), np.vstack(xy), np.array(source), np.concatenate(index), shift)

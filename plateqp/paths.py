@@ -10,6 +10,12 @@ starts from c = ∞. A bad path or value is a :class:`~plateqp.errors.SceneError
 path and what exists there; so is a path that names a table or a list (``plate``,
 ``supports``, ``supports.0``) where :func:`set_param` wants a value: it lists the fields to
 name instead.
+
+Supports are named by their number from 1, the number every table, JSON file and message
+gives them: ``supports.1.gap`` is the first ``[[supports]]`` (``scene.supports[0]``), and
+``supports.0.gap`` is an error that says so. The other lists keep their index from 0
+(``loads.0.P`` is the first load). The same language serves the command line
+(``--param``) and Python (:func:`plateqp.studies.sweep`, :func:`plateqp.studies.exact_path`).
 """
 
 from __future__ import annotations
@@ -25,6 +31,19 @@ from .constraints import EDGE_KEY
 from .scene import EDGE_NAMES, Edge, Scene
 
 _TOP = ("name", "plate", "mesh", "edges", "openings", "pins", "loads", "supports", "foundation")
+
+
+#: The number of a list's first item in a path: supports are numbered from 1, as in every table,
+#: JSON file and message; the other lists (loads, openings, pins) by their index from 0.
+FIRST = {"supports": 1}
+
+
+def _numbering(where: str, n: int) -> str:
+    """How the items of the list ``where`` (of ``n``) are numbered in a path, for a message."""
+    first = FIRST.get(where, 0)
+    if first == 1:
+        return f"numbered from 1 (1..{n}), as in the tables"
+    return f"indexed from 0 (0..{n - 1})"
 
 
 def _path_parts(path: str) -> list[str]:
@@ -48,21 +67,25 @@ def _walk(obj, parts: list[str], where: str, create: bool):
     key, rest = parts[0], parts[1:]
     here = f"{where}.{key}" if where else key
     if isinstance(obj, list):
+        first = FIRST.get(where, 0)  # supports: the tables' numbers, from 1
         if key == "*":
             keys = range(len(obj))
             if not keys:
                 raise SceneError(f"{here}: {where} is empty")
         else:
             try:
-                k = int(key)
+                k = int(key) - first
             except ValueError:
-                raise SceneError(f"{here}: {where} is a list; use an index 0..{len(obj) - 1} or '*'") from None
+                raise SceneError(f"{here}: {where} is a list whose items are {_numbering(where, len(obj))}; "
+                                 "use a number or '*'") from None
+            if not obj:
+                raise SceneError(f"{here}: the scene has no {where}")
             if not 0 <= k < len(obj):
-                raise SceneError(f"{here}: index out of range; the scene has {len(obj)} {where} "
-                                 f"(indices 0..{len(obj) - 1})" if obj else f"{here}: the scene has no {where}")
+                raise SceneError(f"{here}: no such item; the scene has {len(obj)} {where}, "
+                                 f"{_numbering(where, len(obj))}")
             keys = [k]
         for k in keys:
-            sub = f"{where}.{k}"
+            sub = f"{where}.{k + first}"
             if rest:
                 yield from _walk(obj[k], rest, sub, create)
             else:
@@ -172,7 +195,8 @@ def _table_error(path: str, old) -> SceneError:
         if not old:
             return SceneError(f"{path}: names a list of tables, not a value (and the scene has no {path})")
         return SceneError(f"{path}: names a list of tables, not a value; name a field of one item: "
-                          f"{', '.join(f'{path}.0.{n}' for n in _names(old[0]))} (or {path}.*.<field>)")
+                          f"{', '.join(f'{path}.{FIRST.get(path, 0)}.{n}' for n in _names(old[0]))} "
+                          f"(or {path}.*.<field>)")
     if old is None:  # an absent section (foundation)
         return SceneError(f"{path}: names a table, not a value (and the scene has no [{path}] section)")
     return SceneError(f"{path}: names a table, not a value; name one of its fields: "
@@ -186,8 +210,39 @@ def set_param(scene: Scene, path: str, value) -> Scene:
     as the items, one entry each (``set_param(scene, "supports.*.gap", gaps)``).
     Raises SceneError naming the path for a bad path or value.
     """
-    parts = _path_parts(path)
     new = copy.deepcopy(scene)
+    _assign(new, path, value)
+    new.validate()
+    return new
+
+
+def check_values(scene: Scene, path: str, values) -> None:
+    """Check every value of a sweep before any solve: each one set in turn on one copy of
+    ``scene`` and validated. Raises :class:`SceneError` for the first bad one, naming the path
+    and the value (a range that crosses E = 0, a negative thickness)."""
+    new = copy.deepcopy(scene)
+    parts = _path_parts(path)
+    leaves = list(_walk(new, parts, "", create=False))  # an edge not named stays not named
+    original = [copy.deepcopy(c[k] if isinstance(c, list) or (isinstance(c, dict) and k in c)
+                              else None if isinstance(c, dict) else getattr(c, k)) for c, k, _ in leaves]
+    for v in values:
+        try:
+            _assign(new, path, v)
+            new.validate()
+        except SceneError as exn:
+            raise SceneError(f"{exn} (at {path} = {v!r}; nothing was solved)") from None
+        for (c, k, _), old in zip(leaves, original):  # each value is checked on the scene as given
+            if isinstance(c, dict) and old is None:
+                c.pop(k, None)
+            elif isinstance(c, (list, dict)):
+                c[k] = copy.deepcopy(old)
+            else:
+                setattr(c, k, copy.deepcopy(old))
+
+
+def _assign(new: Scene, path: str, value) -> None:
+    """Set the field PATH of ``new`` to ``value`` in place (not validated)."""
+    parts = _path_parts(path)
     leaves = list(_walk(new, parts, "", create=True))
     per_item = ("*" in parts and not isinstance(value, (str, dict)) and np.ndim(value) == 1
                 and len(value) == len(leaves) and len(leaves) > 0)
@@ -202,8 +257,6 @@ def set_param(scene: Scene, path: str, value) -> Scene:
             if k == "type":
                 raise SceneError(f"{where}: the load type cannot be changed by a path; edit the scene")
             setattr(c, k, v)
-    new.validate()
-    return new
 
 
 def as_number(value) -> float:
@@ -213,4 +266,4 @@ def as_number(value) -> float:
     return float(value)
 
 
-__all__ = ["as_number", "get_param", "set_param"]
+__all__ = ["as_number", "check_values", "get_param", "set_param"]

@@ -16,9 +16,11 @@ from __future__ import annotations
 
 import base64
 import html
+import json
 import math
 import re
 import time
+from dataclasses import asdict
 
 import numpy as np
 
@@ -239,3 +241,41 @@ def _scene_facts(r) -> str:
 def _ids(ids) -> str:
     ids = [int(i) for i in ids]
     return ", ".join(map(str, ids)) if ids else "none"
+
+
+# -- the files ---------------------------------------------------------------------------------------
+def _json_safe(d):
+    if isinstance(d, dict):
+        return {k: _json_safe(v) for k, v in d.items()}
+    if isinstance(d, list):
+        return [_json_safe(v) for v in d]
+    if isinstance(d, float) and not math.isfinite(d):
+        return None
+    return d
+
+
+def write_files(out, runs, studies, table: str, force: bool = True) -> None:
+    """Write the demo's figures (``<stem>.png``), one JSON file per scene and study and
+    ``report.html`` into the folder ``out``, by :mod:`plateqp.io.safe`'s rules (no link
+    followed; an existing file replaced only with ``force``)."""
+    from .io.safe import write
+
+    def put(name: str, data) -> None:
+        write(out / name, data, force=force, label=f"--out {out}", root=out)
+
+    for r in runs:
+        for stem, png in r.figures.items():
+            put(f"{stem}.png", png)
+        rep = {"one_sided": r.one.to_dict()}
+        if r.two is not None:
+            rep["two_sided"] = r.two.to_dict()
+        if r.comparison is not None:
+            rep["comparison"] = _json_safe(asdict(r.comparison))
+        if r.skipped:
+            rep["skipped"] = dict(r.skipped)
+        put(f"{r.name}.json", json.dumps(rep, indent=1))
+    for st in studies:
+        for stem, png in st.figures.items():
+            put(f"{stem}.png", png)
+        put(f"{st.name}.json", json.dumps(_json_safe({"lines": st.lines, **st.data}), indent=1))
+    put("report.html", report_html(runs, table, studies))

@@ -233,9 +233,9 @@ class Result:
 
     def write_vtu(self, folder, stem: str | None = None, force: bool = False) -> list:
         """``<stem>.vtu`` (the plate and its fields) and ``<stem>-supports.vtu`` into ``folder``
-        for ParaView / pyvista; nothing overwritten unless ``force``:
-        :func:`plateqp.io.vtk.write_vtu`. ``stem`` defaults to the scene's name made a plain
-        file name."""
+        (made if missing, as ``plateqp solve --out`` does) for ParaView / pyvista; nothing
+        overwritten unless ``force``, no link followed: :func:`plateqp.io.vtk.write_vtu`.
+        ``stem`` defaults to the scene's name made a plain file name."""
         from .io.files import safe_filename
         from .io.vtk import write_vtu
         return write_vtu(self, folder, stem or safe_filename(self.scene.name), force=force)

@@ -52,7 +52,7 @@ def check_scales(scene, derived: tuple[float, float]) -> None:
         if not lo <= logW <= hi:
             scene._fail(f"loads.{i}", f"deflects the plate by about 1e{logW:.0f} (0.01 F L²/D), outside "
                         f"{derived[0]:.0e} … {derived[1]:.0e}; change units")
-    springs = [(f"supports.{i}.stiffness", s.stiffness) for i, s in enumerate(scene.supports) if not s.rigid]
+    springs = [(f"supports.{i + 1}.stiffness", s.stiffness) for i, s in enumerate(scene.supports) if not s.rigid]
     if scene.foundation is not None:
         springs.append(("foundation.k", bed_spring(scene)))
     for where, c in springs:

@@ -376,7 +376,7 @@ class Scene:
         tol = 1e-9 * max(p.a, p.b)
         covered = self._covered(grid, [(getattr(s, "x", None), getattr(s, "y", None)) for s in self.supports])
         for i, s in enumerate(self.supports):
-            where = f"supports.{i}"
+            where = f"supports.{i + 1}"  # numbered from 1, as in every table
             self._num(f"{where}.x", s.x)
             self._num(f"{where}.y", s.y)
             self._num(f"{where}.gap", s.gap, physical=True)
@@ -388,7 +388,7 @@ class Scene:
                 self._num(f"{where}.stiffness", s.stiffness, positive=True, physical=True)
             key = (round(s.x / tol), round(s.y / tol))
             if key in seen:
-                self._fail(where, f"lies on the same point as supports.{seen[key]}; merge them into one support")
+                self._fail(where, f"lies on the same point as supports.{seen[key] + 1}; merge them into one support")
             seen[key] = i
         if self.foundation is not None:
             f = self.foundation
@@ -522,7 +522,7 @@ class Scene:
             items = data.get(key, [])
             if not isinstance(items, list):
                 fail(key, "must be an array of tables ([[" + key + "]], not [" + key + "])")
-            kw[key] = [build(klass, d, f"{key}.{i}") for i, d in enumerate(items)]
+            kw[key] = [build(klass, d, f"{key}.{i + (key == 'supports')}") for i, d in enumerate(items)]
         loads = []
         if not isinstance(data.get("loads", []), list):
             fail("loads", "must be an array of tables ([[loads]])")

@@ -175,7 +175,7 @@ def one_direction(a: Piece, unit: Piece, D: np.ndarray, sign: float) -> tuple[Pi
                 dgap[D] = np.where(opened, z, 0.0)
                 found.append((Piece(sign * du, sign * dR, sign * dgap), opened))
     if not found:
-        raise MechanismError(f"no one-sided derivative exists at the contact points at lift-off {D.tolist()}: "
+        raise MechanismError(f"no one-sided derivative exists at the contact points at lift-off {(D + 1).tolist()}: "
                              "releasing them leaves a rigid motion free, the answer is not unique")
     first = found[0][0]
     scale = max(np.abs(first.dgap).max(initial=0.0), 1.0)
@@ -238,7 +238,7 @@ class Sensitivity:
     Attributes
     ----------
     wrt : "gaps", "stiffness" or "loads"
-    labels : one name per parameter (column): ``supports.3.gap``, ``bed.17.gap`` (a foundation
+    labels : one name per parameter (column): ``supports.3.gap`` (numbered from 1, as in paths), ``bed.17.gap`` (a foundation
         node), ``supports.2.stiffness``, ``foundation.k``, ``loads.0``
     increasing, decreasing : :class:`Derivatives` as the parameter increases (right derivative)
         and as it decreases (the slope of the piece below, left derivative); the same object
@@ -264,7 +264,7 @@ class Sensitivity:
     def _two_sided(self, name: str) -> np.ndarray:
         if not self.smooth:
             bad = [self.labels[j] for j in np.flatnonzero(self.kinked)]
-            pts = ", ".join(str(int(i)) for i in self.degenerate)
+            pts = ", ".join(str(int(i) + 1) for i in self.degenerate)  # numbered from 1
             raise ProblemError(f"not differentiable: contact point(s) {pts} are at lift-off, so the derivative "
                                f"with respect to {', '.join(bad[:4])}{' …' if len(bad) > 4 else ''} differs on "
                                f"either side; use .increasing.{name} or .decreasing.{name}")
@@ -309,8 +309,9 @@ class Sensitivity:
 
     def to_dict(self) -> dict:
         """JSON shape: {wrt, parameters, degenerate, smooth, reactions, deflections, gaps} where
-        smooth, else {..., increasing: {...}, decreasing: {...}} with the one-sided ones."""
-        d = {"wrt": self.wrt, "parameters": list(self.labels), "degenerate": [int(i) for i in self.degenerate],
+        smooth, else {..., increasing: {...}, decreasing: {...}} with the one-sided ones;
+        ``degenerate`` numbers the contact points from 1, as the tables do."""
+        d = {"wrt": self.wrt, "parameters": list(self.labels), "degenerate": [int(i) + 1 for i in self.degenerate],
              "smooth": self.smooth}
         if self.smooth:
             d.update(self.increasing.as_dict())
@@ -322,7 +323,7 @@ class Sensitivity:
 
 def contact_names(model) -> list[str]:
     c = model.contacts
-    return [f"supports.{int(i)}" if s == "support" else f"bed.{int(i)}" for s, i in zip(c.source, c.index)]
+    return [f"supports.{int(i) + 1}" if s == "support" else f"bed.{int(i)}" for s, i in zip(c.source, c.index)]
 
 
 def parameters(model, data: Scaled, R: np.ndarray, wrt: str):
@@ -344,7 +345,7 @@ def parameters(model, data: Scaled, R: np.ndarray, wrt: str):
                 cval = float(scene.supports[int(c.index[k])].stiffness)
                 col[k] = -(D / L2) / cval**2  # ρ̃ = (D/L²)/c
                 cols.append(col)
-                labels.append(f"supports.{int(c.index[k])}.stiffness")
+                labels.append(f"supports.{int(c.index[k]) + 1}.stiffness")
         bed = c.source == "bed"
         if np.any(bed):
             col = np.where(bed, -data.rho / scene.foundation.k, 0.0)  # ρ ∝ 1/k

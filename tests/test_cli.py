@@ -181,7 +181,7 @@ def test_scene_path_that_is_not_a_scene(capsys, path):
 
 
 def test_unbounded_sweep_is_refused(capsys, tmp_path):
-    code, _, err = run_cli(capsys, "sweep", str(small(tmp_path)), "--param", "supports.0.gap", "--range", "0:1:1000000")
+    code, _, err = run_cli(capsys, "sweep", str(small(tmp_path)), "--param", "supports.1.gap", "--range", "0:1:1000000")
     one_line_error(code, err)
     assert "--max-values" in err
 
@@ -223,7 +223,7 @@ def test_json_alone_on_stdout_whatever_the_solver_prints(tmp_path, backend, gap)
 def test_negative_values_are_values_not_options(capsys):
     """``--values -0.2,0`` (a heave) is read as the values, not as an unknown option; the row at
     the scene's own gap is the scene's own solve."""
-    code, out, err = run_cli(capsys, "sweep", "heave", "--param", "supports.1.gap", "--values", "-0.2,0",
+    code, out, err = run_cli(capsys, "sweep", "heave", "--param", "supports.2.gap", "--values", "-0.2,0",
                              "--no-refine", "--json")
     assert code == 0, err
     rows = json.loads(out)["rows"]

@@ -312,11 +312,11 @@ def test_formulation_a_backend_does_not_take():
 
 
 def test_bad_supports_are_scene_errors():
-    with pytest.raises(pq.SceneError, match=r"supports\.0\.stiffness"):
+    with pytest.raises(pq.SceneError, match=r"supports\.1\.stiffness"):
         pq.Scene(supports=[pq.Support(0.5, 0.5, stiffness=-1.0)])
-    with pytest.raises(pq.SceneError, match=r"supports\.0\.gap"):
+    with pytest.raises(pq.SceneError, match=r"supports\.1\.gap"):
         pq.Scene(supports=[pq.Support(0.5, 0.5, gap=float("nan"))])
-    with pytest.raises(pq.SceneError, match=r"supports\.1.*same point"):
+    with pytest.raises(pq.SceneError, match=r"supports\.2.*same point"):
         pq.Scene(supports=[pq.Support(0.5, 0.5), pq.Support(0.5, 0.5)])
     with pytest.raises(pq.SceneError, match="opening"):
         pq.Scene(openings=[pq.Opening(0.5, 1.0, 0.5, 1.0)], supports=[pq.Support(0.8, 0.8)])

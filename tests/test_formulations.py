@@ -59,7 +59,7 @@ def test_condensation_is_reused_across_gap_changes():
     sc = symmetric_scene()
     base = build_model(sc)
     first = pq.solve(sc, backend="lemke", formulation="condensed", model=base)
-    sc2 = set_param(sc, "supports.4.gap", -2e-3)
+    sc2 = set_param(sc, "supports.5.gap", -2e-3)
     reused = pq.solve(sc2, backend="lemke", formulation="condensed", model=adapt_model(base, sc2))
     fresh = pq.solve(sc2, backend="lemke", formulation="condensed")
     assert not np.allclose(first.reactions, fresh.reactions)

@@ -171,8 +171,8 @@ def test_corrupted_toml(data):
 #: Dotted paths into the scene's dict, and where a hostile value goes.
 PATHS = ["name", "plate.a", "plate.b", "plate.h", "plate.E", "plate.nu", "mesh.nx", "mesh.ny", "mesh.element",
          "edges.left", "edges.right", "edges.top", "openings.0.x0", "openings.0.y1", "pins.0.x", "pins.0.w",
-         "loads.0.q", "loads.0.type", "loads.1.P", "loads.1.x", "loads.1.y", "supports.0.x", "supports.0.gap",
-         "supports.1.stiffness", "supports.1.y", "foundation.k", "foundation.region", "foundation.gap",
+         "loads.0.q", "loads.0.type", "loads.1.P", "loads.1.x", "loads.1.y", "supports.1.x", "supports.1.gap",
+         "supports.2.stiffness", "supports.2.y", "foundation.k", "foundation.region", "foundation.gap",
          "foundation.gap.radius", "foundation.gap.depth", "loads", "supports", "plate", "mesh"]
 
 VALUES = st.one_of(

@@ -99,8 +99,8 @@ BAD = [
      "holds segment 2"),
     ("no-size", sub("size = 0.25", ""), "mesh.size", "size = h"),
     ("bad-size", sub("size = 0.25", "size = -1.0"), "mesh.size", "> 0"),
-    ("support-in-hole", sub("x = 1.5\ny = 0.5", "x = 0.5\ny = 0.5"), "supports.0", "in a hole"),
-    ("support-in-notch", sub("x = 1.5\ny = 0.5", "x = 1.5\ny = 1.5"), "supports.0", "outside its shape"),
+    ("support-in-hole", sub("x = 1.5\ny = 0.5", "x = 0.5\ny = 0.5"), "supports.1", "in a hole"),
+    ("support-in-notch", sub("x = 1.5\ny = 0.5", "x = 1.5\ny = 1.5"), "supports.1", "outside its shape"),
     ("bed-off-the-plate", lambda t: t + "\n[foundation]\nk = 100.0\nregion = [1.2, 1.8, 1.2, 1.8]\n",
      "foundation.region", "holds the centre of no cell"),
     ("patch-off-the-shape", lambda t: t + '\n[[loads]]\ntype = "patch"\nq = 1.0\nx0 = 1.2\nx1 = 1.8\ny0 = 1.2\n'

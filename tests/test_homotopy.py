@@ -34,7 +34,7 @@ def test_corner_settlement_lift_off(element, nx, q):
     scene = corners(nx, element, q=q)
     D = scene.plate.D
     dstar = q * A**4 / (8 * D * (1 - NU))
-    path = exact_path(scene, "supports.2.gap", 0.0, 3 * dstar)
+    path = exact_path(scene, "supports.3.gap", 0.0, 3 * dstar)
     assert len(path.breakpoints) == 1
     b = path.breakpoints[0]
     np.testing.assert_allclose(b["at"], dstar, rtol=1e-9)
@@ -50,11 +50,11 @@ def test_corner_settlement_lift_off(element, nx, q):
 
 
 @pytest.mark.parametrize("seed", range(6))
-@pytest.mark.parametrize("param", ["supports.3.gap", "loads.1.P", "supports.*.gap"])
+@pytest.mark.parametrize("param", ["supports.4.gap", "loads.1.P", "supports.*.gap"])
 def test_path_matches_pointwise_solves(seed, param):
     scene = random_scene(seed)
     W = 0.01 / scene.plate.D
-    lo, hi = {"supports.3.gap": (-W, W), "loads.1.P": (0.0, 20.0), "supports.*.gap": (-0.5 * W, 0.5 * W)}[param]
+    lo, hi = {"supports.4.gap": (-W, W), "loads.1.P": (0.0, 20.0), "supports.*.gap": (-0.5 * W, 0.5 * W)}[param]
     path = exact_path(scene, param, lo, hi)
     ts = np.linspace(lo, hi, 13)
     ts = np.concatenate([ts, [b["at"] for b in path.breakpoints]])
@@ -67,12 +67,12 @@ def test_path_matches_pointwise_solves(seed, param):
                                    atol=1e-8 * W)
 
 
-@pytest.mark.parametrize("seed, param", [(1, "supports.3.gap"), (3, "supports.3.gap"), (3, "loads.1.P"),
+@pytest.mark.parametrize("seed, param", [(1, "supports.4.gap"), (3, "supports.4.gap"), (3, "loads.1.P"),
                                          (5, "loads.1.P"), (3, "supports.*.gap")])
 def test_path_matches_bisection(seed, param):
     scene = random_scene(seed)
     W = 0.01 / scene.plate.D
-    lo, hi = {"supports.3.gap": (-W, W), "loads.1.P": (0.0, 20.0), "supports.*.gap": (-0.5 * W, 0.5 * W)}[param]
+    lo, hi = {"supports.4.gap": (-W, W), "loads.1.P": (0.0, 20.0), "supports.*.gap": (-0.5 * W, 0.5 * W)}[param]
     values = list(np.linspace(lo, hi, 7))
     rtol = 1e-7
     bis = sweep(scene, param, values, backend="lemke", accuracy="high", executor="serial", progress=False, rtol=rtol)
@@ -100,7 +100,7 @@ def test_prescribed_displacement_is_linear():
 
 
 @pytest.mark.parametrize("param, values, what", [
-    ("supports.0.stiffness", (1e3, 1e4), "flexibility 1/c"),
+    ("supports.1.stiffness", (1e3, 1e4), "flexibility 1/c"),
     ("foundation.k", (1e3, 1e4), "flexibility 1/c"),
     ("plate.h", (0.01, 0.02), "stiffness matrix"),
     ("mesh.nx", (4, 8), "mesh"),
@@ -117,7 +117,7 @@ def test_refuses_parameters_that_are_not_linear(param, values, what):
 
 def test_exact_sweep_needs_monotone_values():
     with pytest.raises(pq.ProblemError, match="increasing or decreasing"):
-        exact_sweep(corners(), "supports.2.gap", [0.0, 0.02, 0.01], executor="serial", progress=False)
+        exact_sweep(corners(), "supports.3.gap", [0.0, 0.02, 0.01], executor="serial", progress=False)
 
 
 def test_cli_sweep_exact(tmp_path, capsys):
@@ -127,7 +127,7 @@ def test_cli_sweep_exact(tmp_path, capsys):
     path = tmp_path / "corners.toml"
     scene.to_toml(path)
     dstar = A**4 / (8 * scene.plate.D * (1 - NU))
-    argv = ["sweep", str(path), "--param", "supports.2.gap", "--values", f"0,{dstar / 2},{1.5 * dstar},{2 * dstar}",
+    argv = ["sweep", str(path), "--param", "supports.3.gap", "--values", f"0,{dstar / 2},{1.5 * dstar},{2 * dstar}",
             "--workers", "1", "--json"]
     assert main(argv + ["--exact"]) == 0
     d = json.loads(capsys.readouterr().out)
@@ -136,11 +136,11 @@ def test_cli_sweep_exact(tmp_path, capsys):
     assert d["breakpoints"][0]["between"] == [dstar / 2, 1.5 * dstar]
     assert main(argv) == 0
     assert json.loads(capsys.readouterr().out)["method"] == "bisection"
-    assert main(["sweep", str(path), "--param", "supports.2.stiffness", "--values", "1e3,1e4", "--exact"]) == 2
+    assert main(["sweep", str(path), "--param", "supports.3.stiffness", "--values", "1e3,1e4", "--exact"]) == 2
     err = capsys.readouterr().err
     assert "linearly" in err and len(err.strip().splitlines()) == 1
 
 
 def test_step_limit_is_an_error():
     with pytest.raises(pq.ProblemError, match="more than 1 pieces"):
-        exact_path(corners(4), "supports.2.gap", 0.0, 0.05, max_pieces=1)
+        exact_path(corners(4), "supports.3.gap", 0.0, 0.05, max_pieces=1)

@@ -19,14 +19,14 @@ def test_the_studies_package_keeps_the_names():
 def test_get_and_set_paths():
     sc = fig5()
     assert get_param(sc, "plate.h") == 20.0
-    assert get_param(sc, "supports.0.gap") == -0.02
+    assert get_param(sc, "supports.1.gap") == -0.02
     assert get_param(sc, "supports.*.gap")[:3] == [-0.02, -0.02, 0.0]
     assert get_param(sc, "loads.0.P") == 20000.0
     assert get_param(sc, "edges.left") == "free"  # an edge not named is free
 
     s2 = set_param(sc, STIFF, 1e4)
     assert get_param(s2, STIFF) == [1e4] * 25 and get_param(sc, STIFF) == ["rigid"] * 25  # a copy
-    assert get_param(set_param(s2, "supports.3.stiffness", float("inf")), "supports.3.stiffness") == "rigid"
+    assert get_param(set_param(s2, "supports.4.stiffness", float("inf")), "supports.4.stiffness") == "rigid"
     assert get_param(set_param(s2, STIFF, "rigid"), STIFF) == ["rigid"] * 25
     nx = get_param(set_param(sc, "mesh.nx", 16.0), "mesh.nx")
     assert nx == 16 and isinstance(nx, int)
@@ -39,14 +39,16 @@ def test_get_and_set_paths():
 
 
 @pytest.mark.parametrize("path, value, words", [
-    ("supports.25.gap", 0.0, ["supports.25", "25 supports", "0..24"]),
-    ("supports.3.gapp", 0.0, ["supports.3.gapp", "x, y, gap, stiffness"]),
+    ("supports.26.gap", 0.0, ["supports.26", "25 supports", "numbered from 1 (1..25)"]),
+    ("supports.4.gapp", 0.0, ["supports.4.gapp", "x, y, gap, stiffness"]),
     ("plat.h", 1.0, ["plat", "plate", "mesh", "supports"]),
-    ("supports.x.gap", 0.0, ["supports.x", "index", "'*'"]),
+    ("supports.x.gap", 0.0, ["supports.x", "numbered from 1", "'*'"]),
+    ("supports.0.gap", 0.0, ["supports.0", "numbered from 1"]),
+    ("loads.5.P", 0.0, ["loads.5", "indexed from 0 (0.."]),
     ("foundation.k", 1.0, ["foundation", "no foundation"]),
     ("plate.h.x", 1.0, ["plate.h", "value"]),
-    ("supports.3.stiffness", -5.0, ["supports.3.stiffness", "> 0"]),
-    ("supports.3.stiffness", "soft", ["supports.3.stiffness", "soft"]),
+    ("supports.4.stiffness", -5.0, ["supports.4.stiffness", "> 0"]),
+    ("supports.4.stiffness", "soft", ["supports.4.stiffness", "soft"]),
     ("mesh.nx", 2.5, ["mesh.nx", "integer"]),
     ("edges.middle", "simple", ["edges.middle", "left, right, bottom, top"]),
     ("supports..gap", 0.0, ["bad path"]),
@@ -67,8 +69,8 @@ def test_as_number(value, number):
 @pytest.mark.parametrize("path, words", [
     ("plate", ["plate", "a table", "plate.h"]),
     ("mesh", ["mesh", "a table", "mesh.nx"]),
-    ("supports", ["supports", "list", "supports.0.gap"]),
-    ("supports.0", ["supports.0", "a table", "supports.0.gap"]),
+    ("supports", ["supports", "list", "supports.1.gap"]),
+    ("supports.1", ["supports.1", "a table", "supports.1.gap"]),
     ("supports.*", ["supports.*", "a table", "supports.*.gap"]),
     ("loads", ["loads", "list"]),
     ("loads.0", ["loads.0", "a table", "loads.0.P"]),
@@ -88,7 +90,7 @@ def test_a_path_that_names_a_table_is_refused(path, words):
         set_param(s4, "foundation", 2.0)
 
 
-@pytest.mark.parametrize("path", ["plate", "supports", "supports.0", "loads.0", "edges", "mesh", "foundation"])
+@pytest.mark.parametrize("path", ["plate", "supports", "supports.1", "loads.0", "edges", "mesh", "foundation"])
 def test_sweep_of_a_table_is_one_line_exit_2(capsys, path):
     from plateqp.cli import main
 

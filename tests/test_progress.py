@@ -25,7 +25,7 @@ from plateqp.cli.common import _output
 from plateqp.studies import sweep
 
 ROOT = Path(__file__).resolve().parents[1]
-SWEEP = ["sweep", "heave", "--param", "supports.1.gap", "--values", "-0.3,0.1", "--no-refine", "--workers", "1"]
+SWEEP = ["sweep", "heave", "--param", "supports.2.gap", "--values", "-0.3,0.1", "--no-refine", "--workers", "1"]
 
 
 class FakeTTY(io.StringIO):
@@ -55,7 +55,7 @@ def test_hidden_when_stderr_is_not_a_terminal(heave, capsys, monkeypatch):
     with progress.Progress(3, "steps") as bar:
         bar.update(3)
     assert list(progress.track(range(4), "items")) == [0, 1, 2, 3]
-    sweep(heave, "supports.1.gap", [-0.3, 0.1], executor="serial", refine_breakpoints=False)  # progress=True
+    sweep(heave, "supports.2.gap", [-0.3, 0.1], executor="serial", refine_breakpoints=False)  # progress=True
     assert capsys.readouterr().err == ""
 
 
@@ -64,11 +64,11 @@ def test_shown_on_a_terminal(heave, monkeypatch, has_tqdm):
     tty = as_tty(monkeypatch)
     if not has_tqdm:
         monkeypatch.setitem(sys.modules, "tqdm", None)  # as if tqdm were not installed
-    sweep(heave, "supports.1.gap", [-0.3, 0.1], executor="serial", refine_breakpoints=False)
+    sweep(heave, "supports.2.gap", [-0.3, 0.1], executor="serial", refine_breakpoints=False)
     text = tty.getvalue()
-    assert "sweep supports.1.gap" in text
+    assert "sweep supports.2.gap" in text
     if not has_tqdm:
-        assert "sweep supports.1.gap: 2/2" in text
+        assert "sweep supports.2.gap: 2/2" in text
         assert text.endswith("\r") and text.rsplit("\r", 2)[-2].strip() == ""  # the line is wiped at the end
 
 
@@ -103,7 +103,7 @@ def test_json_stays_clean_while_a_bar_is_drawn(capsys, monkeypatch):
     d = json.loads(capsys.readouterr().out)  # JSON alone on standard output
     assert [r["value"] for r in d["rows"]] == [-0.3, 0.1]
     assert sum(d["rows"][0]["reactions"]) == pytest.approx(62000.0, rel=1e-9)  # statics of the heave slab
-    assert "sweep supports.1.gap" in tty.getvalue()  # the bar went to standard error
+    assert "sweep supports.2.gap" in tty.getvalue()  # the bar went to standard error
 
 
 def _log_lines(quiet=False, verbose=0):
@@ -134,7 +134,7 @@ def test_cli_quiet_and_verbose_in_process(capsys):
     handlers = list(root.handlers)
     assert main(["--verbose"] + SWEEP) == 0
     err = capsys.readouterr().err
-    assert "INFO plateqp.studies.sweep: sweep of supports.1.gap: 2 values" in err
+    assert "INFO plateqp.studies.sweep: sweep of supports.2.gap: 2 values" in err
     assert main(SWEEP + ["--quiet"]) == 0
     assert capsys.readouterr().err == ""
     assert main(SWEEP) == 0
@@ -156,7 +156,7 @@ def test_cli_quiet_and_verbose_in_a_subprocess():
         json.loads(r.stdout)
         return r.stderr
 
-    assert "INFO plateqp.studies.sweep: sweep of supports.1.gap" in run("-v")
+    assert "INFO plateqp.studies.sweep: sweep of supports.2.gap" in run("-v")
     assert run("--quiet") == ""
     assert "INFO" not in run()
 
@@ -178,7 +178,7 @@ def _convergence(sc):
 def _exact(sc):
     from plateqp.studies import exact_path
 
-    exact_path(sc, "supports.1.gap", -0.3, 0.1)
+    exact_path(sc, "supports.2.gap", -0.3, 0.1)
 
 
 def _uniform(sc):
@@ -193,7 +193,7 @@ def _regulate(sc):
 
 @pytest.mark.parametrize("run, line", [
     (_convergence, "meshes: 2/2"),
-    (_exact, "exact path of supports.1.gap, % of the range: 100/100"),
+    (_exact, "exact path of supports.2.gap, % of the range: 100/100"),
     (_uniform, "most uniform stiffness: solves: 3"),
     (_regulate, "regulate: gaps, then the check: 2/2"),
 ], ids=["convergence", "exact-path", "uniform-stiffness", "regulate"])

@@ -1,7 +1,7 @@
 """Scene validation and TOML round trips.
 
 Every invalid scene must raise SceneError whose message names the offending field (dotted path,
-e.g. ``supports.1.gap``) and, for a scene read from a file, the file. A scene written to TOML
+e.g. ``supports.2.gap``) and, for a scene read from a file, the file. A scene written to TOML
 and read back must compare equal (dataclass equality) to the one written.
 """
 
@@ -81,17 +81,17 @@ BAD = [
      "loads.1"),
     ("patch-inverted", {"add": '[[loads]]\ntype = "patch"\nq = 1.0\nx0 = 1.0\nx1 = 0.5\ny0 = 0.0\ny1 = 1.0\n'},
      "loads.1"),
-    ("support-outside", {"add": "[[supports]]\nx = 0.5\ny = 1.5\n"}, "supports.0"),
+    ("support-outside", {"add": "[[supports]]\nx = 0.5\ny = 1.5\n"}, "supports.1"),
     ("support-in-opening", {"add": '[[openings]]\nx0 = 1.0\nx1 = 2.0\ny0 = 0.5\ny1 = 1.0\n'
-                                   "[[supports]]\nx = 1.5\ny = 0.9\n"}, "supports.0"),
+                                   "[[supports]]\nx = 1.5\ny = 0.9\n"}, "supports.1"),
     ("two-supports-one-point", {"add": "[[supports]]\nx = 0.5\ny = 0.5\n[[supports]]\nx = 0.7\ny = 0.5\n"
-                                       "[[supports]]\nx = 0.5\ny = 0.5\ngap = 0.1\n"}, "supports.2"),
-    ("negative-stiffness", {"add": "[[supports]]\nx = 0.5\ny = 0.5\nstiffness = -10.0\n"}, "supports.0.stiffness"),
-    ("zero-stiffness", {"add": "[[supports]]\nx = 0.5\ny = 0.5\nstiffness = 0.0\n"}, "supports.0.stiffness"),
-    ("stiffness-word", {"add": '[[supports]]\nx = 0.5\ny = 0.5\nstiffness = "soft"\n'}, "supports.0.stiffness"),
-    ("gap-nan", {"add": "[[supports]]\nx = 0.5\ny = 0.5\ngap = nan\n"}, "supports.0.gap"),
-    ("gap-string", {"add": '[[supports]]\nx = 0.5\ny = 0.5\ngap = "0"\n'}, "supports.0.gap"),
-    ("unknown-support-key", {"add": "[[supports]]\nx = 0.5\ny = 0.5\nk = 1.0\n"}, "supports.0.k"),
+                                       "[[supports]]\nx = 0.5\ny = 0.5\ngap = 0.1\n"}, "supports.3"),
+    ("negative-stiffness", {"add": "[[supports]]\nx = 0.5\ny = 0.5\nstiffness = -10.0\n"}, "supports.1.stiffness"),
+    ("zero-stiffness", {"add": "[[supports]]\nx = 0.5\ny = 0.5\nstiffness = 0.0\n"}, "supports.1.stiffness"),
+    ("stiffness-word", {"add": '[[supports]]\nx = 0.5\ny = 0.5\nstiffness = "soft"\n'}, "supports.1.stiffness"),
+    ("gap-nan", {"add": "[[supports]]\nx = 0.5\ny = 0.5\ngap = nan\n"}, "supports.1.gap"),
+    ("gap-string", {"add": '[[supports]]\nx = 0.5\ny = 0.5\ngap = "0"\n'}, "supports.1.gap"),
+    ("unknown-support-key", {"add": "[[supports]]\nx = 0.5\ny = 0.5\nk = 1.0\n"}, "supports.1.k"),
     ("pin-outside", {"add": "[[pins]]\nx = -0.5\ny = 0.0\n"}, "pins.0"),
     ("pin-off-node", {"add": "[[pins]]\nx = 0.3\ny = 0.0\n"}, "pins.0"),
     ("opening-inverted", {"add": "[[openings]]\nx0 = 1.0\nx1 = 0.5\ny0 = 0.0\ny1 = 1.0\n"}, "openings.0"),
@@ -122,10 +122,10 @@ BAD = [
     ("thin-beyond-range", {"sub": ("h = 0.02", "h = 1e-120")}, "plate.h"),
     ("load-beyond-range", {"sub": ("q = 1.0", "q = 1e300")}, "loads.0.q"),
     ("load-below-range", {"sub": ("q = 1.0", "q = 1e-300")}, "loads.0.q"),
-    ("gap-beyond-range", {"add": "[[supports]]\nx = 1.0\ny = 0.5\ngap = 1e300\n"}, "supports.0.gap"),
+    ("gap-beyond-range", {"add": "[[supports]]\nx = 1.0\ny = 0.5\ngap = 1e300\n"}, "supports.1.gap"),
     ("stiffness-denormal", {"add": "[[supports]]\nx = 1.0\ny = 0.5\nstiffness = 5e-324\n"},
-     "supports.0.stiffness"),
-    ("stiffness-string", {"add": '[[supports]]\nx = 1.0\ny = 0.5\nstiffness = "soft"\n'}, "supports.0.stiffness"),
+     "supports.1.stiffness"),
+    ("stiffness-string", {"add": '[[supports]]\nx = 1.0\ny = 0.5\nstiffness = "soft"\n'}, "supports.1.stiffness"),
     ("name-not-a-string", {"sub": ('name = "base"', "name = [1, 2]")}, "name"),
     ("supports-a-table", {"add": "[supports]\nx = 1.0\n"}, "supports"),
 ]
@@ -174,9 +174,9 @@ def test_invalid_scene_in_python_names_field():
     """Built in Python (no file), the message still names the field."""
     with pytest.raises(pq.SceneError, match=r"^plate\.h:"):
         pq.Scene(plate=pq.Plate(h=-1.0))
-    with pytest.raises(pq.SceneError, match=r"^supports\.0\.gap:"):
+    with pytest.raises(pq.SceneError, match=r"^supports\.1\.gap:"):
         pq.Scene(supports=[pq.Support(0.5, 0.5, gap=math.nan)])
-    with pytest.raises(pq.SceneError, match=r"^supports\.1:.*supports\.0"):
+    with pytest.raises(pq.SceneError, match=r"^supports\.2:.*supports\.1"):
         pq.Scene(supports=[pq.Support(0.5, 0.5), pq.Support(0.5, 0.5, stiffness=10.0)])
     with pytest.raises(pq.SceneError, match=r"^loads\.0:"):
         pq.Scene(loads=[pq.PointLoad(1.0, 1.5, 0.5)])
@@ -363,16 +363,16 @@ def test_validation_locates_all_supports_at_once_with_the_same_answer():
     ok = pq.Scene(plate=base.plate, mesh=base.mesh, openings=[opening], loads=base.loads,
                   supports=[pq.Support(x, y) for x, y in on_plate])
     assert len(ok.supports) == len(on_plate)
-    for x, y in off_plate[:3]:  # one bad support among good ones: named by its own index
+    for x, y in off_plate[:3]:  # one bad support among good ones: named by its own number (from 1)
         sup = [pq.Support(*p) for p in on_plate[:5]] + [pq.Support(x, y)] + [pq.Support(*p) for p in on_plate[5:8]]
-        with pytest.raises(pq.SceneError, match=r"supports\.5: point .* lies in an opening"):
+        with pytest.raises(pq.SceneError, match=r"supports\.6: point .* lies in an opening"):
             pq.Scene(plate=base.plate, mesh=base.mesh, openings=[opening], loads=base.loads, supports=sup)
     # a bad coordinate after a good one still names the first bad field, in order
     sup = [pq.Support(0.1, 0.1), pq.Support("x", 0.2), pq.Support(0.75, 0.75)]
-    with pytest.raises(pq.SceneError, match=r"supports\.1\.x: must be a number"):
+    with pytest.raises(pq.SceneError, match=r"supports\.2\.x: must be a number"):
         pq.Scene(plate=base.plate, mesh=base.mesh, openings=[opening], loads=base.loads, supports=sup)
     sup = [pq.Support(0.1, 0.1), pq.Support(0.75, 0.75, gap=math.nan)]
-    with pytest.raises(pq.SceneError, match=r"supports\.1\.gap: must be finite"):
+    with pytest.raises(pq.SceneError, match=r"supports\.2\.gap: must be finite"):
         pq.Scene(plate=base.plate, mesh=base.mesh, openings=[opening], loads=base.loads, supports=sup)
 
 

@@ -123,7 +123,7 @@ def test_gaps_and_loads_against_finite_differences(seed, backend, formulation):
     W = 0.01 / scene.plate.D
     checked = 0
     for j, sup in enumerate(scene.supports):
-        fd = _fd(scene, f"supports.{j}.gap", sup.gap, 1e-4 * W, r.active, backend, formulation)
+        fd = _fd(scene, f"supports.{j + 1}.gap", sup.gap, 1e-4 * W, r.active, backend, formulation)
         if fd is None:
             continue
         scale = np.abs(Sg.reactions).max()
@@ -148,10 +148,10 @@ def test_stiffness_against_finite_differences(seed):
     r = solve(scene)
     S = pq.sensitivity(r, "stiffness")
     elastic = [j for j, s in enumerate(scene.supports) if not s.rigid]
-    assert S.labels == [f"supports.{j}.stiffness" for j in elastic]
+    assert S.labels == [f"supports.{j + 1}.stiffness" for j in elastic]
     for col, j in enumerate(elastic):
         c = scene.supports[j].stiffness
-        fd = _fd(scene, f"supports.{j}.stiffness", c, 1e-4 * c, r.active, "lemke", "condensed")
+        fd = _fd(scene, f"supports.{j + 1}.stiffness", c, 1e-4 * c, r.active, "lemke", "condensed")
         assert fd is not None
         scale = np.abs(S.reactions).max() * c
         np.testing.assert_allclose(S.reactions[:, col] * c, fd[0] * c, atol=1e-6 * max(scale, 1e-300) + 1e-12)
@@ -195,7 +195,7 @@ def test_one_sided_derivatives_at_lift_off():
     with pytest.raises(pq.ProblemError, match="lift-off"):
         np.asarray(S)
     d = S.to_dict()
-    assert "increasing" in d and "decreasing" in d and d["degenerate"] == [0, 2]
+    assert "increasing" in d and "decreasing" in d and d["degenerate"] == [1, 3]  # JSON: numbered from 1
 
 
 def test_errors():
@@ -235,7 +235,7 @@ def test_cli_sensitivity(tmp_path, capsys):
     d = json.loads(capsys.readouterr().out)
     k = 2 * corners().plate.D * (1 - NU) / A**2
     np.testing.assert_allclose(d["sensitivity"]["reactions"][0][2], -k, rtol=1e-9)
-    assert d["sensitivity"]["parameters"][2] == "supports.2.gap" and d["sensitivity"]["smooth"]
+    assert d["sensitivity"]["parameters"][2] == "supports.3.gap" and d["sensitivity"]["smooth"]
     two_sided = pq.Scene(name="t", edges={"left": "clamped"}, loads=[pq.UniformLoad(1.0)], mesh=pq.MeshSpec(4, 4))
     two_sided.to_toml(tmp_path / "t.toml")
     assert main(["solve", str(tmp_path / "t.toml"), "--sensitivity"]) == 2

@@ -17,7 +17,7 @@ from study_scenes import STIFF, contact_set, fig5, solve
 
 @pytest.mark.parametrize("path, values", [
     (STIFF, ["rigid", 1e6, 3e4, 1e3, 30.0]),
-    ("supports.12.gap", [-0.05, -0.01, 0.0, 0.02]),
+    ("supports.13.gap", [-0.05, -0.01, 0.0, 0.02]),
     ("loads.0.P", [5000.0, 20000.0, 40000.0]),
     ("plate.h", [15.0, 25.0]),  # changes K: rebuilt for each value
 ])
@@ -128,7 +128,7 @@ WARM = [("bpp", "condensed"), ("pdas", "primal")]
 @pytest.mark.parametrize("backend, formulation", WARM)
 @pytest.mark.parametrize("path, values", [
     (STIFF, ["rigid", 1e5, 3e4, 1e4, 3e3, 1e3]),
-    ("supports.12.gap", [0.0, 0.01, 0.02, 0.03, 0.05]),  # settlement of the middle support
+    ("supports.13.gap", [0.0, 0.01, 0.02, 0.03, 0.05]),  # settlement of the middle support
 ])
 def test_warm_and_cold_sweeps_equal_independent_lemke_solves(backend, formulation, path, values):
     """Warm-started, re-used-cold and from-scratch sweeps all give each value's own answer:
@@ -156,7 +156,7 @@ def test_warm_start_makes_an_unchanged_contact_set_one_step():
     of the value before takes one step (the start is the answer), and the sweep takes fewer
     steps in all than the same sweep started cold; bisection finds the same breakpoints."""
     sc = fig5()
-    path, values = "supports.12.gap", list(np.linspace(0.0, 0.05, 11))
+    path, values = "supports.13.gap", list(np.linspace(0.0, 0.05, 11))
     for backend, formulation in WARM:
         if backend not in pq.available_backends():
             continue
@@ -253,7 +253,7 @@ def test_gap_sweep_bisects_linearly():
     """A settlement of the middle support, 0 to 0.05 cm: supports come into contact and lift
     off; each change is bracketed to rtol × max |value| and confirmed by independent solves."""
     sc = fig5()
-    path = "supports.12.gap"
+    path = "supports.13.gap"
     res = sweep(sc, path, [0.0, 0.05], executor="serial", progress=False, rtol=1e-3)
     assert len(res.breakpoints) >= 4
     for b in res.breakpoints:
@@ -284,9 +284,9 @@ def test_cli_sweep_json(capsys, tmp_path):
         assert b["between"] in (["rigid", 1e6], [1e6, 5e5])
     np.testing.assert_allclose(d["rows"][0]["reactions"], one["reactions"], rtol=1e-9, atol=1e-6)
 
-    code = main(["sweep", str(path), "--param", "supports.12.gap", "--range", "0.0:0.04:3", "--no-refine"])
+    code = main(["sweep", str(path), "--param", "supports.13.gap", "--range", "0.0:0.04:3", "--no-refine"])
     out = capsys.readouterr()
-    assert code == 0 and "sweep of supports.12.gap: 3 values" in out.out
+    assert code == 0 and "sweep of supports.13.gap: 3 values" in out.out
 
     # warm or cold, bpp gives the same answers
     runs = [json.loads((main(["sweep", str(path), "--param", STIFF, "--values", "1e6,5e5,1e5", "--json",
@@ -302,7 +302,7 @@ def test_cli_sweep_json(capsys, tmp_path):
 
 
 @pytest.mark.parametrize("argv, code, words", [
-    (["--param", "supports.30.gap", "--values", "0"], 2, ["supports.30", "25 supports"]),
+    (["--param", "supports.31.gap", "--values", "0"], 2, ["supports.31", "25 supports"]),
     (["--param", "loads.0.P", "--range", "1:2:x"], 2, ["--range"]),
     (["--param", "loads.0.P", "--values", "1e4,-1e6", "--workers", "1"], 5, ["1 of 2", "NoEquilibriumError"]),
 ])

@@ -81,7 +81,7 @@ def run_and_interrupt(tmp_path: Path, workers: int, sig: int, extra=()):
     alive when the sweep's last line came)."""
     master, slave = pty.openpty()
     fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))  # tqdm needs a width
-    cmd = [sys.executable, "-m", "plateqp.cli", "sweep", str(scene_file(tmp_path)), "--param", "supports.0.gap",
+    cmd = [sys.executable, "-m", "plateqp.cli", "sweep", str(scene_file(tmp_path)), "--param", "supports.1.gap",
            "--range", f"0:1e-3:{N}", "--no-refine", "--workers", str(workers), *extra]
     env = dict(os.environ, PYTHONPATH=str(Path(pq.__file__).parents[1]))
     env.pop("PLATEQP_DEBUG", None)
@@ -93,7 +93,7 @@ def run_and_interrupt(tmp_path: Path, workers: int, sig: int, extra=()):
     first = SERIAL_FIRST if workers == 1 else 1
     seen_workers: set[int] = set()
     try:
-        while True:  # the counter line: "sweep supports.0.gap: k/N" (or tqdm's "k/N")
+        while True:  # the counter line: "sweep supports.1.gap: k/N" (or tqdm's "k/N")
             ready, _, _ = select.select([master], [], [], 120.0)
             if not ready or p.poll() is not None:
                 pytest.fail(f"the sweep never showed progress (rc {p.poll()}): {err[-500:]!r}")
@@ -165,7 +165,7 @@ def test_a_sweep_that_is_not_interrupted_has_no_interrupted_field():
                   loads=[pq.PointLoad(10.0, 0.5, 0.5)], supports=[pq.Support(0.5, 0.5)])
     from plateqp.studies import sweep
 
-    res = sweep(sc, "supports.0.gap", [0.0, 1e-3], executor="serial", progress=False)
+    res = sweep(sc, "supports.1.gap", [0.0, 1e-3], executor="serial", progress=False)
     assert "interrupted" not in res.to_dict() and res.interrupted is None
 
 
@@ -202,3 +202,17 @@ def test_abort_ends_the_workers_and_the_executor_manager_thread(tmp_path):
     manager_alive, workers_alive, seconds = run.stdout.split()
     assert manager_alive == "0" and workers_alive == "0"
     assert float(seconds) < 10.0  # the sleeping tasks were not waited for
+
+
+def test_an_interrupted_sweep_with_workers_has_stored_every_row_it_reports(tmp_path):
+    """The store holds each row the moment it is solved: after Ctrl-C it holds exactly the rows
+    the sweep reports done (none lost in a chunk the workers had not finished)."""
+    store = tmp_path / "rows.jsonl"
+    rc, out, err, _, _ = run_and_interrupt(tmp_path, 2, signal.SIGINT, ["--json", "--store", str(store)])
+    assert rc == 130, err[-800:]
+    d = json.loads(out)
+    lines = store.read_text().splitlines()
+    stored = sorted(json.loads(x)["index"] for x in lines[1:])
+    assert d["interrupted"]["done"] == len(d["rows"]) == len(stored) >= 1
+    values = np.linspace(0, 1e-3, N)
+    assert sorted(r["value"] for r in d["rows"]) == pytest.approx(sorted(float(values[i]) for i in stored))

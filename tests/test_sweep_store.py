@@ -35,7 +35,7 @@ def heave():
 
 @pytest.fixture(scope="module")
 def fresh(heave):
-    return sweep(heave, "supports.1.gap", VALUES, executor="serial", progress=False)
+    return sweep(heave, "supports.2.gap", VALUES, executor="serial", progress=False)
 
 
 def _stop_after(monkeypatch, k):
@@ -62,13 +62,13 @@ def test_a_stopped_sweep_keeps_its_rows_on_disk_and_resumes(heave, fresh, tmp_pa
     store = tmp_path / "rows.jsonl"
     _stop_after(monkeypatch, 2)
     with pytest.raises(SweepInterrupted) as info:
-        sweep(heave, "supports.1.gap", VALUES, executor="serial", progress=False, store=store)
+        sweep(heave, "supports.2.gap", VALUES, executor="serial", progress=False, store=store)
     assert info.value.result.interrupted["done"] == 2
     header, recs = _stored_rows(store)
     assert header["values"] == VALUES and [r["index"] for r in recs] == [0, 1]
     monkeypatch.undo()
     calls = _stop_after(monkeypatch, 99)  # counts the solves of the resumed run
-    res = sweep(heave, "supports.1.gap", VALUES, executor="serial", progress=False, store=store)
+    res = sweep(heave, "supports.2.gap", VALUES, executor="serial", progress=False, store=store)
     assert calls == VALUES[2:]  # only the values the stopped run lacked
     assert [r["index"] for r in _stored_rows(store)[1]] == [0, 1, 2, 3, 4]
     for row, ref in zip(res.rows, fresh.rows):
@@ -80,27 +80,27 @@ def test_a_stopped_sweep_keeps_its_rows_on_disk_and_resumes(heave, fresh, tmp_pa
 
 def test_a_store_of_another_sweep_is_refused(heave, tmp_path):
     store = tmp_path / "rows.jsonl"
-    sweep(heave, "supports.1.gap", VALUES[:2], executor="serial", progress=False, store=store)
+    sweep(heave, "supports.2.gap", VALUES[:2], executor="serial", progress=False, store=store)
     before = store.read_text()
     with pytest.raises(ProblemError, match="holds another sweep .*values"):
-        sweep(heave, "supports.1.gap", VALUES, executor="serial", progress=False, store=store)
+        sweep(heave, "supports.2.gap", VALUES, executor="serial", progress=False, store=store)
     other = pq.Scene.from_toml(scenes.path("heave"))
     other.mesh.nx = other.mesh.ny = 4
     with pytest.raises(ProblemError, match="holds another sweep .*scene"):
-        sweep(other, "supports.1.gap", VALUES[:2], executor="serial", progress=False, store=store)
+        sweep(other, "supports.2.gap", VALUES[:2], executor="serial", progress=False, store=store)
     assert store.read_text() == before  # nothing mixed in
     (tmp_path / "junk.jsonl").write_text("not json\n")
     with pytest.raises(ProblemError, match="not a plateqp sweep store"):
-        sweep(heave, "supports.1.gap", VALUES[:2], executor="serial", progress=False, store=tmp_path / "junk.jsonl")
+        sweep(heave, "supports.2.gap", VALUES[:2], executor="serial", progress=False, store=tmp_path / "junk.jsonl")
 
 
 def test_a_line_cut_by_a_crash_is_solved_again(heave, fresh, tmp_path, monkeypatch):
     store = tmp_path / "rows.jsonl"
-    sweep(heave, "supports.1.gap", VALUES, executor="serial", progress=False, store=store)
+    sweep(heave, "supports.2.gap", VALUES, executor="serial", progress=False, store=store)
     text = store.read_text()
     store.write_text(text[: len(text) - len(text.splitlines()[-1]) // 2 - 1])  # the last row half written
     calls = _stop_after(monkeypatch, 99)
-    res = sweep(heave, "supports.1.gap", VALUES, executor="serial", progress=False, store=store)
+    res = sweep(heave, "supports.2.gap", VALUES, executor="serial", progress=False, store=store)
     assert calls == [VALUES[-1]]
     assert [r["index"] for r in _stored_rows(store)[1]] == [0, 1, 2, 3, 4]  # the file is whole again
     np.testing.assert_allclose(res.rows[-1]["reactions"], fresh.rows[-1]["reactions"], rtol=1e-9,
@@ -110,7 +110,7 @@ def test_a_line_cut_by_a_crash_is_solved_again(heave, fresh, tmp_path, monkeypat
 def test_cli_store_and_netcdf(tmp_path, capsys):
     xr = pytest.importorskip("xarray")
     out, store = tmp_path / "s.nc", tmp_path / "s.jsonl"
-    argv = ["sweep", "heave", "--param", "supports.1.gap", "--values", "-0.3,-0.1,0.1", "--no-refine",
+    argv = ["sweep", "heave", "--param", "supports.2.gap", "--values", "-0.3,-0.1,0.1", "--no-refine",
             "--json", "--store", str(store), "--out", str(out)]
     assert main(argv) == 0
     d = json.loads(capsys.readouterr().out)

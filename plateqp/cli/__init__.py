@@ -60,8 +60,17 @@ def _output_flags(p, here: bool) -> None:
                    help="the library's log messages on standard error (-v: INFO, -vv: DEBUG)")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with its errors as one line (what is wrong, and where to read the usage) and
+    exit code 2, instead of the usage followed by the error."""
+
+    def error(self, message):
+        cmd = self.prog.split(" ", 1)[1] + ": " if " " in self.prog else ""
+        self.exit(2, f"plateqp: {cmd}{message} (see {self.prog} --help)\n")
+
+
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="plateqp", description="Thin plates on one-sided supports, contact as a convex QP.")
+    ap = _Parser(prog="plateqp", description="Thin plates on one-sided supports, contact as a convex QP.")
     _output_flags(ap, True)
     sub = ap.add_subparsers(dest="cmd", required=True)
     d = sub.add_parser("demo", help="solve a built-in scene and print a summary")
@@ -95,7 +104,8 @@ def main(argv=None) -> int:
                    help="refuse meshes estimated to need more (e.g. 8G; default 80%% of this machine's memory)")
     w = sub.add_parser("sweep", help="solve a scene for a range of one parameter; find where the contact set changes")
     w.add_argument("scene")
-    w.add_argument("--param", required=True, metavar="PATH", help="e.g. supports.*.stiffness, supports.3.gap, loads.0.P")
+    w.add_argument("--param", required=True, metavar="PATH", help="e.g. supports.*.stiffness, supports.3.gap (support "
+                   "number 3: supports are numbered from 1, as in the tables), loads.0.P")
     wv = w.add_mutually_exclusive_group(required=True)
     wv.add_argument("--values", metavar="V1,V2,...", help="values in sweep order ('rigid' allowed for a stiffness)")
     wv.add_argument("--range", metavar="A:B:N[:log]", help="N values from A to B, evenly or log spaced")
@@ -109,7 +119,10 @@ def main(argv=None) -> int:
     w.add_argument("--exact", action="store_true",
                    help="breakpoints exactly, by parametric pivoting, for a parameter that enters linearly "
                         "(a gap, a load, a prescribed displacement); refused for a stiffness")
-    w.add_argument("--workers", type=int, default=None, help="local worker processes (default 2; 1: serial)")
+    w.add_argument("--workers", type=int, default=None, help="local worker processes (default 2; 1: serial); "
+                   "at most the cores this process may use, unless --force-workers")
+    w.add_argument("--force-workers", action="store_true",
+                   help="start --workers N processes even when N is more than the cores (with a warning)")
     w.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run the sweep on the existing Dask cluster "
                    "whose scheduler is at this address (not with --workers)")
     w.add_argument("--scheduler-timeout", type=float, default=10.0, metavar="S",
@@ -147,6 +160,7 @@ def main(argv=None) -> int:
     b.add_argument("--json", action="store_true")
     for p in sub.choices.values():
         _output_flags(p, False)
+    # a bad flag: one line and SystemExit(2) (_Parser.error); --help: SystemExit(0)
     args = ap.parse_args(_negative_values_joined(sys.argv[1:] if argv is None else list(argv)))
     if args.quiet and args.verbose:
         ap.error("--quiet and --verbose: choose one")

@@ -10,6 +10,7 @@ import contextlib
 import json
 import logging
 import os
+import stat
 import sys
 import warnings
 from pathlib import Path
@@ -116,20 +117,15 @@ def _backend_name(name: str) -> str:
 
 
 def _out_dir(text: str, files: list[str], force: bool) -> Path:
-    """Check ``--out`` before any work: a folder (made if missing) that is writable and holds none
-    of ``files`` (unless ``force``)."""
-    out = Path(text)
-    if out.exists() and not out.is_dir():
-        raise ProblemError(f"--out {out}: exists and is not a folder")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exn:
-        raise ProblemError(f"--out {out}: cannot be made ({exn.strerror or exn})") from None
-    if not os.access(out, os.W_OK | os.X_OK):
-        raise ProblemError(f"--out {out}: is not writable")
-    there = [f for f in files if (out / f).exists()]
-    if there and not force:
-        raise ProblemError(f"--out {out}: {there[0]} exists; use --force to overwrite")
+    """Check ``--out`` before any work (:mod:`plateqp.io.safe`): a folder, not a link, made if
+    missing, writable, where none of ``files`` exists (unless ``force``) and nothing on the way
+    to them is a link."""
+    from ..io.safe import check_target, out_folder
+
+    label = f"--out {text}"
+    out = out_folder(text, label=label)
+    for f in files:
+        check_target(out / f, force=force, label=label, root=out)
     return out
 
 
@@ -173,6 +169,9 @@ def _scene_or_builtin(text: str) -> Scene:
         if text in scenes.names():
             return scenes.load(text)
         raise SceneError(f"{text}: no such file, nor a built-in scene ({', '.join(scenes.names())})")
+    # a FIFO, a device or a folder: refused before it is opened (reading a FIFO blocks)
+    if not stat.S_ISREG(path.stat().st_mode):
+        raise SceneError(f"{text}: is not a regular file (a FIFO, a device or a folder); name a scene file")
     return Scene.from_toml(path)
 
 

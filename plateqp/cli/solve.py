@@ -80,7 +80,7 @@ def _sensitivity(result, as_json: bool):
     if sens.smooth:
         sides = [("dR_i/dg0_j", sens.increasing)]
     else:
-        at = ", ".join(str(int(i)) for i in sens.degenerate)
+        at = ", ".join(str(int(i) + 1) for i in sens.degenerate)  # numbered from 1, as in the table
         sides = [(f"dR_i/dg0_j as the gap increases (support(s) {at} at lift-off)", sens.increasing),
                  (f"dR_i/dg0_j as the gap decreases (support(s) {at} at lift-off)", sens.decreasing)]
     lines = []
@@ -142,8 +142,13 @@ def cmd_solve(args) -> int:
         if args.sensitivity:
             print(_sensitivity(result, False))
     if out is not None:
-        (out / f"{stem}.json").write_text(json.dumps(result.to_dict(args.probe), indent=1))
-        np.save(out / f"{stem}-w.npy", result.w_nodes())
+        from ..io.safe import write
+
+        label = f"--out {args.out}"
+        write(out / f"{stem}.json", json.dumps(result.to_dict(args.probe), indent=1), force=args.force,
+              label=label, root=out)
+        w = result.w_nodes()
+        write(out / f"{stem}-w.npy", lambda tmp: np.save(tmp, w), force=args.force, label=label, root=out)
         if vtu:
-            write_vtu(result, out, stem, force=True)  # the folder was checked before any work
+            write_vtu(result, out, stem, force=args.force)
     return 0 if result.status in (Status.OPTIMAL,) and reached else 5

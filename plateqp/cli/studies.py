@@ -16,7 +16,7 @@ from ..accuracy import Status
 from ..solving import solve
 from ..errors import PlateQPError, ProblemError
 from ..progress import Progress
-from .common import _options, _backend_name, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, _numbers
+from .common import _options, _backend_name, _stdout_to_stderr, _set_memory_limit, _scene_or_builtin, _numbers, log
 
 
 def cmd_regulate(args) -> int:
@@ -53,8 +53,9 @@ def cmd_regulate(args) -> int:
     error = float(np.abs(got - reg.reactions).max(initial=0.0) / scale)
     ok = check.status == Status.OPTIMAL and error <= 1e-6
     if args.out:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        reg.scene.to_toml(args.out)
+        from ..io.safe import write
+
+        write(args.out, reg.scene.to_toml(), force=args.force, label=f"--out {args.out}")
     rows = [{"support": int(k) + 1, "gap_before": float(scene.supports[k].gap), "gap": float(reg.gaps[k]),
              "target": float(t), "reaction": float(r), "reaction_check": float(g)}
             for k, t, r, g in zip(reg.supports, reg.target, reg.reactions, got)]
@@ -137,8 +138,21 @@ def _executor(args, stack: contextlib.ExitStack) -> tuple:
 
         client = stack.enter_context(connect(args.scheduler, timeout=args.scheduler_timeout))
         return client, 1
-    workers = 2 if args.workers is None else args.workers
-    return ("serial" if workers <= 1 else None), max(workers, 1)
+    from ..studies.parallel import available_cores
+
+    if args.workers is not None and args.workers < 1:
+        raise ProblemError(f"--workers: at least 1 (1: solve in this process; got {args.workers})")
+    cores = available_cores()
+    workers = min(2, cores) if args.workers is None else args.workers
+    if workers > cores:
+        if args.force_workers:
+            log.warning("--workers %d --force-workers: %d processes share the %d core(s) this process may use",
+                        workers, workers, cores)
+        else:
+            log.warning("--workers %d: capped at the %d core(s) this process may use "
+                        "(add --force-workers to start %d)", workers, cores, workers)
+            workers = cores
+    return ("serial" if workers <= 1 else None), workers
 
 
 def _sweep_exact(scene, values, opts, args, executor, workers):
@@ -165,6 +179,9 @@ def cmd_sweep(args) -> int:
         from ..io.fields import _optional
         from ..io.files import check_file
 
+        if Path(args.out).suffix.lower() not in NETCDF:
+            raise ProblemError(f"--out {args.out}: the format follows the extension, and plateqp writes "
+                               f"netCDF ({', '.join(NETCDF)}); name a .nc file")
         _optional("xarray")
         check_file(args.out, force=args.force, label=f"--out {args.out}", flag="--force")
     with _sigterm_as_interrupt() as seen, contextlib.ExitStack() as stack:
@@ -180,7 +197,7 @@ def cmd_sweep(args) -> int:
                                 warm_start=not args.no_warm_start, store=args.store)
         except SweepInterrupted as exn:
             part = exn.result
-            _write_netcdf(part, args.out)
+            _write_netcdf(part, args.out, args.force)
             print(json.dumps({"method": "none" if args.no_refine else "bisection", **part.to_dict()}, indent=1)
                   if args.json else part)
             sys.stdout.flush()
@@ -191,7 +208,7 @@ def cmd_sweep(args) -> int:
                   f" ({where}); not done: {len(left)}"
                   + (f" (from {args.param} = {left[0]})" if left else ""), file=sys.stderr)
             return 143 if seen else 130
-    _write_netcdf(res, args.out)
+    _write_netcdf(res, args.out, args.force)
     if args.json:
         print(json.dumps({"method": "none" if args.no_refine else "bisection", **res.to_dict()}, indent=1))
     else:
@@ -204,15 +221,20 @@ def cmd_sweep(args) -> int:
     return 0
 
 
-def _write_netcdf(res, out) -> None:
+#: The extensions ``sweep --out`` takes: netCDF (any other is refused before any work).
+NETCDF = (".nc", ".nc3", ".cdf", ".netcdf")
+
+
+def _write_netcdf(res, out, force: bool) -> None:
     """--out FILE.nc: the rows as an xarray Dataset (:meth:`SweepResult.to_xarray`), netCDF 3
-    through SciPy (no netCDF library needed); the file was checked before any work."""
+    through SciPy (no netCDF library needed), by :mod:`plateqp.io.safe`'s rules; the file was
+    checked before any work."""
     if not out:
         return
-    from pathlib import Path
+    from ..io.safe import write
 
-    Path(out).parent.mkdir(parents=True, exist_ok=True)
-    res.to_xarray().to_netcdf(out, engine="scipy")
+    ds = res.to_xarray()
+    write(out, lambda tmp: ds.to_netcdf(tmp, engine="scipy"), force=force, label=f"--out {out}")
 
 
 @contextlib.contextmanager

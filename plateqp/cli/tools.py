@@ -19,7 +19,7 @@ def cmd_demo(args) -> int:
     names = [args.name] if args.name else None
     files = output_files(names)  # an unknown scene: SceneError before any folder is made
     out = _out_dir(args.out or DEFAULT_OUT, files, args.force)  # before any work
-    return run(names, out)
+    return run(names, out, force=args.force)
 
 
 def cmd_backends(args) -> int:

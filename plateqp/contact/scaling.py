@@ -200,7 +200,7 @@ def check_distinct_contacts(data: Scaled, model: Model) -> None:
         flex = max(1.0 / kb[i] + data.rho[i], 1.0 / kb[j] + data.rho[j])
         ratio = (rel / max(kb[i], kb[j]) + data.rho[i] + data.rho[j]) / flex
         if ratio < DEPENDENT_ROWS:
-            names = [f"supports.{c.index[k]}" if c.source[k] == "support"
+            names = [f"supports.{c.index[k] + 1}" if c.source[k] == "support"
                      else f"the foundation node at ({c.xy[k, 0]:g}, {c.xy[k, 1]:g})" for k in (i, j)]
             d = float(np.hypot(*(c.xy[i] - c.xy[j])))
             raise ProblemError(

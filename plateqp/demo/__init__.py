@@ -56,12 +56,11 @@ read the grid's rows of nodes) and the convergence study by mesh halving (the st
 from __future__ import annotations
 
 import importlib.util
-import json
 import logging
 import math
 import time
 import warnings
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -70,7 +69,7 @@ from .. import scenes
 from ..errors import PlateQPWarning, SceneError
 from ..plotting.data import support_spacing
 from ..progress import Progress
-from ..report import format_table, report_html, summary_row
+from ..report import _json_safe, format_table, summary_row, write_files  # noqa: F401 - _json_safe: its old home
 from .paper import STUDIES, TITLES, run_study
 
 DEFAULT_OUT = "plateqp-demo"
@@ -511,7 +510,8 @@ def output_files(names: list[str] | None = None) -> list[str]:
             + [f for n in st_names for f in [f"{n}.json"] + [f"{n}-{stem}.png" for stem in STUDIES[n]]])
 
 
-def run(names: list[str] | None = None, out: Path | None = None, *, study_mesh: int | None = None) -> int:
+def run(names: list[str] | None = None, out: Path | None = None, *, study_mesh: int | None = None,
+        force: bool = True) -> int:
     """Solve the built-in scenes and run the studies ``names`` (all when None or empty), print
     the summary, write the report.
 
@@ -521,12 +521,15 @@ def run(names: list[str] | None = None, out: Path | None = None, *, study_mesh: 
     meshes, or on ``study_mesh`` cells per side (coarser for tests). Returns 0 when every
     one-sided result met its accuracy, else 5 (the exit code of ``plateqp solve`` for a
     missed accuracy). Raises :class:`~plateqp.errors.SceneError` for an unknown name, before
-    any work.
+    any work. Files are written by :mod:`plateqp.io.safe`'s rules: never through a link (an
+    ``out`` that is a link is refused), and over an existing file only with ``force`` (a link
+    there is then replaced, not its target).
     """
 
     names, study_names = _split(names)  # unknown name: SceneError now, not after minutes of work
-    out = Path(out) if out is not None else Path.cwd() / DEFAULT_OUT
-    out.mkdir(parents=True, exist_ok=True)
+    from ..io.safe import out_folder
+
+    out = out_folder(Path(out) if out is not None else Path.cwd() / DEFAULT_OUT, label=f"--out {out or DEFAULT_OUT}")
     t0 = time.perf_counter()
     figures = importlib.util.find_spec("matplotlib") is not None
     if not figures:
@@ -559,33 +562,9 @@ def run(names: list[str] | None = None, out: Path | None = None, *, study_mesh: 
         print(f"\n{st.name}: {st.title}")
         for line in st.lines:
             print(f"  {line}")
-    for r in runs:
-        for stem, png in r.figures.items():
-            (out / f"{stem}.png").write_bytes(png)
-        rep = {"one_sided": r.one.to_dict()}
-        if r.two is not None:
-            rep["two_sided"] = r.two.to_dict()
-        if r.comparison is not None:
-            rep["comparison"] = _json_safe(asdict(r.comparison))
-        if r.skipped:
-            rep["skipped"] = dict(r.skipped)
-        (out / f"{r.name}.json").write_text(json.dumps(rep, indent=1))
-    for st in studies:
-        for stem, png in st.figures.items():
-            (out / f"{stem}.png").write_bytes(png)
-        (out / f"{st.name}.json").write_text(json.dumps(_json_safe({"lines": st.lines, **st.data}), indent=1))
-    (out / "report.html").write_text(report_html(runs, table, studies), encoding="utf-8")
+    write_files(out, runs, studies, table, force=force)
     n_png = sum(len(r.figures) for r in runs) + sum(len(st.figures) for st in studies)
     print(f"\nwrote {n_png} figures, {len(runs) + len(studies)} JSON files and report.html to {out}"
           f" ({time.perf_counter() - t0:.1f} s)")
     return 0 if all(r.ok for r in runs) and all(st.ok for st in studies) else 5
 
-
-def _json_safe(d):
-    if isinstance(d, dict):
-        return {k: _json_safe(v) for k, v in d.items()}
-    if isinstance(d, list):
-        return [_json_safe(v) for v in d]
-    if isinstance(d, float) and not math.isfinite(d):
-        return None
-    return d

@@ -1,4 +1,5 @@
-"""Where an export may write, checked before any work is done.
+"""Where an export may write, checked before any work is done (the writing itself, and the rules
+for links: :mod:`plateqp.io.safe`).
 
 The promise (issue 10): nothing is written outside the path asked for, nothing that exists is
 overwritten unless forced, and a path that cannot be written says so in one line before the
@@ -70,6 +71,8 @@ def check_folder(directory, files=(), folders=(), *, force: bool = False, label:
     """
     directory = Path(directory)
     label = label or str(directory)
+    if os.path.islink(directory):
+        raise ExportError(f"{label}: is a symbolic link; name the directory itself (plateqp never writes through links)")
     if os.path.lexists(directory) and not directory.is_dir():
         raise ExportError(f"{label}: exists and is not a directory")
     if not directory.is_dir():
@@ -87,6 +90,8 @@ def check_folder(directory, files=(), folders=(), *, force: bool = False, label:
             must_be_folder = is_folder or k < len(rel.parts) - 1
             if not os.path.lexists(p):
                 break
+            if must_be_folder and os.path.islink(p):
+                raise ExportError(f"{label}: {p} is a symbolic link (plateqp never writes through links)")
             if must_be_folder and not p.is_dir():
                 raise ExportError(f"{label}: {p} is in the way (a file where a directory goes)")
             if not must_be_folder and p.is_dir():

@@ -56,12 +56,15 @@ def write_npz(qp, path, meta: dict | None = None) -> Path:
         else:
             arrays[key] = np.asarray(M, dtype=float)
     arrays["meta"] = np.array(json.dumps(meta, sort_keys=True))
-    path = Path(path)
-    try:
-        np.savez_compressed(path, **arrays)
-    except OSError as exn:
-        raise ExportError(f"{path}: cannot write ({exn.strerror or exn})") from exn
-    return path
+    from .safe import write
+
+    path = Path(path if str(path).endswith(".npz") else f"{path}.npz")  # numpy's rule
+
+    def save(tmp):
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+
+    return write(path, save, force=True)  # over a file, never through a link
 
 
 def npz_arrays(path) -> dict:

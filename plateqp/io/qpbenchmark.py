@@ -172,14 +172,26 @@ def _save_dense(qp, path: Path) -> None:
     except ImportError:
         raise ExportError("qpsolvers is not installed (it writes the dense problems of a qpbenchmark test "
                           "set): pip install 'plateqp[solvers]'") from None
-    qpsolvers.Problem(qp.P, qp.q, qp.G, qp.h, qp.A, qp.b, qp.lb, qp.ub).save(str(path))
+    from .safe import write
+
+    def save(tmp):
+        with open(tmp, "wb") as fh:
+            qpsolvers.Problem(qp.P, qp.q, qp.G, qp.h, qp.A, qp.b, qp.lb, qp.ub).save(fh)
+
+    write(path, save, force=True)
 
 
 def _save_reference(ref: dict, meta: dict, path: Path) -> None:
     arrays = {k: np.asarray(ref[k], dtype=float) for k in ("x", "z", "z_box", "reactions") if ref.get(k) is not None}
     arrays["objective"] = np.array(float(ref["objective"]))
     arrays["meta"] = np.array(json.dumps(meta, sort_keys=True))
-    np.savez_compressed(path, **arrays)
+    from .safe import write
+
+    def save(tmp):
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+
+    write(path, save, force=True)
 
 
 def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, title: str | None = None,
@@ -254,11 +266,14 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
         reader=textwrap.dedent(inspect.getsource(npz_arrays)))
     text = text.replace("DENSIFY_MAX_N = None", "DENSIFY_MAX_N = float('inf')")
     module = directory / f"{name}.py"
+    from .safe import make_folders, out_folder, write
+
+    out_folder(directory)  # made; a link refused
+    make_folders(directory, data_dir)
+    make_folders(directory, "results")  # where `qpbenchmark ... --results-path results/...` writes
+    if references is not None:
+        make_folders(directory, solutions_dir)
     try:
-        (directory / data_dir).mkdir(parents=True, exist_ok=True)
-        (directory / "results").mkdir(exist_ok=True)  # where `qpbenchmark ... --results-path results/...` writes
-        if references is not None:
-            (directory / solutions_dir).mkdir(parents=True, exist_ok=True)
         for (pname, problem), (qp, _, _, meta) in zip(items, qps):
             path = directory / data_dir / f"{pname}.npz"
             if sp.issparse(qp.P):
@@ -269,7 +284,7 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
                 ref = refs[pname]
                 _save_reference(ref, dict(meta or {}, **(ref.get("meta") or {})),
                                 directory / solutions_dir / f"{pname}.npz")
-        module.write_text(text)
+        write(module, text, force=True, root=directory)
     except OSError as exn:
         raise ExportError(f"{directory}: cannot write ({exn.strerror or exn})") from exn
     return module

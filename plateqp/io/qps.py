@@ -156,11 +156,9 @@ def write_qps(qp, path, name: str | None = None, *, var_names=None, row_names=No
             for i, v in zip(Pl.indices[Pl.indptr[j]:Pl.indptr[j + 1]], Pl.data[Pl.indptr[j]:Pl.indptr[j + 1]]):
                 w(f"    {var_names[j]}  {var_names[i]}  {_num(v)}")
     w("ENDATA")
-    try:
-        path.write_text("\n".join(out) + "\n")
-    except OSError as exn:
-        raise ExportError(f"{path}: cannot write ({exn.strerror or exn})") from exn
-    return path
+    from .safe import write
+
+    return write(path, "\n".join(out) + "\n", force=True)  # over a file, never through a link
 
 
 def read_qps(path, with_info: bool = False):

@@ -77,26 +77,28 @@ def supports_mesh(result):
 
 
 def write_vtu(result, folder, stem: str, force: bool = False) -> list[Path]:
-    """Write ``<stem>.vtu`` (and ``<stem>-supports.vtu``) into ``folder``; returns the paths.
+    """Write ``<stem>.vtu`` (and ``<stem>-supports.vtu``) into ``folder``, made if missing;
+    returns the paths.
 
-    Nothing is overwritten unless ``force``; every target is checked before the first is
-    written. Raises :class:`~plateqp.errors.ExportError` for a target that exists or cannot be
-    written, :class:`~plateqp.errors.PlateQPError` when meshio is missing.
+    The files are written by :mod:`plateqp.io.safe`'s rules: nothing is overwritten unless
+    ``force``, a link is never followed (with ``force`` a link where a file goes is replaced,
+    not its target), a ``folder`` that is a link is refused, and every target is checked
+    before the first is written. Raises :class:`~plateqp.errors.ExportError` for a target
+    that exists or cannot be written, :class:`~plateqp.errors.PlateQPError` when meshio is
+    missing.
     """
+    from .safe import check_target, out_folder, write
+
     meshio = _optional("meshio")
     if safe_filename(stem) != stem:
         raise ExportError(f"{stem!r}: not a plain file name (letters, digits, '._-', no leading dot); "
                           f"for example {safe_filename(stem)!r}")
-    folder = Path(folder)
+    folder = out_folder(folder)
     paths = [folder / name for name in vtu_files(stem, result)]
-    if not force:
-        for p in paths:
-            if p.exists() or p.is_symlink():
-                raise ExportError(f"{p}: exists; use --force to overwrite")
+    for p in paths:
+        check_target(p, force=force, flag="force=True", root=folder)
     meshes = [plate_mesh(result)] + ([supports_mesh(result)] if len(paths) > 1 else [])
     for p, mesh in zip(paths, meshes):
-        try:
-            meshio.write(p, mesh, file_format="vtu")
-        except OSError as exn:
-            raise ExportError(f"{p}: cannot be written ({exn.strerror or exn})") from None
+        write(p, lambda tmp, mesh=mesh: meshio.write(tmp, mesh, file_format="vtu"), force=force,
+              flag="force=True", root=folder)
     return paths

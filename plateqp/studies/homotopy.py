@@ -43,7 +43,7 @@ from ..scene import Scene
 from ..sensitivity import MAX_DEGENERATE, classify, held_solve, one_direction
 from ..solving import solve
 from .reuse import adapt_model
-from .sweep import SweepResult, sweep
+from .sweep import SweepResult, numbered, sweep
 
 logger = logging.getLogger(__name__)
 
@@ -306,9 +306,11 @@ class ExactSweepResult(SweepResult):
     method: str = "exact"
 
     def to_dict(self) -> dict:
-        """{rows, breakpoints, method: "exact", pieces}."""
+        """{rows, breakpoints, method: "exact", pieces}; contact points numbered from 1, as in
+        :meth:`SweepResult.to_dict`."""
         return {**super().to_dict(), "method": self.method,
-                "pieces": self.exact.pieces if self.exact is not None else []}
+                "pieces": [{**p, "contact": numbered(p["contact"])} for p in self.exact.pieces]
+                if self.exact is not None else []}
 
     def __str__(self) -> str:
         text = super().__str__()

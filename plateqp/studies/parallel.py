@@ -15,6 +15,7 @@ whole process group, and the sweep, not each worker, decides what happens (it st
 from __future__ import annotations
 
 import concurrent.futures as cf
+import os
 import pickle
 import signal
 import logging
@@ -28,11 +29,20 @@ logger = logging.getLogger(__name__)
 SERIAL_BELOW = 8
 
 
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system says, else all)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return max(1, os.cpu_count() or 1)
+
+
 class Serial:
     """Runs each task when its result is asked for, so progress advances as it goes."""
 
     kind = "serial"
     workers = 1
+    rows = None
 
     class _Task:
         def __init__(self, fn, args):
@@ -58,12 +68,35 @@ class Serial:
 
 
 class Futures:
-    """A concurrent.futures executor (ours or the user's) or a Dask distributed Client."""
+    """A concurrent.futures executor (ours or the user's) or a Dask distributed Client.
 
-    def __init__(self, executor, own: bool, dask: bool, workers: int):
+    ``rows``: for our own worker processes, the queue on which they send each row as soon as
+    it is solved (:func:`stream_row`), so that the sweep stores it then, not when the whole
+    chunk of values returns; None for other executors (the sweep then sends one value per
+    task)."""
+
+    def __init__(self, executor, own: bool, dask: bool, workers: int, rows=None):
         self.ex, self.own, self.dask, self.workers = executor, own, dask, workers
         self.kind = "dask" if dask else "futures"
         self.submitted: list = []
+        self.rows = rows
+
+    def drain(self):
+        """The rows the workers have sent so far: a list of (token, index, row), without waiting."""
+        import queue
+
+        out = []
+        while self.rows is not None:
+            try:
+                out.append(self.rows.get_nowait())
+            except (queue.Empty, OSError, ValueError, EOFError):
+                break
+        return out
+
+    def wait_any(self, futs, timeout: float = 0.1):
+        """The futures of ``futs`` done within ``timeout`` seconds (our own processes only)."""
+        done, _ = cf.wait(list(futs), timeout=timeout, return_when=cf.FIRST_COMPLETED)
+        return done
 
     def submit(self, fn, *args):
         fut = self.ex.submit(fn, *args, pure=False) if self.dask else self.ex.submit(fn, *args)
@@ -84,6 +117,7 @@ class Futures:
     def close(self):
         if self.own:
             self.ex.shutdown(wait=True)
+            self.rows.close()
 
     def abort(self, grace: float = 2.0):
         """Cancel every task not yet started; stop our own worker processes (SIGTERM, then
@@ -102,6 +136,7 @@ class Futures:
                 pass
         if not self.own:
             return
+        self.drain_left = self.drain()  # what the workers sent before they are stopped
         procs = list((getattr(self.ex, "_processes", None) or {}).values())
         manager = getattr(self.ex, "_executor_manager_thread", None)  # shutdown() forgets it
         self.ex.shutdown(wait=False, cancel_futures=True)
@@ -115,11 +150,31 @@ class Futures:
                 p.join(grace)
         if manager is not None:
             manager.join(grace)
+        self.drain_left += self.drain()
+        self.rows.close()
+
+
+#: In a worker process of ours: the queue its rows go to as they are solved (see :class:`Futures`).
+_ROWS = None
+
+
+def _init_worker(rows=None):
+    """Worker initializer: Ctrl-C is the parent's to handle (it stops the workers); ``rows`` is
+    the queue for :func:`stream_row`."""
+    global _ROWS
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _ROWS = rows
 
 
 def _ignore_sigint():
-    """Worker initializer: Ctrl-C is the parent's to handle (it stops the workers)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _init_worker(None)
+
+
+def stream_row(token: str, index: int, row: dict) -> None:
+    """In one of our worker processes, send a row to the sweep as soon as it is solved (nothing
+    elsewhere: there the chunk's result carries it)."""
+    if _ROWS is not None:
+        _ROWS.put((token, index, row))
 
 
 def mp_context():
@@ -185,8 +240,10 @@ def make_runner(executor, n: int, max_workers: int, payload):
         except Exception:
             logger.warning("the scene cannot be pickled (a Python callable in it?): sweeping in this process")
             return Serial()
-        return Futures(cf.ProcessPoolExecutor(max_workers=max_workers, mp_context=mp_context(),
-                                              initializer=_ignore_sigint), True, False, max_workers)
+        ctx = mp_context()
+        rows = ctx.Queue()
+        return Futures(cf.ProcessPoolExecutor(max_workers=max_workers, mp_context=ctx, initializer=_init_worker,
+                                              initargs=(rows,)), True, False, max_workers, rows)
     if is_dask(executor):
         try:
             workers = max(1, sum(executor.nthreads().values()))
@@ -199,4 +256,4 @@ def make_runner(executor, n: int, max_workers: int, payload):
                        f"dask distributed Client (got {executor!r})")
 
 
-__all__ = ["CONNECT_TIMEOUT", "SERIAL_BELOW", "connect", "Futures", "Progress", "Serial", "is_dask", "make_runner", "mp_context"]
+__all__ = ["CONNECT_TIMEOUT", "SERIAL_BELOW", "available_cores", "connect", "stream_row", "Futures", "Progress", "Serial", "is_dask", "make_runner", "mp_context"]

@@ -9,6 +9,8 @@ value's result is taken. Rows arrive in the main process whatever the executor (
 processes, Dask), so one writer serves them all. On resuming, the header must match the sweep
 asked (the same scene, path, values and solver settings): a store of another sweep is a clear
 error, never mixed in. A last line cut off by a crash is ignored (its value is solved again).
+The file is never opened through a symbolic link, and a link, a FIFO or a device given as the
+store is refused at once (:mod:`plateqp.io.safe`).
 
 :meth:`SweepResult.to_xarray` turns the rows into an :class:`xarray.Dataset` with the
 parameter value as the dimension (``plateqp sweep --out FILE.nc`` writes it as netCDF).
@@ -22,6 +24,7 @@ import os
 from pathlib import Path
 
 from ..errors import ProblemError
+from ..io.safe import regular_or_absent, write
 
 #: The header's format; a store written by another format is refused.
 FORMAT = "plateqp-sweep-rows/1"
@@ -47,20 +50,20 @@ class RowStore:
         self.path = Path(path)
         self.header = {"format": FORMAT, **json.loads(json.dumps(header, default=str))}
         self.done: dict[int, dict] = {}
-        if self.path.is_dir():
-            raise ProblemError(f"sweep store {self.path}: is a directory, not a file")
-        if self.path.exists() and self.path.stat().st_size > 0:
+        label = f"sweep store {self.path}"
+        # a link, a folder, a FIFO or a device is refused at once (reading a FIFO would block)
+        there = regular_or_absent(self.path, label)
+        if there and self.path.stat().st_size > 0:
             self._read()
-        else:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            with open(self.path, "w", encoding="utf-8") as fh:
-                fh.write(json.dumps(self.header) + "\n")
-                fh.flush()
-                os.fsync(fh.fileno())
+        else:  # a new file (or an empty one, replaced), never through a link
+            write(self.path, lambda tmp: _write_synced(tmp, json.dumps(self.header) + "\n"), force=there,
+                  label=label)
 
     def _read(self) -> None:
         try:
-            text = self.path.read_text(encoding="utf-8")
+            fd = os.open(self.path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+            with open(fd, encoding="utf-8") as fh:
+                text = fh.read()
             lines = text.splitlines()
         except (OSError, UnicodeDecodeError) as exn:
             raise ProblemError(f"sweep store {self.path}: cannot be read ({exn})") from None
@@ -91,18 +94,24 @@ class RowStore:
             self.done[i] = row
             kept.append(line)
         if len(kept) < len(lines) or not text.endswith("\n"):
-            with open(self.path, "w", encoding="utf-8") as fh:  # drop the cut line before appending
-                fh.write("\n".join(kept) + "\n")
-                fh.flush()
-                os.fsync(fh.fileno())
+            text = "\n".join(kept) + "\n"  # drop the cut line before appending
+            write(self.path, lambda tmp: _write_synced(tmp, text), force=True, label=f"sweep store {self.path}")
 
     def append(self, index: int, row: dict) -> None:
         """Write the row of value ``index`` and sync it to the disk."""
-        with open(self.path, "a", encoding="utf-8") as fh:
+        fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | getattr(os, "O_NOFOLLOW", 0))
+        with open(fd, "a", encoding="utf-8") as fh:
             fh.write(json.dumps({"index": int(index), "row": row}, default=_jsonable) + "\n")
             fh.flush()
             os.fsync(fh.fileno())
         self.done[int(index)] = row
+
+
+def _write_synced(path, text: str) -> None:
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write(text)
+        fh.flush()
+        os.fsync(fh.fileno())
 
 
 def _jsonable(v):

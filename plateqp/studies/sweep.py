@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ProblemError
-from ..paths import as_number, get_param, set_param
+from ..paths import as_number, check_values, get_param
 from ..scene import Scene
 from .breakpoints import Bisection, contact_set, refine_bracket
 from ..progress import Progress
@@ -76,8 +76,12 @@ class SweepResult:
 
     def to_dict(self) -> dict:
         """The JSON shape of ``plateqp sweep --json``: {rows, breakpoints}, and ``interrupted``
-        for a sweep that was stopped (see the field)."""
-        d = {"rows": self.rows, "breakpoints": self.breakpoints}
+        for a sweep that was stopped (see the field). In it the breakpoints' ``before`` and
+        ``after`` number the contact points from 1 (supports in scene order, then bed nodes),
+        as the tables do; :attr:`breakpoints` keeps Python's indices from 0."""
+        d = {"rows": self.rows,
+             "breakpoints": [{**b, "before": numbered(b["before"]), "after": numbered(b["after"])}
+                             for b in self.breakpoints]}
         if self.interrupted is not None:
             d["interrupted"] = self.interrupted
         return d
@@ -134,7 +138,7 @@ class SweepResult:
         lines = [f"sweep of {self.path}: {len(self.rows)} values", head]
         if self.interrupted is not None:
             lines[0] += (f" (interrupted: {self.interrupted['done']} of {self.interrupted['of']} done;"
-                         f" not done: {self.interrupted['not_done']})")
+                         f" not done: {_few(self.interrupted['not_done'])})")
         for r in self.rows:
             v = r["value"]
             vs = v if isinstance(v, str) else f"{v:.6g}"
@@ -155,9 +159,28 @@ class SweepResult:
                 lines.append(f"  between {b['between'][0]} and {b['between'][1]}: {where};"
                              f" comes into contact {on or '-'}, lifts off {off or '-'}"
                              + (f" ({b['note']})" if b.get("note") else ""))
-        else:
+        failed = sum(r["active"] is None for r in self.rows)
+        if self.interrupted is not None:
+            lines.append("the sweep was interrupted: changes of the contact set were not all searched")
+        elif not self.breakpoints and failed:
+            lines.append(f"the contact set is the same for every value solved ({failed} of {len(self.rows)}"
+                         " failed: nothing is said of them)")
+        elif not self.breakpoints:
             lines.append("the contact set is the same for every value")
         return "\n".join(lines)
+
+
+def numbered(indices) -> list[int]:
+    """Contact-point indices from 0 (Python's) as the numbers users read, from 1."""
+    return [int(i) + 1 for i in indices]
+
+
+def _few(values, keep: int = 3) -> str:
+    """A list of values for a table's line: all when few, else the first and last and how many."""
+    vs = [v if isinstance(v, str) else f"{v:.6g}" for v in values]
+    if len(vs) <= 2 * keep:
+        return "[" + ", ".join(vs) + "]"
+    return f"{len(vs)} values: [{', '.join(vs[:keep])}, ..., {', '.join(vs[-keep:])}]"
 
 
 def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", formulation: str = "auto",
@@ -168,12 +191,17 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
 
     Parameters
     ----------
-    scene, path : the scene and the field to vary (see :func:`set_param`)
-    values : the values, in sweep order ("rigid" allowed for a stiffness)
+    scene, path : the scene and the field to vary (see :func:`plateqp.paths.set_param`; the
+        same path language as ``plateqp sweep --param``: ``supports.1.gap`` is the first
+        support, supports being numbered from 1 as in every table)
+    values : the values, in sweep order ("rigid" allowed for a stiffness); every one is
+        checked against the scene before any solve (:func:`plateqp.paths.check_values`)
     backend, formulation, accuracy, options : as for :func:`plateqp.solve`
     executor : None (local processes, ``max_workers`` of them, or this process for fewer
         than :data:`SERIAL_BELOW` values), "serial", "process", any
-        :class:`concurrent.futures.Executor`, or a Dask ``distributed.Client``. Local
+        :class:`concurrent.futures.Executor`, or a Dask ``distributed.Client`` (each of these
+        gets one value per task, so that each row comes back as it is solved; plateqp's own
+        processes solve chunks of values and send each row as it is solved). Local
         processes start from a fresh interpreter (forkserver/spawn), so a script that sweeps
         with them needs the usual ``if __name__ == "__main__":`` guard.
     progress : a progress bar on stderr, drawn only when stderr is a terminal and not under
@@ -214,7 +242,7 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
     if not isinstance(warm_start, (bool, np.bool_)):
         raise ProblemError(f"warm_start must be True or False (got {warm_start!r})")
     current = get_param(scene, path)  # a bad path fails here, naming what exists
-    set_param(scene, path, values[0])  # and a bad value
+    check_values(scene, path, values)  # and a bad value, any of them, before any solve
     first = current[0] if isinstance(current, list) else current
     is_int = isinstance(first, int) and not isinstance(first, bool)  # mesh.nx: bisect on integers
     finite = [x for x in (as_number(v) for v in values) if math.isfinite(x)]
@@ -247,6 +275,17 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
             rows[i] = row
             actives[i] = tuple(row["active"]) if row.get("active") is not None else None
     todo = [i for i in range(n) if rows[i] is None]
+
+    def take(i: int, row: dict) -> bool:
+        """Keep the row of value ``i`` (and store it) unless it is kept already."""
+        if rows[i] is not None:
+            return False
+        rows[i] = row
+        actives[i] = tuple(row["active"]) if row["active"] is not None else None
+        if rowstore is not None:
+            rowstore.append(i, row)
+        return True
+
     logger.info("sweep of %s: %d values (%d from the store), executor %s with %d worker(s)", path, n, n - len(todo),
                 runner.kind, runner.workers)
     try:
@@ -263,21 +302,32 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
                     state = new or state
                     bar.update()
             else:
-                size = max(1, math.ceil(len(todo) / (4 * runner.workers)))
+                # our own processes send each row as it is solved (runner.rows), so chunks of values
+                # keep their warm starts; other executors get one value per task, each row returned
+                # as it is solved
+                stream = runner.rows is not None
+                size = max(1, math.ceil(len(todo) / (4 * runner.workers))) if stream else 1
                 chunks = [[(i, values[i]) for i in todo[j:j + size]] for j in range(0, len(todo), size)]
                 futs = {runner.submit(run_chunk, ctx, ch): ch for ch in chunks}
-                for key, fut in runner.as_completed(futs):
-                    ch = futs[key]
+
+                def finished(fut):
                     try:
-                        done = fut.result()
+                        return fut.result()
                     except Exception:  # a worker died or could not run it: do this chunk here
-                        done = run_chunk(ctx, ch)
-                    for i, row in done:
-                        rows[i] = row
-                        actives[i] = tuple(row["active"]) if row["active"] is not None else None
-                        if rowstore is not None:
-                            rowstore.append(i, row)
-                    bar.update(len(ch))
+                        return run_chunk(ctx, futs[fut])
+
+                if stream:
+                    pending = set(futs)
+                    while pending:
+                        done = runner.wait_any(pending)
+                        got = [(i, row) for tok, i, row in runner.drain() if tok == ctx.token]
+                        for fut in done:
+                            pending.discard(fut)
+                            got += finished(fut)
+                        bar.update(sum(take(i, row) for i, row in got))
+                else:
+                    for key, fut in runner.as_completed(futs):
+                        bar.update(sum(take(i, row) for i, row in finished(key)))
         finally:
             bar.close()
         t1 = time.perf_counter()
@@ -309,6 +359,9 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
     except KeyboardInterrupt:
         stopped = True
         runner.abort()
+        for tok, i, row in getattr(runner, "drain_left", ()):  # rows sent before the workers stopped
+            if tok == ctx.token:
+                take(i, row)
         done = [i for i in range(n) if rows[i] is not None]
         partial = SweepResult(path, [values[i] for i in done], [rows[i] for i in done],
                               [b for i in sorted(found) for b in found[i]],

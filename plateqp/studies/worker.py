@@ -142,10 +142,13 @@ def next_start(ctx: Context, state):
 
 def run_chunk(ctx: Context, items: list[tuple[int, Any]], state=None):
     """Solve values in order, each warm-started from the one before when the backend allows."""
+    from .parallel import stream_row
+
     out = []
     for i, v in items:
         row, _, new = solve_value(ctx, v, next_start(ctx, state))
         out.append((i, row))
+        stream_row(ctx.token, i, row)  # in our worker processes: to the sweep now, not with the chunk
         state = new or state
     return out
 
