@@ -110,6 +110,11 @@ KNOWN_GIVE_UP = {
     ("test_soft_supports_tend_to_no_support", "clarabel", "primal"): "inaccurate",
     ("test_soft_supports_tend_to_no_support", "qpsolvers:proxqp", "primal"): "inaccurate",
 }
+#: Give-ups whose residual ends within rounding of the tolerance: whether they reach it depends on
+#: the BLAS's rounding, so they may also end OPTIMAL (and must then be right). Measured: proxqp on
+#: the primal with 1e-8 D springs ends with its spring residual at 0.989e-9 with one OpenBLAS
+#: thread (OPTIMAL) and 1.0002e-9 with two (INACCURATE), against a tolerance of 1e-9.
+ROUNDING_EDGE = {("test_soft_supports_tend_to_no_support", "qpsolvers:proxqp", "primal")}
 
 
 def current_test() -> str:
@@ -124,7 +129,7 @@ def check_claim(res, ref, rtol=1e-7):
     key = (current_test(), res.backend, res.formulation)
     known = KNOWN_GIVE_UP.get(key)
     if res.status == pq.Status.OPTIMAL:
-        assert known is None, f"{key} now succeeds: remove it from KNOWN_GIVE_UP"
+        assert known is None or key in ROUNDING_EDGE, f"{key} now succeeds: remove it from KNOWN_GIVE_UP"
         assert res.kkt.ok
         np.testing.assert_allclose(res.reactions, ref, rtol=0, atol=rtol * max(np.abs(ref).max(), 1e-300))
         return
