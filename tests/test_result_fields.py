@@ -242,3 +242,16 @@ def test_json_prints_the_result(solved):
     for key in ("stationarity", "spring", "primal", "dual", "complementarity", "natural", "tol", "scale", "floor"):
         assert kkt[key] == getattr(r.kkt, key), key
     assert kkt["ok"] is r.kkt.ok
+
+
+def test_compressions_are_the_springs_law():
+    """Elastic piles: each compression is its reaction over the pile's stiffness (R = c s), zero
+    where the pile carries nothing, and the gaps close where the piles act."""
+    sc = family("grid_elastic", 16, 5)
+    r = pq.solve(sc, backend="lemke", formulation="condensed", accuracy="high")
+    c = np.array([s.stiffness for s in sc.supports], dtype=float)
+    assert r.status == pq.Status.OPTIMAL and (r.reactions > 0).any() and (r.reactions == 0).any()
+    np.testing.assert_allclose(r.compressions, r.reactions / c, rtol=1e-9, atol=1e-12 * np.abs(r.compressions).max())
+    on = r.reactions > 0
+    assert r.active[on].all()
+    np.testing.assert_allclose(r.gaps[on], 0.0, atol=1e-9 * np.abs(r.compressions).max())
