@@ -8,10 +8,10 @@ penetrated, one reaction moved without its deflections. Each perturbation is far
 rounding floor, so a field compared at rtol 1e-9 is the formula's value and not noise; at the
 exact answer the fields are compared with a margin of the problem's own rounding floor.
 
-The result's other fields are checked the same way: gaps, the contact set, the residual, the
-largest deflection and the probes from the dof vector, the reactions by statics, the iteration
-count from Lemke's own pivot trace, the times by how they tile the solve, and the JSON of
-``plateqp solve --json`` (:meth:`Result.to_dict`) against the result it prints.
+The result's other fields are checked the same way: gaps, compressions (R = c s), the contact
+set, the residual, the largest deflection and the probes from the dof vector, the reactions by
+statics, the iteration count from Lemke's own pivot trace, the times by how they tile the solve,
+and the JSON of ``plateqp solve --json`` (:meth:`Result.to_dict`) against the result it prints.
 """
 
 from __future__ import annotations
