@@ -246,6 +246,8 @@ def test_anchored_lawson_hanson_giving_up_starts_the_exact_steps_from_its_set(on
 
     _, _, ref = one_edge_every_node
     monkeypatch.setattr(pdas_sparse, "LH_MEMORY", 200)
+    monkeypatch.setattr(pdas_sparse, "LH_ANCHORED", 1e9)  # a loaded machine must not change the path checked
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", 1e9)
     res = solve(one_edge(16, "all"), options={"method": "sparse"})
     assert res.status == pq.Status.OPTIMAL and res.kkt.ok
     assert res.extras["first_phase"] == "anchored lawson-hanson (gave up)" and res.extras["lh_gave_up"] == "memory"
@@ -261,8 +263,8 @@ def test_anchored_lawson_hanson_stops_on_a_broad_contact(monkeypatch):
     machine the wall clock stopped it first, "time".)"""
     from plateqp.backends.pdas import sparse as pdas_sparse
 
-    monkeypatch.setattr(pdas_sparse, "LH_ANCHORED", float("inf"))
-    monkeypatch.setattr(pdas_sparse, "LH_TIME", float("inf"))
+    monkeypatch.setattr(pdas_sparse, "LH_ANCHORED", 1e9)
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", 1e9)
     sc = F.grid_rigid(24, "all")
     sc = pq.Scene(name="free-every-node", plate=sc.plate, mesh=sc.mesh, loads=sc.loads, supports=sc.supports)
     res = solve(sc, options={"method": "sparse"})
