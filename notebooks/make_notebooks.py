@@ -534,7 +534,9 @@ for d in deltas:
     assert np.all(B @ u_d <= g + 1e-15) and np.all(R_d >= 0)          # a feasible pair
     gap_d = Pi(u_d) + Pi_c(R_d)
     gaps.append(gap_d)
-    assert gap_d > 0 and abs(gap_d - d * R_d.sum()) < 1e-8 * gap_d     # the closed form above
+    # the closed form above, to 1e-8 and to the rounding of the two energies that cancel in gap_d
+    floor = 64 * np.finfo(float).eps * (abs(Pi(u_d)) + abs(Pi_c(R_d)))
+    assert gap_d > 0 and abs(gap_d - d * R_d.sum()) < 1e-8 * gap_d + floor
     print(f"δ = {d:.0e}: Π(u_δ) + Π_c(R_δ) = {gap_d:.6e}   δ·ΣR_δ = {d * R_d.sum():.6e}")
 
 # a pair not in equilibrium with each other: u_δ and some other non-negative reactions

@@ -46,6 +46,13 @@ KNOWN_INFEASIBLE_STATUS: dict[str, Status] = {
     "qpsolvers:piqp": Status.MAX_ITER,
 }
 
+#: Known deviations at "high", as data: (backend, reference problem) whose solver's own tolerance
+#: there is at the edge of what it reaches, so whether it converges depends on the BLAS's rounding.
+#: It may end ERROR (xfail, said so), never a wrong OPTIMAL (an OPTIMAL answer is checked as any
+#: other). Measured: CVXOPT through cvxpy's cone form at abstol 1e-9 ends "solver_error" on
+#: lcp_symmetric_pd with OpenBLAS's SandyBridge kernels, OPTIMAL with Haswell's.
+MAY_FAIL_HIGH = {("cvxpy:CVXOPT", "lcp_symmetric_pd")}
+
 MODULES = ("osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
 
 
@@ -278,6 +285,8 @@ def test_reference_problem_high(backend, ref, fmt):
         problem = as_sparse(problem)
     sol = backend.solve(problem, accuracy="high")
     atol_x, atol_mult = tol(backend.name)
+    if sol.status is Status.ERROR and (backend.name, ref) in MAY_FAIL_HIGH:
+        pytest.xfail(f"{backend.name} ended {sol.solver_status} on {ref} at 'high' (MAY_FAIL_HIGH)")
     assert sol.status is Status.OPTIMAL, (sol.status, sol.solver_status)
     assert sol.solve_time >= 0
     qp = as_qp(problem)

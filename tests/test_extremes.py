@@ -1,4 +1,4 @@
-"""Extremes (issue 5, item 4): units, thickness, support stiffness, gaps, degenerate contact,
+"""Extremes: units, thickness, support stiffness, gaps, degenerate contact,
 floating plates, nearly coincident supports, and the KKT check that catches a wrong claim.
 
 Every case has a reference that does not come from the solver under test: an invariance
@@ -46,6 +46,7 @@ from plateqp.assembly import build_model
 from plateqp.backends import registry
 from plateqp.backends.base import RawSolution, Status
 from plateqp.contact import Scaled
+from plateqp.contact.formulations import formulate
 
 INSTALLED = set(pq.available_backends())
 IN_HOUSE = [("lemke", "condensed"), ("lemke", "dual"), ("bpp", "condensed"), ("bpp", "dual"),
@@ -109,6 +110,11 @@ KNOWN_GIVE_UP = {
     ("test_soft_supports_tend_to_no_support", "clarabel", "primal"): "inaccurate",
     ("test_soft_supports_tend_to_no_support", "qpsolvers:proxqp", "primal"): "inaccurate",
 }
+#: Give-ups whose residual ends within rounding of the tolerance: whether they reach it depends on
+#: the BLAS's rounding, so they may also end OPTIMAL (and must then be right). Measured: proxqp on
+#: the primal with 1e-8 D springs ends with its spring residual at 0.989e-9 with one OpenBLAS
+#: thread (OPTIMAL) and 1.0002e-9 with two (INACCURATE), against a tolerance of 1e-9.
+ROUNDING_EDGE = {("test_soft_supports_tend_to_no_support", "qpsolvers:proxqp", "primal")}
 
 
 def current_test() -> str:
@@ -123,7 +129,7 @@ def check_claim(res, ref, rtol=1e-7):
     key = (current_test(), res.backend, res.formulation)
     known = KNOWN_GIVE_UP.get(key)
     if res.status == pq.Status.OPTIMAL:
-        assert known is None, f"{key} now succeeds: remove it from KNOWN_GIVE_UP"
+        assert known is None or key in ROUNDING_EDGE, f"{key} now succeeds: remove it from KNOWN_GIVE_UP"
         assert res.kkt.ok
         np.testing.assert_allclose(res.reactions, ref, rtol=0, atol=rtol * max(np.abs(ref).max(), 1e-300))
         return
@@ -353,21 +359,49 @@ def test_nearly_coincident_rigid_supports_are_refused(backend, formulation):
         run(pair_scene(1e-9 / 8), backend, formulation)
 
 
+def dual_floor(scene, R) -> float:
+    """The dual's own rounding floor for the reactions: ε·cond₂(M_AA), M the dual LCP's matrix
+    (B K⁻¹ Bᵀ, scaled) on the contact set A of ``R``. The dual finds R_A by a solve with M_AA,
+    whose relative (2-norm) error is up to about that (Higham, Accuracy and Stability, §7.1);
+    it is a property of the problem, whatever the backend or the BLAS kernel."""
+    M = formulate(Scaled.from_model(build_model(scene)), "dual").lcp.M
+    A = np.flatnonzero(R > 0)
+    return float(np.finfo(float).eps * np.linalg.cond(M[np.ix_(A, A)]))
+
+
 @pytest.mark.parametrize("backend,formulation", PAIRS)
 def test_close_rigid_supports_are_solved(backend, formulation):
     """1e-3 of a cell apart: well enough determined; exact solvers agree, nobody claims wrong.
 
     The reference is Lemke on the dual with the pair's split taken from the scene's symmetry
     (equal shares): the dual's matrix holds the two nearly equal rows of B K⁻¹ Bᵀ, so its own
-    split carries rounding of about ε·cond ≈ 4e-10 of the reaction (measured: 3.6e-10 with
-    NumPy 2.4 / SciPy 1.17), while their sum is determined to rounding."""
+    split carries rounding up to ε·cond₂(M_AA) ≈ 6e-9 of the reactions (:func:`dual_floor`),
+    while their sum is determined to rounding.
+
+    That floor is above the tolerance of "high" (1e-9): whether a dual answer's split lands
+    within 1e-9 depends on the rounding of the BLAS kernel (measured: BPP's natural residual
+    4e-11 with one OpenBLAS kernel, 1.4e-9 with another (SandyBridge), and 1.8e-9 after a
+    correction on a fresh install: the correction re-solves with the same M_AA and draws a new
+    rounding error of the same size). So on the dual either outcome is right, as long as it is honest: OPTIMAL and
+    right, or INACCURATE with the KKT check failed by no more than the floor's margin and the
+    reactions as close as that floor allows."""
     sc = pair_scene(1e-3 / 8)
     ref = run(sc, "lemke", "dual").reactions
     assert (ref[[8, 9]] > 0).all()  # both in contact: the split matters
-    assert abs(ref[8] - ref[9]) <= 1e-8 * ref.max()  # the dual's split: right to its conditioning
+    floor = dual_floor(sc, ref)
+    margin = 10.0 * floor  # γ_m·ε·cond with m = 10 contact rows
+    assert floor > 1e-9  # the premise above: this pair's split is below the dual's floor
+    # the dual's split: right to its conditioning
+    assert abs(ref[8] - ref[9]) <= margin * np.linalg.norm(ref)
     ref[[8, 9]] = ref[[8, 9]].mean()  # by symmetry
+    # the primal never forms M: its split is right to far below the dual's floor
     np.testing.assert_allclose(run(sc, "pdas", "primal").reactions, ref, rtol=0, atol=1e-10 * ref.max())
-    check_claim(run(sc, backend, formulation), ref)
+    res = run(sc, backend, formulation)
+    if formulation == "dual" and res.status == pq.Status.INACCURATE:
+        assert not res.kkt.ok and res.kkt.worst <= margin
+        np.testing.assert_allclose(res.reactions, ref, rtol=0, atol=margin * np.linalg.norm(ref))
+        return
+    check_claim(res, ref)
 
 
 @pytest.mark.parametrize("backend,formulation", [p for p in EXACT if p[1] != "condensed"])

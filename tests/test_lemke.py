@@ -292,6 +292,26 @@ def test_degenerate_problem_that_cycles_without_lexicographic_rule():
     assert len(bases) == len(set(bases))
 
 
+def test_artificial_variable_leaves_first_on_a_tie():
+    """M = [[4, 2], [2, −2]], q = (−2, −1), d = 1, traced by hand.
+
+    1. z0 enters; min q_i/d_i = −2 (row 1): w1 leaves, z0 = 2.
+    2. z1 enters: w1 = 0 gives z0 = 2 − 4 z1, and w2 = −1 + 2 z1 + z0 = 1 − 2 z1: z0 and w2
+       both block at z1 = 1/2, a tie. With z0 leaving, z = (1/2, 0), w = M z + q = (0, 0)
+       solves the LCP (check: 4·½ − 2 = 0, 2·½ − 1 = 0). With w2 leaving instead, z2 enters
+       and z1 falls back to 0 at z2 = 1/4; M is not copositive-plus (M_22 = −2), and that
+       path ends on a ray that proves nothing.
+    """
+    M = np.array([[4.0, 2.0], [2.0, -2.0]])
+    q = np.array([-2.0, -1.0])
+    sol = L.lemke(M, q, trace=True)
+    assert sol.status is Status.OPTIMAL
+    np.testing.assert_allclose(sol.x, [0.5, 0.0], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(sol.w, [0.0, 0.0], rtol=0, atol=1e-15)
+    assert [(s["entering"], s["leaving"]) for s in sol.extras["trace"]] == [
+        (("z0", None), ("w", 0)), (("z", 0), ("z0", None))]
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_degenerate_ties_spd(seed):
     """SPD M with q having many equal entries and zeros (ties in every ratio test)."""

@@ -283,7 +283,9 @@ def test_smallest_eigenvalue_of_the_trailing_block(method):
     s = 1.0 / np.sqrt(L.diagonal())
     low = np.linalg.eigvalsh(dense_schur(sp.csc_matrix(sp.diags(s) @ L @ sp.diags(s)), last))[0]
     est = SchurFactor(L, last, method=method).smallest_eigenvalue()
-    assert low < 1e-12 and est <= 2 * low + 1e-15
+    # nearly singular: below the pivot tolerance that refuses it (the eigenvalue is 1.0e-12 to
+    # rounding, either side of 1e-12 by the BLAS kernel)
+    assert low < 1e-11 and est <= 2 * low + 1e-15
     with pytest.raises(SingularMatrixError, match="singular"):
         SchurFactor(L, last, pivot_tol=1e-11, method=method)
 
@@ -402,7 +404,9 @@ def test_the_contact_pipeline_keeps_the_plates_stored_pattern():
 
     model = build_model(grid_rigid(8, 3))
     K = sp.csc_matrix(model.K)
-    assert np.count_nonzero(K.data == 0) > 0  # the assembly stores exact zeros (ACM node blocks)
+    # the assembly stores zeros (ACM node blocks): exact, or rounding of a cancelling product
+    # (5e-14 of 6e4 with OpenBLAS's SandyBridge kernels)
+    assert np.count_nonzero(np.abs(K.data) <= 1e-15 * np.abs(K.data).max()) > 0
     data = Scaled.from_model(model)
     assert data.K.nnz == K.nnz
     pb = ReducedQP(formulate(data, "primal").problem(frozenset({"qp"})), max_rows=10**6)

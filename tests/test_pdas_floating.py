@@ -246,6 +246,8 @@ def test_anchored_lawson_hanson_giving_up_starts_the_exact_steps_from_its_set(on
 
     _, _, ref = one_edge_every_node
     monkeypatch.setattr(pdas_sparse, "LH_MEMORY", 200)
+    monkeypatch.setattr(pdas_sparse, "LH_ANCHORED", 1e9)  # a loaded machine must not change the path checked
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", 1e9)
     res = solve(one_edge(16, "all"), options={"method": "sparse"})
     assert res.status == pq.Status.OPTIMAL and res.kkt.ok
     assert res.extras["first_phase"] == "anchored lawson-hanson (gave up)" and res.extras["lh_gave_up"] == "memory"
@@ -253,11 +255,16 @@ def test_anchored_lawson_hanson_giving_up_starts_the_exact_steps_from_its_set(on
     np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-8 * scale)
 
 
-def test_anchored_lawson_hanson_stops_on_a_broad_contact():
+def test_anchored_lawson_hanson_stops_on_a_broad_contact(monkeypatch):
     """A floating slab with a post on every interior node (24²): about 44 % of the rows end in
     contact, one row a Lawson–Hanson step would take hundreds of steps; with 96 rows freed
     more than 30 % are still pressed (LH_ANCHORED_PROBE), so it stops there and the exact
-    steps start from its set, ending at Lemke's answer."""
+    steps start from its set, ending at Lemke's answer. (Its time budget lifted: on a busy
+    machine the wall clock stopped it first, "time".)"""
+    from plateqp.backends.pdas import sparse as pdas_sparse
+
+    monkeypatch.setattr(pdas_sparse, "LH_ANCHORED", 1e9)
+    monkeypatch.setattr(pdas_sparse, "LH_TIME", 1e9)
     sc = F.grid_rigid(24, "all")
     sc = pq.Scene(name="free-every-node", plate=sc.plate, mesh=sc.mesh, loads=sc.loads, supports=sc.supports)
     res = solve(sc, options={"method": "sparse"})
