@@ -106,6 +106,8 @@ class Result:
         except ValueError:
             raise ArgumentError(f"x and y: shapes {x.shape} and {y.shape} do not broadcast together") from None
         xb, yb = np.broadcast_arrays(x, y)
+        if xb.size == 0:  # no points: no values
+            return np.zeros(shape)
         vals = self.model.interpolation(xb.ravel(), yb.ravel(), dx, dy) @ self.u
         return vals.reshape(shape) if shape else float(vals[0])
 

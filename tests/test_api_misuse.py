@@ -353,3 +353,7 @@ def test_numpy_polygons_holes_and_regions_are_taken(tmp_path):
     assert pq.Scene.from_toml(arr.to_toml(tmp_path / "a.toml") and tmp_path / "a.toml").to_dict() == plain.to_dict()
     box = pq.Scene(foundation=pq.Foundation(10.0, region=np.array([0.0, 0.5, 0.0, 0.5])), loads=[pq.UniformLoad(1.0)])
     assert box.foundation.region == [0.0, 0.5, 0.0, 0.5] and isinstance(box.foundation.region[0], float)
+
+
+def test_no_points_give_no_values(res):
+    assert res.deflection(0.0, ()).shape == (0,) and res.moments([], [])[0].shape == (0,)
