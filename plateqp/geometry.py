@@ -9,8 +9,9 @@ with holes of the same two kinds. In a scene file::
     [[holes]]
     circle = [0.5, 0.5, 0.2]
 
-:func:`parse_shape` turns one such table into a shape and checks it (at least 3 vertices,
-counter-clockwise, not self-intersecting; a circle's r > 0); :func:`check_holes` checks that every
+:func:`parse_shape` turns one such table into a shape and checks it (at least 3 and at most
+:data:`MAX_VERTICES` vertices, counter-clockwise, not self-intersecting: :mod:`plateqp.crossings`;
+a circle's r > 0); :func:`check_holes` checks that every
 hole lies strictly inside the plate and that no two holes touch or overlap. Every failure is a
 SceneError through the ``fail(where, what)`` callable the scene passes in (it names the field and
 the file). :class:`Domain` answers "is this point on the plate?" for the scene's other checks.

@@ -106,6 +106,12 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     Returns
     -------
     Result, whose ``status`` says whether the KKT residuals meet the asked accuracy.
+
+    Raises
+    ------
+    SceneError if ``scene`` is not a valid Scene (checked again here: it may have been changed
+    since it was built), and an error naming the argument for any other bad argument
+    (:func:`check_arguments`), before any work.
     """
     accuracy = check_arguments(scene, backend, formulation, accuracy, options, model, check_statics)
     auto = isinstance(accuracy, str) and accuracy == "auto"

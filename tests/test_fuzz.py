@@ -6,6 +6,9 @@ in {0, 2, 3, 4, 5} (never 1, an internal error, and never a traceback), a failur
 stderr that starts with "plateqp:", and with ``--json`` standard output parses as JSON whenever
 a result was computed. ``Scene.from_toml`` raises SceneError and nothing else.
 
+The Python API has the same promise: hostile values on a scene's parts (before or after its
+construction) and in a Result's methods' arguments give a scene and a solve, or a PlateQPError.
+
 The budget is bounded (``FUZZ_EXAMPLES`` examples per strategy, about a minute in all on two cores);
 ``PLATEQP_FUZZ_EXAMPLES=2000 pytest tests/test_fuzz.py`` hunts longer.
 """
