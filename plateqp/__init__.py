@@ -12,6 +12,7 @@ positive downward; a gap g0 > 0 is settlement, g0 < 0 heave; reactions R ≥ 0 p
 from .accuracy import Accuracy, Status
 from .backends import available_backends, get_backend, registry
 from .errors import (
+    ArgumentError,
     MechanismError,
     NoEquilibriumError,
     PlateQPError,
@@ -43,7 +44,7 @@ __version__ = "0.1.0"
 
 
 __all__ = [
-    "Accuracy", "Edge", "ExportError", "Foundation", "KKTReport", "MechanismError", "MeshSpec", "NoEquilibriumError", "Opening",
+    "Accuracy", "ArgumentError", "Edge", "ExportError", "Foundation", "KKTReport", "MechanismError", "MeshSpec", "NoEquilibriumError", "Opening",
     "PatchLoad", "Pin", "Plate", "PlateQPError", "PlateQPWarning", "PointLoad", "ProblemError", "ResourceError", "Result",
     "Scene", "SceneError", "Sensitivity", "SolverError", "Status", "Support", "UniformLoad", "available_backends",
     "get_backend", "registry", "sensitivity", "solve", "solve_bilateral",

@@ -41,6 +41,11 @@ class ProblemError(PlateQPError, ValueError):
     """A QP or LCP is malformed, or a formulation cannot be built for a scene."""
 
 
+class ArgumentError(PlateQPError, ValueError):
+    """A public function or method was given an argument it cannot take (a wrong type, a value
+    outside its range): the message names the argument."""
+
+
 class SolverError(PlateQPError):
     """A backend failed, is unknown, is not installed, or rejected the problem."""
 

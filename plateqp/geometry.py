@@ -9,8 +9,9 @@ with holes of the same two kinds. In a scene file::
     [[holes]]
     circle = [0.5, 0.5, 0.2]
 
-:func:`parse_shape` turns one such table into a shape and checks it (at least 3 vertices,
-counter-clockwise, not self-intersecting; a circle's r > 0); :func:`check_holes` checks that every
+:func:`parse_shape` turns one such table into a shape and checks it (at least 3 and at most
+:data:`MAX_VERTICES` vertices, counter-clockwise, not self-intersecting: :mod:`plateqp.crossings`;
+a circle's r > 0); :func:`check_holes` checks that every
 hole lies strictly inside the plate and that no two holes touch or overlap. Every failure is a
 SceneError through the ``fail(where, what)`` callable the scene passes in (it names the field and
 the file). :class:`Domain` answers "is this point on the plate?" for the scene's other checks.
@@ -23,9 +24,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Callable
 
 import numpy as np
+
+from .crossings import check_simple, cross_any
 
 Fail = Callable[[str, str], None]
 
@@ -51,9 +55,27 @@ class Polygon:
         p = self.xy
         return np.stack([p, np.roll(p, -1, axis=0)], axis=1)
 
+    @cached_property
+    def _index(self):
+        """shapely's prepared polygon and an STRtree of its segments, for a polygon of more than
+        :data:`INDEXED_VERTICES` vertices when shapely is installed (else None: loops over the
+        segments, each a pass over the points)."""
+        if len(self.vertices) <= INDEXED_VERTICES:
+            return None
+        try:
+            import shapely
+        except ImportError:
+            return None
+        poly = shapely.Polygon(self.vertices)
+        shapely.prepare(poly)
+        return shapely, poly, shapely.STRtree(shapely.linestrings(self.segments()))
+
     def contains(self, x, y, tol: float = 0.0) -> np.ndarray:
         """Points inside or within ``tol`` of the polygon (boundary included)."""
         x, y = np.atleast_1d(np.asarray(x, float)), np.atleast_1d(np.asarray(y, float))
+        if self._index is not None:
+            shp, poly, _ = self._index
+            return shp.contains_xy(poly, x, y) | (self.distance(x, y) <= tol)
         seg = self.segments()
         inside = np.zeros(x.shape, dtype=bool)
         for (x0, y0), (x1, y1) in seg:  # even-odd ray casting along +x
@@ -65,6 +87,13 @@ class Polygon:
     def distance(self, x, y) -> np.ndarray:
         """Distance of points to the polygon's boundary."""
         x, y = np.atleast_1d(np.asarray(x, float)), np.atleast_1d(np.asarray(y, float))
+        if self._index is not None:  # the nearest segment of each point, from the spatial index
+            shp, _, tree = self._index
+            (which, _), d = tree.query_nearest(shp.points(x.ravel(), y.ravel()), return_distance=True,
+                                               all_matches=False)
+            out = np.full(x.size, np.nan)
+            out[which] = d
+            return out.reshape(x.shape)
         return np.min([_point_segment(x, y, s) for s in self.segments()], axis=0)
 
     @property
@@ -123,25 +152,13 @@ def _point_segment(x, y, seg) -> np.ndarray:
     return np.hypot(x - x0 - t * dx, y - y0 - t * dy)
 
 
-def _segments_cross(s, t) -> bool:
-    """True if closed segments s and t share a point."""
-    (p1, p2), (p3, p4) = np.asarray(s, float), np.asarray(t, float)
-
-    def orient(a, b, c):
-        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-
-    d1, d2, d3, d4 = orient(p3, p4, p1), orient(p3, p4, p2), orient(p1, p2, p3), orient(p1, p2, p4)
-    if ((d1 > 0) != (d2 > 0)) and ((d3 > 0) != (d4 > 0)) and 0 not in (d1, d2, d3, d4):
-        return True
-    scale = max(np.abs([p1, p2, p3, p4]).max(), 1e-300)
-    on = 1e-12 * scale * scale
-    for d, a, b, c in ((d1, p3, p4, p1), (d2, p3, p4, p2), (d3, p1, p2, p3), (d4, p1, p2, p4)):
-        if abs(d) <= on and min(a[0], b[0]) - 1e-12 * scale <= c[0] <= max(a[0], b[0]) + 1e-12 * scale \
-                and min(a[1], b[1]) - 1e-12 * scale <= c[1] <= max(a[1], b[1]) + 1e-12 * scale:
-            return True
-    return False
-
-
+#: The most vertices a polygon (a plate's outline, a hole, a bed region) may have, and the plate's
+#: boundaries all together: every boundary vertex becomes a mesh node, and no plate needs more.
+MAX_VERTICES = 20_000
+#: A polygon of more vertices than this answers :meth:`Polygon.contains` and
+#: :meth:`Polygon.distance` with shapely's spatial index (when installed), not a loop over its
+#: segments; the two agree to rounding.
+INDEXED_VERTICES = 64
 def _number(v, where: str, fail: Fail) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(float(v)):
         fail(where, f"must be a finite number (got {v!r:.60})")
@@ -164,8 +181,11 @@ def parse_shape(value, where: str, fail: Fail) -> Shape:
         if r <= 0:
             fail(where, f"a degenerate circle: the radius must be > 0 (got {r!r})")
         return Circle(xc, yc, r)
+    data = data.tolist() if isinstance(data, np.ndarray) else data
     if not isinstance(data, (list, tuple)) or len(data) < 3:
         fail(where, f"a polygon needs at least 3 vertices [[x, y], ...] (got {data!r:.60})")
+    if len(data) > MAX_VERTICES:
+        fail(where, f"{len(data)} vertices, more than any plate needs (at most {MAX_VERTICES}); simplify the outline")
     verts = []
     for i, v in enumerate(data):
         if not isinstance(v, (list, tuple)) or len(v) != 2:
@@ -175,21 +195,11 @@ def parse_shape(value, where: str, fail: Fail) -> Shape:
     seg = poly.segments()
     n = len(seg)
     scale = max(np.abs(poly.xy).max(), np.ptp(poly.xy, axis=0).max())
-    for i in range(n):
-        if np.hypot(*(seg[i, 1] - seg[i, 0])) <= 1e-12 * scale:
-            fail(f"{where}.{i}", f"vertex {i} repeats vertex {(i + 1) % n}: remove one")
-    for i in range(n):
-        for j in range(i + 1, n):
-            adjacent = j == i + 1 or (i == 0 and j == n - 1)
-            if adjacent:
-                # neighbours share one vertex; they cross only if they fold back onto each other
-                a, b = (seg[i], seg[j]) if j == i + 1 else (seg[j], seg[i])
-                u, w = a[1] - a[0], b[1] - b[0]
-                if abs(u[0] * w[1] - u[1] * w[0]) <= 1e-12 * scale**2 and np.dot(u, w) < 0:
-                    fail(where, f"self-intersecting: segments {i} and {j} fold back onto each other")
-            elif _segments_cross(seg[i], seg[j]):
-                fail(where, f"self-intersecting: segment {i} (vertices {i}-{(i + 1) % n}) crosses "
-                     f"segment {j} (vertices {j}-{(j + 1) % n})")
+    length = np.hypot(*(seg[:, 1] - seg[:, 0]).T)
+    if (length <= 1e-12 * scale).any():
+        i = int(np.argmax(length <= 1e-12 * scale))
+        fail(f"{where}.{i}", f"vertex {i} repeats vertex {(i + 1) % n}: remove one")
+    check_simple(seg, scale, where, fail)
     if abs(poly.area) <= 1e-12 * scale**2:
         fail(where, "the polygon has no area")
     if poly.area < 0:
@@ -197,7 +207,7 @@ def parse_shape(value, where: str, fail: Fail) -> Shape:
     return poly
 
 
-def _inside_strictly(inner: Shape, outer: Shape) -> bool:
+def _inside_strictly(inner: Shape, outer: Shape, where: str, fail: Fail) -> bool:
     """True if ``inner`` lies inside ``outer`` without touching its boundary."""
     if isinstance(outer, Circle):
         if isinstance(inner, Circle):
@@ -205,19 +215,19 @@ def _inside_strictly(inner: Shape, outer: Shape) -> bool:
         return bool(np.all(np.hypot(inner.xy[:, 0] - outer.xc, inner.xy[:, 1] - outer.yc) < outer.r))
     if isinstance(inner, Circle):
         return bool(outer.contains(inner.xc, inner.yc)[0] and outer.distance(inner.xc, inner.yc)[0] > inner.r)
-    if any(_segments_cross(s, t) for s in inner.segments() for t in outer.segments()):
+    if cross_any(inner.segments(), outer.segments(), where, fail):
         return False
     return bool(outer.contains(*inner.xy[0])[0])
 
 
-def _disjoint(s: Shape, t: Shape) -> bool:
+def _disjoint(s: Shape, t: Shape, where: str, fail: Fail) -> bool:
     """True if two shapes neither overlap nor touch."""
     if isinstance(s, Circle) and isinstance(t, Circle):
         return math.hypot(s.xc - t.xc, s.yc - t.yc) > s.r + t.r
     if isinstance(s, Circle) or isinstance(t, Circle):
         c, p = (s, t) if isinstance(s, Circle) else (t, s)
         return not p.contains(c.xc, c.yc)[0] and p.distance(c.xc, c.yc)[0] > c.r
-    if any(_segments_cross(a, b) for a in s.segments() for b in t.segments()):
+    if cross_any(s.segments(), t.segments(), where, fail):
         return False
     return not (t.contains(*s.xy[0])[0] or s.contains(*t.xy[0])[0])
 
@@ -227,11 +237,11 @@ def check_holes(outer: Shape, holes: list[Shape], fail: Fail, names: list[str] |
     each hole's field (default ``holes.I``)."""
     names = names or [f"holes.{i}" for i in range(len(holes))]
     for i, h in enumerate(holes):
-        if not _inside_strictly(h, outer):
+        if not _inside_strictly(h, outer, names[i], fail):
             fail(names[i], "the hole is not inside the plate: it lies outside it, crosses or touches its boundary")
     for i, h in enumerate(holes):
         for j in range(i):
-            if not _disjoint(h, holes[j]):
+            if not _disjoint(h, holes[j], names[i], fail):
                 fail(names[i], f"overlaps or touches {names[j]}; merge them into one hole or move them apart")
 
 
@@ -281,7 +291,12 @@ def scene_domain(scene) -> Domain:
     (:func:`cutout_shapes`)."""
     p = scene.plate
     outer = parse_shape(p.shape, "plate.shape", scene._fail) if p.shape is not None else rectangle(p.a, p.b)
-    return Domain(outer, tuple(cutout_shapes(scene)))
+    holes = tuple(cutout_shapes(scene))
+    total = sum(len(s.vertices) for s in (outer, *holes) if isinstance(s, Polygon))
+    if total > MAX_VERTICES:
+        scene._fail("holes", f"the plate's boundaries have {total} vertices in all, more than any plate needs "
+                    f"(at most {MAX_VERTICES}); simplify the outlines")
+    return Domain(outer, holes)
 
 
 def nearest_segment(shape: Shape, points: np.ndarray, normals: np.ndarray, h: float) -> np.ndarray:

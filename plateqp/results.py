@@ -20,6 +20,7 @@ import numpy as np
 
 from . import post
 from .accuracy import Status
+from .errors import ArgumentError
 
 
 @dataclass
@@ -100,9 +101,14 @@ class Result:
 
     # -- fields at points ---------------------------------------------------------------------
     def _eval(self, x, y, dx, dy):
-        x = np.asarray(x, dtype=float)
-        shape = np.broadcast(x, np.asarray(y)).shape
-        xb, yb = np.broadcast_arrays(x, np.asarray(y, dtype=float))
+        x, y = _coordinates(x, "x"), _coordinates(y, "y")
+        try:
+            shape = np.broadcast(x, y).shape
+        except ValueError:
+            raise ArgumentError(f"x and y: shapes {x.shape} and {y.shape} do not broadcast together") from None
+        xb, yb = np.broadcast_arrays(x, y)
+        if xb.size == 0:  # no points: no values
+            return np.zeros(shape)
         vals = self.model.interpolation(xb.ravel(), yb.ravel(), dx, dy) @ self.u
         return vals.reshape(shape) if shape else float(vals[0])
 
@@ -135,6 +141,8 @@ class Result:
 
         ``quantity``: "w", "Mx", "My", "Mxy", "sx", "sy", "txy", "s1", "s2".
         """
+        p0, p1, n = _point(p0, "p0"), _point(p1, "p1"), _count(n, "n")
+        _quantity(quantity)
         t = np.linspace(0.0, 1.0, n)
         x = p0[0] + t * (p1[0] - p0[0])
         y = p0[1] + t * (p1[1] - p0[1])
@@ -154,9 +162,7 @@ class Result:
             "s1": lambda: self.principal_stresses(x, y)[0],
             "s2": lambda: self.principal_stresses(x, y)[1],
         }
-        if quantity not in table:
-            raise ValueError(f"unknown quantity {quantity!r}; choose one of {sorted(table)}")
-        return table[quantity]()
+        return table[_quantity(quantity)]()
 
     def nodal(self, quantity: str = "w") -> np.ndarray:
         """(n,) smoothed nodal values, one per node of the plate in ``mesh.nodes`` order, on
@@ -164,7 +170,7 @@ class Result:
         (:class:`plateqp.post.NodalOperator`). On the structured grid ``model.grid.to_grid``
         gives the (ny+1, nx+1) view (NaN off the plate), and :meth:`to_xarray` the same on x, y.
         ``quantity`` as for :meth:`section`."""
-        return post.nodal_operator(self.model)(self.u, self.scene.plate, quantity)
+        return post.nodal_operator(self.model)(self.u, self.scene.plate, _quantity(quantity))
 
     # -- summaries --------------------------------------------------------------------------
     def w_nodes(self) -> np.ndarray:
@@ -189,6 +195,7 @@ class Result:
         unique; see the class), kkt, iterations, times (build, solve, total); with
         ``accuracy="auto"`` also the discretisation error estimate; where the status is not
         OPTIMAL, ``why`` (the solver's own words and the KKT residual, ``extras["why"]``)."""
+        probes = _probes(probes)
         w, x, y = self.w_max()
         d = {
             "scene": self.scene.name,
@@ -244,3 +251,48 @@ class Result:
 def _unwrap(v):
     a = np.asarray(v)
     return float(a) if a.ndim == 0 else a
+
+
+# -- the public methods' arguments: an ArgumentError naming the argument, NumPy numbers taken -------
+def _coordinates(v, name: str) -> np.ndarray:
+    """A number or an array of numbers (NumPy's too) as a float array."""
+    try:
+        a = np.asarray(v)
+    except (ValueError, TypeError):  # a ragged list
+        a = np.asarray(None)
+    if a.dtype.kind not in "iuf":
+        raise ArgumentError(f"{name}: must be a number or an array of numbers (got {_short(v)})")
+    return a.astype(float)
+
+
+def _point(p, name: str) -> tuple[float, float]:
+    a = _coordinates(p, name)
+    if a.shape != (2,):
+        raise ArgumentError(f"{name}: must be a point (x, y) (got {_short(p)})")
+    return float(a[0]), float(a[1])
+
+
+def _count(n, name: str) -> int:
+    n = n.item() if isinstance(n, np.generic) else n
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise ArgumentError(f"{name}: must be an integer >= 1 (got {_short(n)})")
+    return n
+
+
+def _quantity(q) -> str:
+    if not isinstance(q, str) or q not in post.QUANTITIES:
+        raise ArgumentError(f"quantity: unknown quantity {_short(q)}; choose one of {sorted(post.QUANTITIES)}")
+    return str(q)
+
+
+def _probes(probes) -> list[tuple[float, float]]:
+    try:
+        items = list(probes)
+    except TypeError:
+        raise ArgumentError(f"probes: must be a list of points (x, y) (got {_short(probes)})") from None
+    return [_point(p, f"probes.{i}") for i, p in enumerate(items)]
+
+
+def _short(v, n: int = 60) -> str:
+    from .parts import _short as short
+    return short(v, n)

@@ -19,6 +19,7 @@ from typing import Any, Callable
 
 from .elements import ELEMENTS
 from .errors import SceneError
+from .parts import _short, check_parts, check_path, check_source, check_table
 
 #: Magnitudes plateqp computes with safely: a non-zero physical number (length, modulus, load,
 #: gap, stiffness, prescribed displacement) must lie in this range, and so must the bending
@@ -207,6 +208,7 @@ class Scene:
     source: str | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
+        _check_parts(self)
         # tuples given in Python become lists, as they come back from TOML (exact round trips)
         for key in ("openings", "pins", "loads", "supports", "holes"):
             if isinstance(getattr(self, key), tuple):
@@ -295,7 +297,9 @@ class Scene:
         return out.tolist()
 
     def validate(self) -> None:
-        """Check every field; raises SceneError naming the first bad one."""
+        """Check every field; raises SceneError naming the first bad one. :func:`plateqp.solve`
+        calls it again, so a scene changed after construction gets the same message."""
+        _check_parts(self)
         p = self.plate
         for k in ("a", "b", "h", "E"):
             self._num(f"plate.{k}", getattr(p, k), positive=True, physical=True)
@@ -456,6 +460,7 @@ class Scene:
         Anything that is not a readable scene file (no file, a directory, unreadable, not UTF-8,
         larger than :data:`MAX_FILE_BYTES`, not TOML, nested too deep) is a SceneError naming it.
         """
+        check_path(path)
         if str(path) == "":
             raise SceneError("the scene file name is an empty path")
         path = Path(path)
@@ -485,6 +490,7 @@ class Scene:
     @classmethod
     def from_dict(cls, data: dict, source: str | None = None) -> Scene:
         """Build a scene from the nested dict shape of the TOML file."""
+        check_table(data, source)
         prefix = f"{source}: " if source else ""
 
         def fail(where, what):
@@ -496,7 +502,7 @@ class Scene:
             names = {f.name for f in fields(klass) if f.init}
             extra = set(d) - names - ({"type"} if klass in _LOADS.values() else set())
             if extra:
-                fail(f"{where}.{sorted(extra)[0]}", f"unknown key; allowed: {sorted(names)}")
+                fail(f"{where}.{sorted(extra, key=str)[0]}", f"unknown key; allowed: {sorted(names)}")
             try:
                 return klass(**{k: v for k, v in d.items() if k != "type"})
             except TypeError as exn:
@@ -505,7 +511,7 @@ class Scene:
         top = {"name", "plate", "mesh", "edges", "openings", "pins", "loads", "supports", "foundation", "holes"}
         extra = set(data) - top
         if extra:
-            fail(sorted(extra)[0], f"unknown key; allowed top-level keys: {sorted(top)}")
+            fail(sorted(extra, key=str)[0], f"unknown key; allowed top-level keys: {sorted(top)}")
         name = data.get("name", "scene")
         if not isinstance(name, str):
             fail("name", f"must be a string (got {_short(name)})")
@@ -583,10 +589,7 @@ def _edge_from(v, where: str, source: str | None) -> Edge:
     raise SceneError(f"{prefix}{where}: must be a kind (\"free\", \"simple\", \"clamped\") or a table")
 
 
-def _short(v, n: int = 60) -> str:
-    """repr(v), cut to n characters (a hostile value must not flood the one-line message)."""
-    try:
-        r = repr(v)
-    except Exception:  # noqa: BLE001 - a repr that fails is still a bad value
-        r = f"<{type(v).__name__}>"
-    return r if len(r) <= n else r[: n - 1] + "…"
+def _check_parts(sc: Scene) -> None:
+    """The parts of the scene of their types, its NumPy numbers made Python's (:mod:`plateqp.parts`)."""
+    check_parts(sc, {"plate": Plate, "mesh": MeshSpec, "foundation": Foundation, "edges": Edge, "openings": Opening,
+                     "pins": Pin, "loads": (UniformLoad, PatchLoad, PointLoad), "supports": Support, "holes": object})

@@ -8,6 +8,7 @@ the function ``plateqp.solve`` would shadow it.)
 
 from __future__ import annotations
 
+import os
 import time
 import warnings
 
@@ -17,9 +18,10 @@ from .accuracy import Accuracy
 from .assembly import Model, build_model
 from .contact import solve_bilateral as _solve_bilateral
 from .contact import solve_contact
-from .errors import MechanismError, PlateQPWarning
+from .errors import ArgumentError, MechanismError, PlateQPWarning, ProblemError, SceneError, SolverError
 from .estimate import auto_tolerance, confirm
 from .linalg import Factor
+from .parts import _short, plain
 from .results import Result
 from .scene import Scene
 
@@ -40,6 +42,37 @@ def solve_two_sided(model: Model, factor: Factor | None = None) -> tuple[np.ndar
     factor = factor or Factor(model.K)
     u = factor.solve(model.f)
     return u, factor.residual(u, model.f), factor
+
+
+def check_arguments(scene, backend="auto", formulation="auto", accuracy="default", options=None, model=None,
+                    check_statics=True):
+    """The arguments of :func:`solve`, before any work: the scene a Scene, validated again (it
+    may have changed since it was built: the same SceneError its construction would give), the
+    others of their types, each error naming its argument. Returns ``accuracy`` with a NumPy
+    number made a Python one."""
+    if not isinstance(scene, Scene):
+        hint = {dict: "; build one with Scene.from_dict(d)", str: "; load a file with Scene.from_toml(path)"}
+        kind = next((v for k, v in hint.items() if isinstance(scene, k)), "")
+        kind = kind or ("; load a file with Scene.from_toml(path)" if isinstance(scene, os.PathLike) else "")
+        raise SceneError(f"scene: must be a plateqp Scene (got {_short(scene)}){kind}")
+    scene.validate()
+    if not isinstance(backend, str) or not backend:
+        raise SolverError(f"backend: must be a backend name such as \"auto\" or \"lemke\" (got {_short(backend)})")
+    if not isinstance(formulation, str):
+        raise ProblemError(f"formulation: must be \"auto\", \"primal\", \"condensed\" or \"dual\" "
+                           f"(got {_short(formulation)})")
+    accuracy = plain(accuracy)
+    if not isinstance(accuracy, (str, int, float)) or isinstance(accuracy, bool):
+        raise ProblemError(f"accuracy: must be \"low\", \"default\", \"high\", \"auto\" or a tolerance "
+                           f"(got {_short(accuracy)})")
+    if options is not None and (not isinstance(options, dict) or not all(isinstance(k, str) for k in options)):
+        raise ArgumentError(f"options: must be a dict of option names to values, or None (got {_short(options)})")
+    if model is not None and not isinstance(model, Model):
+        raise ArgumentError(f"model: must be a Model built from this scene (plateqp.assembly.build_model), "
+                            f"or None (got {_short(model)})")
+    if not isinstance(plain(check_statics), bool):
+        raise ArgumentError(f"check_statics: must be True or False (got {_short(check_statics)})")
+    return accuracy
 
 
 def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accuracy: str | float = "default",
@@ -74,7 +107,14 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     Returns
     -------
     Result, whose ``status`` says whether the KKT residuals meet the asked accuracy.
+
+    Raises
+    ------
+    SceneError if ``scene`` is not a valid Scene (checked again here: it may have been changed
+    since it was built), and an error naming the argument for any other bad argument
+    (:func:`check_arguments`), before any work.
     """
+    accuracy = check_arguments(scene, backend, formulation, accuracy, options, model, check_statics)
     auto = isinstance(accuracy, str) and accuracy == "auto"
     if not auto:
         accuracy = Accuracy.parse(accuracy)  # a bad accuracy fails before any work
@@ -112,4 +152,5 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
 
 def solve_bilateral(scene: Scene, model: Model | None = None) -> Result:
     """The paper's comparison: the same scene with every one-sided support made two-sided."""
+    check_arguments(scene, model=model)
     return _solve_bilateral(model or build_model(scene))

@@ -353,10 +353,11 @@ def pair_scene(d, stiffness="rigid"):
 
 @pytest.mark.parametrize("backend,formulation", EXACT)
 def test_nearly_coincident_rigid_supports_are_refused(backend, formulation):
-    """1e-9 of a cell apart: the split of the load between them is not determined in double
-    precision; the solve says so instead of returning one split or another."""
+    """1e-8 of a cell apart (1e-9 of the plate: closer, the scene refuses them as one point): the
+    split of the load between them is not determined in double precision; the solve says so
+    instead of returning one split or another."""
     with pytest.raises(pq.ProblemError, match="apart"):
-        run(pair_scene(1e-9 / 8), backend, formulation)
+        run(pair_scene(1e-8 / 8), backend, formulation)
 
 
 def dual_floor(scene, R) -> float:
@@ -407,7 +408,7 @@ def test_close_rigid_supports_are_solved(backend, formulation):
 @pytest.mark.parametrize("backend,formulation", [p for p in EXACT if p[1] != "condensed"])
 def test_nearly_coincident_elastic_supports_are_solved(backend, formulation):
     """Springs determine the split however close the supports are: solved, and exact."""
-    sc = pair_scene(1e-9 / 8, stiffness=1e3 * grid_scene().plate.D)
+    sc = pair_scene(1e-8 / 8, stiffness=1e3 * grid_scene().plate.D)
     ref = run(sc, "lemke", "dual").reactions
     res = run(sc, backend, formulation)
     assert res.status == pq.Status.OPTIMAL

@@ -6,6 +6,9 @@ in {0, 2, 3, 4, 5} (never 1, an internal error, and never a traceback), a failur
 stderr that starts with "plateqp:", and with ``--json`` standard output parses as JSON whenever
 a result was computed. ``Scene.from_toml`` raises SceneError and nothing else.
 
+The Python API has the same promise: hostile values on a scene's parts (before or after its
+construction) and in a Result's methods' arguments give a scene and a solve, or a PlateQPError.
+
 The budget is bounded (``FUZZ_EXAMPLES`` examples per strategy, about a minute in all on two cores);
 ``PLATEQP_FUZZ_EXAMPLES=2000 pytest tests/test_fuzz.py`` hunts longer.
 """
@@ -17,6 +20,7 @@ import io
 import json
 import os
 import tempfile
+import warnings
 from pathlib import Path
 
 import pytest
@@ -219,3 +223,85 @@ def test_structured_but_wrong(edits, backend, formulation):
     if backend not in ("auto", *pq.available_backends()):
         backend = "auto"
     solve_text(text, "--backend", backend, "--formulation", formulation)
+
+
+# -- the Python API: anything where a number, a part or an argument belongs ---------------------------
+#: Values a Python caller may put anywhere: numbers (NumPy's too), wrong types, containers.
+import numpy as np  # noqa: E402
+
+PY_VALUES = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True), st.integers(min_value=-10**30, max_value=10**30),
+    st.sampled_from([None, True, "", "x", "rigid", "simple", b"1", 1j, (), [], {}, [1, 2], {"a": 1}, object(),
+                     np.float32(0.3), np.int64(3), np.float64(-1.0), np.array(0.5), np.array([1.0, 2.0]),
+                     np.bool_(True), np.nan, pq.Plate(), pq.Support(0.0, 0.0), pq.UniformLoad(1.0)]),
+)
+#: (part, field) of the fuzzed scene that a value replaces; "" the scene's own field.
+PY_FIELDS = [("plate", f) for f in ("a", "b", "h", "E", "nu")] + [("mesh", f) for f in ("nx", "ny", "element")] + [
+    ("supports.0", f) for f in ("x", "y", "gap", "stiffness")] + [("loads.0", "q"), ("loads.1", "P"),
+    ("loads.1", "x"), ("foundation", "k"), ("foundation", "region"), ("foundation", "gap"), ("pins.0", "x")] + [
+    ("", f) for f in ("name", "plate", "mesh", "edges", "openings", "pins", "loads", "supports", "foundation")]
+
+
+def py_scene(**kw) -> pq.Scene:
+    return pq.Scene(name="fuzz", plate=pq.Plate(a=2.0, b=1.0, h=0.02), mesh=pq.MeshSpec(nx=4, ny=2),
+                    edges={"left": pq.Edge("simple")}, pins=[pq.Pin(0.0, 0.0)],
+                    loads=[pq.UniformLoad(1.0), pq.PointLoad(3.0, 1.2, 0.5)],
+                    supports=[pq.Support(2.0, 0.0, gap=-0.001), pq.Support(1.0, 1.0, stiffness=500.0)],
+                    foundation=pq.Foundation(50.0, region=[0.0, 1.0, 0.0, 1.0]), **kw)
+
+
+def test_python_base_scene_solves():
+    assert pq.solve(py_scene()).status.solved
+
+
+@FUZZ
+@given(st.lists(st.tuples(st.sampled_from(PY_FIELDS), PY_VALUES), min_size=1, max_size=3), st.booleans())
+def test_python_api_misuse_is_a_plateqp_error(edits, after):
+    """Values set on the scene's parts before construction (a new Scene from them) or after it
+    (then solve checks again): a scene and a solve, or a PlateQPError and nothing else."""
+    sc = py_scene()
+    try:
+        for (part, name), value in edits:
+            obj = sc
+            for k in part.split(".") if part else ():
+                obj = obj[int(k)] if k.isdigit() else getattr(obj, k)
+            setattr(obj, name, value)
+    except (AttributeError, IndexError, KeyError, TypeError):  # a part replaced earlier by a bare value
+        return
+    try:
+        if not after:
+            sc = pq.Scene(**{f: getattr(sc, f) for f in ("name", "plate", "mesh", "edges", "openings", "pins",
+                                                          "loads", "supports", "foundation")})
+        sc.validate()  # what solve checks first
+        if sc.mesh.nx * sc.mesh.ny > 64:  # a valid scene on a large mesh: its solve is not this test's
+            return
+        with warnings.catch_warnings():  # ill-conditioned scenes (a support 1e-160 from a pin) are
+            warnings.simplefilter("ignore")  # solved and flagged: the status is asserted below
+            res = pq.solve(sc)
+    except pq.PlateQPError as exn:
+        assert "\n" not in str(exn).strip()
+        return
+    assert res.status in set(pq.Status)
+
+
+@FUZZ
+@given(st.sampled_from(["deflection", "slopes", "curvatures", "moments", "stresses", "principal_stresses",
+                        "section", "at", "nodal", "to_dict"]),
+       st.lists(st.one_of(PY_VALUES, st.lists(st.floats(-1, 3), min_size=1, max_size=3)), max_size=3))
+def test_python_result_methods_misuse_is_a_plateqp_error(method, args):
+    res = _fuzz_result()
+    try:
+        getattr(res, method)(*args)
+    except pq.PlateQPError as exn:
+        assert "\n" not in str(exn).strip()
+    except TypeError as exn:  # the wrong number of arguments: Python's own call check
+        assert "positional argument" in str(exn), exn
+
+
+_RESULT = []
+
+
+def _fuzz_result():
+    if not _RESULT:
+        _RESULT.append(pq.solve(py_scene()))
+    return _RESULT[0]

@@ -177,3 +177,129 @@ def test_domain_covers_is_the_plate():
     y = np.array([0.5, 1.5, 0.5, 1.5, 0.5, 1.5, 0.5 + 0.2 * math.sin(1.0)])
     assert d.covers(x, y).tolist() == [True, False, False, True, True, True, True]
     assert d.area == pytest.approx(3.0 - math.pi * 0.04, rel=1e-14)
+
+
+# -- large polygons: the checks in n log n, and a vertex limit -------------------------------------
+def star(n: int, centre=(0.0, 0.0), radius: float = 1.0) -> list[list[float]]:
+    """A simple counter-clockwise polygon of n vertices (a wavy circle: r = R (1 + 0.2 sin 7θ))."""
+    t = 2 * np.pi * np.arange(n) / n
+    r = radius * (1 + 0.2 * np.sin(7 * t))
+    return np.column_stack([centre[0] + r * np.cos(t), centre[1] + r * np.sin(t)]).tolist()
+
+
+def shaped(outline, holes=(), **kw) -> pq.Scene:
+    return pq.Scene(plate=pq.Plate(shape={"polygon": outline}), mesh=pq.MeshSpec(element="dkt", size=0.5),
+                    holes=[{"polygon": h} for h in holes], **kw)
+
+
+def test_polygon_checks_do_not_test_every_pair_of_segments(monkeypatch):
+    """The crossing checks of a plate's outline and of a hole in it look at the segments near each
+    other (a spatial index), not at all n² / 2 pairs: the pairwise test runs far fewer than n times."""
+    pytest.importorskip("shapely")
+    from plateqp import crossings
+
+    calls = []
+    pairwise = crossings._segments_cross
+    monkeypatch.setattr(crossings, "_segments_cross", lambda s, t: calls.append(1) or pairwise(s, t))
+    n = 400
+    sc = shaped(star(n), holes=[star(n, radius=0.3)])
+    assert len(sc.holes[0]["polygon"]) == n
+    assert len(calls) < n
+
+
+def brute_crossing(pts) -> tuple[int, int] | None:
+    """The first pair (i, j), i < j, of non-adjacent segments that cross (points in general
+    position: proper crossings only), by testing every pair."""
+    n = len(pts)
+    seg = [(pts[i], pts[(i + 1) % n]) for i in range(n)]
+
+    def orient(a, b, c):
+        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+    for i in range(n):
+        for j in range(i + 2, n):
+            if i == 0 and j == n - 1:
+                continue
+            (p1, p2), (p3, p4) = seg[i], seg[j]
+            if (orient(p3, p4, p1) > 0) != (orient(p3, p4, p2) > 0) and \
+                    (orient(p1, p2, p3) > 0) != (orient(p1, p2, p4) > 0):
+                return i, j
+    return None
+
+
+def test_self_intersections_agree_with_every_pair_tested():
+    """Random polygons (3 to 12 random vertices): a polygon is refused as self-intersecting exactly
+    when testing every pair of segments finds a crossing, and the message names that first pair."""
+    from plateqp.geometry import parse_shape
+
+    rng = np.random.default_rng(7)
+    seen = {True: 0, False: 0}
+    for _ in range(300):
+        pts = rng.random((int(rng.integers(3, 13)), 2)).tolist()
+        expect = brute_crossing(pts)
+        msgs = []
+        try:
+            parse_shape({"polygon": pts}, "plate.shape", lambda where, what: msgs.append(what) or 1 / 0)
+        except ZeroDivisionError:
+            pass
+        crossing = bool(msgs) and "self-intersecting" in msgs[0]
+        assert crossing == (expect is not None), (pts, msgs, expect)
+        if expect is not None:
+            i, j = expect
+            assert f"segment {i} (vertices" in msgs[0] and f"crosses segment {j} (vertices" in msgs[0], msgs
+        seen[crossing] += 1
+    assert min(seen.values()) > 30  # both verdicts drawn many times
+
+
+@pytest.mark.parametrize("where", ["outline", "hole"])
+def test_a_crossing_far_along_a_large_polygon_is_found(where):
+    """Two segments of a 5000-vertex outline (or hole) made to cross, far apart in the list."""
+    outline, hole = star(5000), star(5000, radius=0.3)
+    bad = outline if where == "outline" else hole
+    bad[4000], bad[4001] = bad[4001], bad[4000]  # a bow tie between vertices 3999 and 4002
+    with pytest.raises(pq.SceneError) as info:
+        shaped(outline, holes=[hole])
+    field = "plate.shape.polygon" if where == "outline" else "holes.0.polygon"
+    assert str(info.value).startswith(f"{field}: self-intersecting: segment 3999") and "segment 4001" in str(info.value)
+
+
+def test_vertex_limit_is_a_clear_error(monkeypatch):
+    from plateqp import geometry
+
+    monkeypatch.setattr(geometry, "MAX_VERTICES", 60)
+    shaped(star(60))
+    with pytest.raises(pq.SceneError, match=r"^plate\.shape\.polygon: 61 vertices, more than .* \(at most 60\)"):
+        shaped(star(61))
+    with pytest.raises(pq.SceneError, match=r"^holes\.1\.polygon: 61 vertices"):
+        shaped(star(8), holes=[star(8, (0.5, 0.0), 0.1), star(61, (-0.5, 0.0), 0.1)])
+    # all boundaries together, the holes' vertices counted with the outline's
+    with pytest.raises(pq.SceneError, match=r"^holes: the plate's boundaries have 70 vertices in all, more than"):
+        shaped(star(40), holes=[star(30, (0.4, 0.0), 0.2)])
+    with pytest.raises(pq.SceneError, match=r"^foundation\.region\.polygon: 61 vertices"):
+        shaped(star(8), foundation=pq.Foundation(1.0, region={"polygon": star(61, radius=0.3)}))
+
+
+def test_the_vertex_limit_is_checked_before_the_vertices_are_read():
+    """A polygon over the limit is refused at once by its length, whatever its vertices hold."""
+    from plateqp import geometry
+
+    with pytest.raises(pq.SceneError, match="vertices, more than"):
+        shaped([[0, 0]] * (geometry.MAX_VERTICES + 1))
+
+
+def test_without_shapely_small_polygons_are_checked_pair_by_pair(monkeypatch):
+    """shapely missing (the shapes extra not installed): polygons up to PAIRWISE_VERTICES vertices are
+    checked by testing every pair of segments, with the same verdicts; larger ones ask for shapely."""
+    import sys
+
+    from plateqp import crossings
+
+    monkeypatch.setitem(sys.modules, "shapely", None)  # import shapely raises ImportError
+    monkeypatch.setattr(crossings, "PAIRWISE_VERTICES", n := 80)
+    outline = star(n)
+    shaped(outline, holes=[star(n, radius=0.3)])
+    outline[50], outline[51] = outline[51], outline[50]
+    with pytest.raises(pq.SceneError, match=r"^plate\.shape\.polygon: self-intersecting: segment 49 "):
+        shaped(outline)
+    with pytest.raises(pq.SceneError, match=rf"^plate\.shape\.polygon: {n + 1} vertices: .* needs shapely"):
+        shaped(star(n + 1))
