@@ -243,8 +243,12 @@ def check_memory(scene: Scene) -> None:
 GENERATORS = {"quad": Grid, "triangle": TriMesh}
 
 
-def _generator(scene: Scene):
+def mesh_generator(scene: Scene):
+    """The generator that meshes ``scene`` (:data:`GENERATORS`, by its element's cell type)."""
     return GENERATORS[ELEMENTS[scene.mesh.element].cell_type]
+
+
+_generator = mesh_generator
 
 
 def mesh_cells(scene: Scene) -> tuple[int, int]:

@@ -256,17 +256,12 @@ KNOWN_MESH_KIND_BRANCHES: dict[str, int] = {
     "plateqp.constraints:warn_changed_all": 1,
     "plateqp.demo:run_scene": 1,
     "plateqp.io.fields:to_xarray": 1,  # the grid view where the mesh has one
-    "plateqp.estimate:Quantities.of": 1,
-    "plateqp.io.export:contact_qp": 1,
     "plateqp.plotting.charts:plot_reactions": 1,
     "plateqp.plotting.data:_bbox": 1,
     "plateqp.plotting.marks:_draw_outline": 1,
     "plateqp.plotting.plan:default_sections": 1,
     "plateqp.plotting.plan:plot_mesh": 1,
     "plateqp.post:NodalOperator.__init__": 1,
-    "plateqp.report:_scene_facts": 1,
-    "plateqp.studies.refinement:TargetResult.__str__": 1,
-    "plateqp.studies.reuse:same_structure": 1,
 }
 
 

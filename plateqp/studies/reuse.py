@@ -12,7 +12,7 @@ import dataclasses
 
 import numpy as np
 
-from ..assembly import Model
+from ..assembly import Model, mesh_generator
 from ..scene import Scene
 
 
@@ -24,7 +24,7 @@ def same_structure(a: Scene, b: Scene) -> bool:
         return False
     if [(s.x, s.y) for s in a.supports] != [(s.x, s.y) for s in b.supports]:
         return False
-    if a.triangles and _point_loads(a) != _point_loads(b):  # point loads are nodes of a triangle mesh
+    if mesh_generator(a).points_are_nodes and _point_loads(a) != _point_loads(b):  # a moved node: a new mesh
         return False
     if (a.foundation is None) != (b.foundation is None):
         return False
