@@ -157,7 +157,7 @@ class TriMesh:
 
     def summary(self, element: str) -> dict:
         """The mesh in numbers, for a file's metadata: element, size, nodes and triangles."""
-        return {"element": element, "size": float(self.size), "nodes": int(self.n_nodes),
+        return {"element": element, "size": float(self.size), "nodes": self.n_nodes,
                 "triangles": int(len(self.triangles))}
 
     def summary_text(self, element: str, units: str = "") -> str:
@@ -167,7 +167,6 @@ class TriMesh:
 
     def grid_view(self, values: np.ndarray) -> None:
         """None: a triangle mesh has no grid view of its nodal fields."""
-        return None
 
     @staticmethod
     def describe(scene) -> tuple[str, str, str]:

@@ -261,7 +261,6 @@ KNOWN_MESH_KIND_BRANCHES: dict[str, int] = {
     "plateqp.plotting.marks:_draw_outline": 1,
     "plateqp.plotting.plan:default_sections": 1,
     "plateqp.plotting.plan:plot_mesh": 1,
-    "plateqp.post:NodalOperator.__init__": 1,
 }
 
 
@@ -297,7 +296,7 @@ def mesh_kind_branches() -> dict[str, int]:
         if any(name == m or name.startswith(m + ".") for m in MESH_KIND_MODULES):
             continue
 
-        def visit(node, where):
+        def visit(node, where, name=name):
             for child in ast.iter_child_nodes(node):
                 inner = where
                 if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
@@ -305,7 +304,7 @@ def mesh_kind_branches() -> dict[str, int]:
                 if _asks_mesh_kind(child):
                     key = f"{name}:{inner}"
                     out[key] = out.get(key, 0) + 1
-                visit(child, inner)
+                visit(child, inner, name)
 
         visit(ast.parse(path.read_text(encoding="utf-8")), "")
     return out
