@@ -85,6 +85,11 @@ class Grid:
         """The mesh in words, for a report (``units``: of length, unused on a grid)."""
         return f"mesh {self.nx} × {self.ny} {element.upper()}"
 
+    @property
+    def bbox(self) -> tuple[float, float, float, float]:
+        """(x0, x1, y0, y1) of the plate: the rectangle a × b."""
+        return 0.0, float(self.a), 0.0, float(self.b)
+
     def grid_view(self, values: np.ndarray) -> np.ndarray:
         """The (ny + 1, nx + 1) view of a nodal field, NaN off the plate (:meth:`to_grid`)."""
         return self.to_grid(values)

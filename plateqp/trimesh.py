@@ -165,6 +165,12 @@ class TriMesh:
         return (f"mesh: {len(self.triangles)} triangles, {self.n_nodes} nodes, size {self.size:g} {units}, "
                 f"{element.upper()}")
 
+    @property
+    def bbox(self) -> tuple[float, float, float, float]:
+        """(x0, x1, y0, y1) of the plate: its outer boundary's box."""
+        x0, x1, y0, y1 = self.domain.outer.bbox
+        return x0, x1, y0, y1
+
     def grid_view(self, values: np.ndarray) -> None:
         """None: a triangle mesh has no grid view of its nodal fields."""
 

@@ -257,7 +257,6 @@ KNOWN_MESH_KIND_BRANCHES: dict[str, int] = {
     "plateqp.demo:run_scene": 1,
     "plateqp.io.fields:to_xarray": 1,  # the grid view where the mesh has one
     "plateqp.plotting.charts:plot_reactions": 1,
-    "plateqp.plotting.data:_bbox": 1,
     "plateqp.plotting.marks:_draw_outline": 1,
     "plateqp.plotting.plan:default_sections": 1,
     "plateqp.plotting.plan:plot_mesh": 1,

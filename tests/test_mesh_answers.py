@@ -93,3 +93,11 @@ def test_corner_curvatures_are_the_basis_at_the_corners(name):
                 np.testing.assert_array_equal(ref, np.eye(el.ndof)[v * el.ndof_node])
             else:
                 np.testing.assert_allclose(W[cell, v], ref, rtol=1e-12, atol=1e-12)
+
+
+def test_the_bounding_box_is_the_nodes_span(model):
+    """(x0, x1, y0, y1) of the plate, the box its nodes span."""
+    x0, x1, y0, y1 = model.grid.bbox
+    nodes = model.grid.nodes
+    span = (nodes[:, 0].min(), nodes[:, 0].max(), nodes[:, 1].min(), nodes[:, 1].max())
+    assert (x0, x1, y0, y1) == pytest.approx(span, rel=1e-9, abs=1e-12)
