@@ -74,8 +74,7 @@ def _cell_edges(mesh) -> np.ndarray:
 
 
 def _bbox(result: Result) -> tuple[float, float, float, float]:
-    """(x0, x1, y0, y1) of the plate: the rectangle a × b of a grid, the outer boundary's box
-    of a shaped plate."""
+    """(x0, x1, y0, y1) of the plate, as its mesh gives it (``mesh.bbox``)."""
     return result.model.grid.bbox
 
 
