@@ -197,7 +197,7 @@ def estimate_memory(scene: Scene) -> int:
     """Bytes a build and solve of ``scene`` is expected to need at its peak (see BYTES_PER_DOF):
     the dofs of the mesh its generator expects (``estimate_nodes``)."""
     nd = len(ELEMENTS[scene.mesh.element].node_dofs)
-    return int(BYTES_PER_DOF * nd * _generator(scene).estimate_nodes(scene))
+    return int(BYTES_PER_DOF * nd * mesh_generator(scene).estimate_nodes(scene))
 
 
 def memory_limit() -> int:
@@ -236,7 +236,7 @@ def check_memory(scene: Scene) -> None:
     """ResourceError before any allocation if ``scene`` would need more memory than allowed."""
     need, limit = estimate_memory(scene), memory_limit()
     if need > limit:
-        where, mesh, fix = _generator(scene).describe(scene)
+        where, mesh, fix = mesh_generator(scene).describe(scene)
         raise ResourceError(f"{where}: a {mesh} needs about {human_bytes(need)} to build and solve, above the limit "
                             f"of {human_bytes(limit)}; {fix}, or raise the limit (--max-memory or ${MEMORY_ENV})")
 
@@ -247,21 +247,23 @@ def check_memory(scene: Scene) -> None:
 GENERATORS = {"quad": Grid, "triangle": TriMesh}
 
 
-def _generator(scene: Scene):
+def mesh_generator(scene: Scene):
+    """The generator that meshes ``scene`` (:data:`GENERATORS`, by its element's cell type)."""
     return GENERATORS[ELEMENTS[scene.mesh.element].cell_type]
+
 
 
 def mesh_cells(scene: Scene) -> tuple[int, int]:
     """The mesh of a scene as the studies by mesh halving count it, in cells a side: (nx, ny) of
     a grid; on triangles (n, n), n = L / h rounded (halving h doubles n)."""
-    return _generator(scene).cells_a_side(scene)
+    return mesh_generator(scene).cells_a_side(scene)
 
 
 def with_cells(scene: Scene, nx: int, ny: int) -> Scene:
     """A validated copy of ``scene`` meshed nx × ny cells a side (:func:`mesh_cells`; on
     triangles the element size L / nx)."""
     sc = copy.deepcopy(scene)
-    _generator(scene).set_cells(sc, nx, ny)
+    mesh_generator(scene).set_cells(sc, nx, ny)
     sc.validate()
     return sc
 
@@ -269,7 +271,7 @@ def with_cells(scene: Scene, nx: int, ny: int) -> Scene:
 def start_cells(scene: Scene, cells: int = 4) -> tuple[int, int]:
     """The first mesh of a refinement ladder: ``cells`` on the shorter side, the other in
     proportion to the scene's own grid (on triangles (cells, cells))."""
-    return _generator(scene).start_cells(scene, cells)
+    return mesh_generator(scene).start_cells(scene, cells)
 
 
 def build_model(scene: Scene) -> Model:
@@ -278,7 +280,7 @@ def build_model(scene: Scene) -> Model:
     loads (:func:`load_vector`), its two-sided supports (:func:`plateqp.constraints.prescribed`)
     and its contact operator; the same steps on every mesh."""
     check_memory(scene)
-    mesh = _generator(scene).from_scene(scene)
+    mesh = mesh_generator(scene).from_scene(scene)
     el = ELEMENTS[scene.mesh.element]()
     nd = el.ndof_node
     D, nu = scene.plate.D, scene.plate.nu

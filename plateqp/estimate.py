@@ -76,7 +76,7 @@ class Quantities:
                 p = float(sc.foundation.k * np.asarray(res.compressions)[src == "bed"].max(initial=0.0))
         w, mesh = res.w_nodes(), res.model.grid
         return cls(mesh_cells(sc), float(np.max(np.abs(w))), R, p,
-                   mesh.to_grid(w) if mesh.grid_shape is not None else None)
+                   mesh.grid_view(w))
 
 
 def changes(coarse: Quantities, fine: Quantities) -> dict[str, float]:

@@ -69,6 +69,31 @@ class Grid:
         m = scene.mesh
         return "mesh", f"{m.nx} x {m.ny} {m.element} mesh", "use a coarser mesh"
 
+    #: a point load stands anywhere in its cell, not at a node (a moved load keeps the mesh)
+    points_are_nodes = False
+
+    @staticmethod
+    def size_note(scene) -> str:
+        """Words after a refinement ladder's "nx x ny" (the cells say it all on a grid): ""."""
+        return ""
+
+    def summary(self, element: str) -> dict:
+        """The mesh in numbers, for a file's metadata: cells a side and element."""
+        return {"nx": int(self.nx), "ny": int(self.ny), "element": element}
+
+    def summary_text(self, element: str, units: str = "") -> str:
+        """The mesh in words, for a report (``units``: of length, unused on a grid)."""
+        return f"mesh {self.nx} × {self.ny} {element.upper()}"
+
+    @property
+    def bbox(self) -> tuple[float, float, float, float]:
+        """(x0, x1, y0, y1) of the plate: the rectangle a × b."""
+        return 0.0, float(self.a), 0.0, float(self.b)
+
+    def grid_view(self, values: np.ndarray) -> np.ndarray:
+        """The (ny + 1, nx + 1) view of a nodal field, NaN off the plate (:meth:`to_grid`)."""
+        return self.to_grid(values)
+
     # the meshes of a refinement ladder, counted in cells a side (plateqp.studies.refinement)
     @staticmethod
     def cells_a_side(scene) -> tuple[int, int]:

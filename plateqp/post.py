@@ -74,10 +74,6 @@ def from_curvatures(plate, quantity: str, kxx, kyy, kxy) -> np.ndarray:
     raise ValueError(f"{quantity!r} is not recovered from the curvatures")
 
 
-#: The corners of a quad cell in the order of Grid.cell_nodes, in cell coordinates.
-_CORNERS = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
-
-
 class NodalOperator:
     """Nodal averages of the fields of one mesh (the structured grid or a triangle mesh).
 
@@ -88,10 +84,10 @@ class NodalOperator:
     one mesh (a sweep) cost a sparse product each. Valid for every model that shares the mesh,
     element and kept cells of ``model`` (an adapted model of a sweep).
 
-    How a cell gives its corner values depends only on its element: a quad (ACM, BFS) is
-    evaluated just inside (1e-9 of a cell) each corner through the model's interpolation, w
-    included; a triangle (DKT) gives its linear curvature field at its vertices
-    (:meth:`~plateqp.elements.dkt.DKT.curvature_matrix`), and w is the node's own dof.
+    A cell's corner values are its element's answer, one call on every mesh:
+    ``element.corner_curvatures(xy)`` (a quad (ACM, BFS) evaluated just inside, 1e-9 of a
+    cell, each corner; a triangle (DKT) its linear curvature field at its vertices) and
+    ``element.corner_w(xy)`` (None where a corner's w is its node's own dof, as on DKT).
 
     Parameters
     ----------
@@ -105,18 +101,11 @@ class NodalOperator:
         self._ids = mesh.plate_node_ids
         self._nd = model.element.ndof_node
         cells = mesh.cells
+        self._xy = mesh.nodes[cells]
         self._w = None
         self._curv = None
-        self._points = None
-        if mesh.cell_type == "triangle":
-            self._curv = _triangle_vertex_curvatures(model)
-            corner_nodes = cells.ravel()  # vertex v of triangle k at 3 k + v, as its rows
-        else:
-            x0 = (model.cells % mesh.nx) * mesh.hx
-            y0 = (model.cells // mesh.nx) * mesh.hy
-            self._points = [(x0 + (1e-9 + (1 - 2e-9) * cx) * mesh.hx, y0 + (1e-9 + (1 - 2e-9) * cy) * mesh.hy)
-                            for cx, cy in _CORNERS]  # just inside each corner of each cell
-            corner_nodes = cells.T.ravel()  # corner 0 of every cell, then corner 1, ...
+        self._w_at_nodes = model.element.corner_w(self._xy[:1]) is None  # a corner's w is its node's dof
+        corner_nodes = cells.ravel()  # corner v of cell k at k · corners + v, as its columns
         # averaging: (n, n_corners) with 1/count at (node, each of its corners)
         cnt = np.bincount(corner_nodes, minlength=self.n_nodes).astype(float)
         self._on = cnt > 0
@@ -129,12 +118,15 @@ class NodalOperator:
         """(n,): one value per node of the plate."""
         return (self.n_nodes,)
 
-    def _op(self, orders) -> sp.csr_matrix:
-        """The quad corner points' interpolation (w and its derivatives ``orders``), stacked as
-        [order 0: corners 0..3; order 1: corners 0..3; ...], from the full dofs."""
-        m = self.model
-        return sp.vstack([m.interpolation(x, y, dx, dy) for dx, dy in orders for x, y in self._points],
-                         format="csr")
+    def _op(self, values: np.ndarray) -> sp.csr_matrix:
+        """The cells' corner values ``values`` (ncell, corners, k, ndof) as one operator from the
+        full dofs: row i · (ncell · corners) + c · corners + v for value i of corner v of cell c."""
+        nc, nv, k, _ = values.shape
+        rows = (np.arange(k)[None, None, :, None] * (nc * nv) + (np.arange(nc)[:, None, None, None] * nv
+                + np.arange(nv)[None, :, None, None]))
+        cols = self.model.cell_dofs[:, None, None, :]
+        rows, cols = np.broadcast_arrays(rows, cols)
+        return sp.csr_matrix((values.ravel(), (rows.ravel(), cols.ravel())), shape=(k * nc * nv, self.model.n_full))
 
     def _averaged(self, values: np.ndarray) -> np.ndarray:
         out = self._average @ values
@@ -146,29 +138,15 @@ class NodalOperator:
         ``u`` of a plate (``plate``: its :class:`~plateqp.scene.Plate`), in ``mesh.nodes`` order."""
         check_quantity(quantity)
         if quantity == "w":
-            if self._points is None:  # a triangle's w at its vertex is the node's own dof
+            if self._w_at_nodes:
                 return nodal_w(self.model, u)
             if self._w is None:
-                self._w = self._op(((0, 0),))
+                self._w = self._op(self.model.element.corner_w(self._xy)[:, :, None])
             return self._averaged(self._w @ u)
         if self._curv is None:
-            self._curv = self._op(((2, 0), (0, 2), (1, 1)))
+            self._curv = self._op(self.model.element.corner_curvatures(self._xy))
         kxx, kyy, kxy = (self._curv @ u).reshape(3, -1)
         return self._averaged(from_curvatures(plate, quantity, kxx, kyy, kxy))
-
-
-def _triangle_vertex_curvatures(model) -> sp.csr_matrix:
-    """(9 nt, n_full): the curvatures (w,xx, w,yy, w,xy) of each triangle at each of its
-    vertices, row c · (3 nt) + 3 k + v for curvature c of vertex v of triangle k."""
-    t = model.grid.cells
-    nt = len(t)
-    B = model.element.curvature_matrix(model.grid.nodes[t], np.eye(3)).copy()  # (nt, 3, 3, 9)
-    B[..., 2, :] *= 0.5  # κ3 = 2 w,xy -> w,xy
-    rows = (np.arange(3)[None, None, :, None] * 3 * nt + 3 * np.arange(nt)[:, None, None, None]
-            + np.arange(3)[None, :, None, None])
-    rows = np.broadcast_to(rows, B.shape)
-    cols = np.broadcast_to(model.cell_dofs[:, None, None, :], B.shape)
-    return sp.csr_matrix((B.ravel(), (rows.ravel(), cols.ravel())), shape=(9 * nt, model.n_full))
 
 
 def nodal_operator(model) -> NodalOperator:

@@ -209,15 +209,9 @@ def _scene_facts(r) -> str:
             loads.append(f"patch q = {ld.q:g} on [{ld.x0:g}, {ld.x1:g}] × [{ld.y0:g}, {ld.y1:g}]")
     n = len(sc.supports)
     Eu, Du = (f" {F}/{L}²", f" {F}·{L}") if r.units else ("", "")
-    if sc.triangles:
-        mesh = r.one.model.grid
-        shape = ", ".join(f"{k} {v}" for k, v in (p.shape or {}).items()) or f"{p.a:g} × {p.b:g}"
-        plan = f"plate {shape} {L}" + (f" with {len(sc.holes)} hole(s)" if sc.holes else "")
-        mesh_txt = (f"mesh: {len(mesh.triangles)} triangles, {mesh.n_nodes} nodes, size {mesh.size:g} {L}, "
-                    f"{sc.mesh.element.upper()}")
-    else:
-        plan = f"plate {p.a:g} × {p.b:g} {L}"
-        mesh_txt = f"mesh {sc.mesh.nx} × {sc.mesh.ny} {sc.mesh.element.upper()}"
+    shape = ", ".join(f"{k} {v}" for k, v in (p.shape or {}).items()) or f"{p.a:g} × {p.b:g}"
+    plan = f"plate {shape} {L}" + (f" with {len(sc.holes)} hole(s)" if sc.holes else "")
+    mesh_txt = r.one.model.grid.summary_text(sc.mesh.element, L)
     facts = [f"{plan}, h = {p.h:g} {L}, E = {p.E:g}{Eu}, ν = {p.nu:g}, "
              f"D = {p.D:.4g}{Du}; {mesh_txt}",
              "loads: " + "; ".join(loads)]

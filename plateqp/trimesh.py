@@ -147,6 +147,33 @@ class TriMesh:
         """(cells, cells): element size L / cells."""
         return cells, cells
 
+    #: a node stands at every point load (:meth:`from_scene`): a moved load is a new mesh
+    points_are_nodes = True
+
+    @staticmethod
+    def size_note(scene) -> str:
+        """Words after a refinement ladder's "n x n": the element size."""
+        return f" (element size {scene.mesh.size:g})"
+
+    def summary(self, element: str) -> dict:
+        """The mesh in numbers, for a file's metadata: element, size, nodes and triangles."""
+        return {"element": element, "size": float(self.size), "nodes": self.n_nodes,
+                "triangles": int(len(self.triangles))}
+
+    def summary_text(self, element: str, units: str = "") -> str:
+        """The mesh in words, for a report (``units``: of length)."""
+        return (f"mesh: {len(self.triangles)} triangles, {self.n_nodes} nodes, size {self.size:g} {units}, "
+                f"{element.upper()}")
+
+    @property
+    def bbox(self) -> tuple[float, float, float, float]:
+        """(x0, x1, y0, y1) of the plate: its outer boundary's box."""
+        x0, x1, y0, y1 = self.domain.outer.bbox
+        return x0, x1, y0, y1
+
+    def grid_view(self, values: np.ndarray) -> None:
+        """None: a triangle mesh has no grid view of its nodal fields."""
+
     @staticmethod
     def describe(scene) -> tuple[str, str, str]:
         """(field, the mesh in words, what makes it smaller) for a message about its size."""

@@ -238,3 +238,93 @@ def test_the_length_checks_see_a_long_function(tmp_path, monkeypatch):
     (pkg / "scene.py").write_text("def f():\n" + "    x = 1\n" * MAX_FUNCTION_LINES + "    return x\n")
     monkeypatch.setattr(__import__(__name__), "ROOT", pkg)
     assert long_functions() == {"plateqp.scene:f": MAX_FUNCTION_LINES + 2}
+
+
+# -- which mesh a module holds: asked only where meshes are made and elements chosen -------------
+#: The mesh generators and element families: the only modules that may ask which kind of mesh
+#: they hold.
+MESH_KIND_MODULES = ("plateqp.mesh", "plateqp.trimesh", "plateqp.elements")
+#: Names a scene goes by, whose ``.triangles`` read asks which generator meshes it.
+SCENE_NAMES = {"scene", "sc", "a", "b", "s", "self"}
+#: Known remaining questions about the mesh kind, ``module:function`` → how many, declared as
+#: data: each must still be there, so that removing one removes it from here.
+KNOWN_MESH_KIND_BRANCHES: dict[str, int] = {
+    "plateqp.scene:Scene.validate": 6,  # the scene's validation, reworked on its own
+    "plateqp.scene:Scene._inside": 1,
+    "plateqp.cli.solve:_check_probes": 1,
+    "plateqp.constraints:warn_changed_all": 1,
+    "plateqp.demo:run_scene": 1,
+    "plateqp.io.fields:to_xarray": 1,  # the grid view where the mesh has one
+    "plateqp.plotting.charts:plot_reactions": 1,
+    "plateqp.plotting.marks:_draw_outline": 1,
+    "plateqp.plotting.plan:default_sections": 1,
+    "plateqp.plotting.plan:plot_mesh": 1,
+}
+
+
+def _asks_mesh_kind(node: ast.AST) -> bool:
+    """Whether ``node`` asks which kind of mesh is held: a scene's ``triangles``, a call of
+    ``on_triangles``, a comparison with a ``cell_type`` or of ``grid_shape`` with None, an
+    ``isinstance`` with Grid or TriMesh."""
+    def name(n):
+        return n.id if isinstance(n, ast.Name) else n.attr if isinstance(n, ast.Attribute) else None
+
+    if isinstance(node, ast.Attribute) and node.attr == "triangles" and isinstance(node.ctx, ast.Load):
+        return name(node.value) in SCENE_NAMES
+    if isinstance(node, ast.Call):
+        if name(node.func) == "on_triangles":
+            return True
+        if name(node.func) == "isinstance" and len(node.args) == 2:
+            kinds = node.args[1].elts if isinstance(node.args[1], ast.Tuple) else [node.args[1]]
+            return any(name(k) in ("Grid", "TriMesh") for k in kinds)
+    if isinstance(node, ast.Compare):
+        sides = [node.left, *node.comparators]
+        if any(name(s) == "cell_type" for s in sides):
+            return True
+        return any(name(s) == "grid_shape" for s in sides) and any(
+            isinstance(s, ast.Constant) and s.value is None for s in sides)
+    return False
+
+
+def mesh_kind_branches() -> dict[str, int]:
+    """``module:function`` (``module:`` at module level) → how many questions about the kind of
+    mesh it asks, outside :data:`MESH_KIND_MODULES`."""
+    out: dict[str, int] = {}
+    for name, path in sources().items():
+        if any(name == m or name.startswith(m + ".") for m in MESH_KIND_MODULES):
+            continue
+
+        def visit(node, where, name=name):
+            for child in ast.iter_child_nodes(node):
+                inner = where
+                if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                    inner = f"{where}.{child.name}" if where else child.name
+                if _asks_mesh_kind(child):
+                    key = f"{name}:{inner}"
+                    out[key] = out.get(key, 0) + 1
+                visit(child, inner, name)
+
+        visit(ast.parse(path.read_text(encoding="utf-8")), "")
+    return out
+
+
+def test_no_code_asks_which_mesh_it_holds():
+    found = mesh_kind_branches()
+    new = {k: n for k, n in found.items() if n > KNOWN_MESH_KIND_BRANCHES.get(k, 0)}
+    assert not new, f"code outside the mesh generators and elements asks which mesh it holds: {new}"
+    fixed = {k: n for k, n in KNOWN_MESH_KIND_BRANCHES.items() if found.get(k, 0) < n}
+    assert not fixed, f"{sorted(fixed)} ask less now (or are gone): lower them in KNOWN_MESH_KIND_BRANCHES"
+
+
+def test_the_mesh_kind_check_sees_a_branch(tmp_path, monkeypatch):
+    """The check finds each planted kind of question (a check that cannot fail is no check)."""
+    pkg = tmp_path / "plateqp"
+    (pkg / "plotting").mkdir(parents=True)
+    (pkg / "plotting" / "plan.py").write_text(
+        "def f(sc, mesh, result):\n"
+        "    if sc.triangles or on_triangles(result) or mesh.cell_type == 'quad':\n"
+        "        return isinstance(mesh, (Grid, int)) or mesh.grid_shape is None\n"
+        "    return mesh.triangles\n")
+    (pkg / "trimesh.py").write_text("def g(sc):\n    return sc.triangles\n")
+    monkeypatch.setattr(__import__(__name__), "ROOT", pkg)
+    assert mesh_kind_branches() == {"plateqp.plotting.plan:f": 5}

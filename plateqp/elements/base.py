@@ -27,6 +27,9 @@ CORNERS = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 _gp, _gw = np.polynomial.legendre.leggauss(4)
 GAUSS_X = 0.5 * (_gp + 1.0)
 GAUSS_W = 0.5 * _gw
+#: the corners, 1e-9 of a cell inside it; the derivative orders of (w,xx, w,yy, w,xy)
+_INSIDE = 1e-9 + (1.0 - 2e-9) * CORNERS
+_CURVATURE_ORDERS = ((2, 0), (0, 2), (1, 1))
 
 
 def _sizes(xy) -> list[tuple[tuple[float, float], np.ndarray]]:
@@ -126,6 +129,18 @@ class RectElement:
         for (sx, sy), at in _sizes(xy):
             out[at] = self.shape(local[at, 0], local[at, 1], sx, sy, dx, dy)
         return out
+
+    def corner_curvatures(self, xy) -> np.ndarray:
+        """(ncell, 4, 3, ndof): the curvatures (w,xx, w,yy, w,xy) of each cell (corners ``xy``
+        (ncell, 4, 2)) at each of its corners, evaluated just inside it (1e-9 of the cell) so
+        that the value is the cell's own."""
+        return self._per_size(xy, lambda sx, sy: np.stack(
+            [self.shape(_INSIDE[:, 0], _INSIDE[:, 1], sx, sy, dx, dy) for dx, dy in _CURVATURE_ORDERS], axis=1))
+
+    def corner_w(self, xy) -> np.ndarray:
+        """(ncell, 4, ndof): w of each cell just inside each of its corners (as
+        :meth:`corner_curvatures`)."""
+        return self._per_size(xy, lambda sx, sy: self.shape(_INSIDE[:, 0], _INSIDE[:, 1], sx, sy))
 
     def cell_stiffness(self, xy, D: float, nu: float) -> np.ndarray:
         """(ncell, ndof, ndof): :meth:`stiffness` of each cell (corners ``xy`` (ncell, 4, 2))."""

@@ -181,6 +181,16 @@ class DKT:
             N[at_node, 3 * lam[at_node].argmax(axis=1) + list(self.node_dofs).index((dx, dy))] = 1.0
         return N
 
+    def corner_curvatures(self, xy) -> np.ndarray:
+        """(nt, 3, 3, 9): the curvatures (w,xx, w,yy, w,xy) of each triangle at each of its
+        vertices (DKT's linear curvature field, :meth:`curvature_matrix` with κ3 = 2 w,xy halved)."""
+        B = self.curvature_matrix(xy, np.eye(3)).copy()
+        B[..., 2, :] *= 0.5
+        return B
+
+    def corner_w(self, xy) -> None:
+        """None: a triangle's w at a vertex is the vertex's own w dof."""
+
     def cell_stiffness(self, xy, D: float, nu: float) -> np.ndarray:
         """(nt, 9, 9): :meth:`stiffness`."""
         return self.stiffness(xy, D, nu)

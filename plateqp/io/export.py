@@ -152,9 +152,7 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
         "scene": sc.name,
         "formulation": formulation,
         "plate": {"a": sc.plate.a, "b": sc.plate.b, "h": sc.plate.h, "E": sc.plate.E, "nu": sc.plate.nu},
-        "mesh": ({"element": sc.mesh.element, "size": float(model.grid.size), "nodes": int(model.grid.n_nodes),
-                  "triangles": int(len(model.grid.triangles))} if sc.triangles else
-                 {"nx": sc.mesh.nx, "ny": sc.mesh.ny, "element": sc.mesh.element}),
+        "mesh": model.grid.summary(sc.mesh.element),
         "n_dofs": int(data.n),
         "n_contacts": int(data.m),
         "n_elastic": int(np.count_nonzero(data.rho > 0)),

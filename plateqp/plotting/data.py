@@ -74,13 +74,8 @@ def _cell_edges(mesh) -> np.ndarray:
 
 
 def _bbox(result: Result) -> tuple[float, float, float, float]:
-    """(x0, x1, y0, y1) of the plate: the rectangle a × b of a grid, the outer boundary's box
-    of a shaped plate."""
-    mesh = result.model.grid
-    if mesh.grid_shape is not None:
-        return 0.0, float(mesh.a), 0.0, float(mesh.b)
-    x0, x1, y0, y1 = mesh.domain.outer.bbox
-    return x0, x1, y0, y1
+    """(x0, x1, y0, y1) of the plate, as its mesh gives it (``mesh.bbox``)."""
+    return result.model.grid.bbox
 
 
 def _point_loads(scene):

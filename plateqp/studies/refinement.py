@@ -260,8 +260,7 @@ class TargetResult:
                          f"{r['status']:>10s} {r['time']:7.2f}s")
         if self.reached:
             sc = self.result.scene
-            lines.append(f"reached on {sc.mesh.nx}x{sc.mesh.ny}" + (f" (element size {sc.mesh.size:g})"
-                                                                      if sc.triangles else ""))
+            lines.append(f"reached on {sc.mesh.nx}x{sc.mesh.ny}" + self.result.model.grid.size_note(sc))
         else:
             lines.append("NOT reached on the meshes tried: raise --max-mesh, or loosen the target")
         return "\n".join(lines)

@@ -12,19 +12,19 @@ import dataclasses
 
 import numpy as np
 
-from ..assembly import Model
+from ..assembly import Model, mesh_generator
 from ..scene import Scene
 
 
 def same_structure(a: Scene, b: Scene) -> bool:
     """True if the two scenes have the same K and contact operator B (only gaps, stiffnesses,
-    bed modulus and gap field, or loads differ; on a triangle mesh, whose nodes stand at the
-    point loads, a point load that moves changes the mesh)."""
+    bed modulus and gap field, or loads differ; where the generator puts a node at every point
+    load (``points_are_nodes``: the triangle meshes), a point load that moves changes the mesh)."""
     if (a.plate, a.mesh, a.edges, a.openings, a.pins) != (b.plate, b.mesh, b.edges, b.openings, b.pins):
         return False
     if [(s.x, s.y) for s in a.supports] != [(s.x, s.y) for s in b.supports]:
         return False
-    if a.triangles and _point_loads(a) != _point_loads(b):  # point loads are nodes of a triangle mesh
+    if mesh_generator(a).points_are_nodes and _point_loads(a) != _point_loads(b):  # a moved node: a new mesh
         return False
     if (a.foundation is None) != (b.foundation is None):
         return False
