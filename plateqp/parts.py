@@ -4,7 +4,7 @@ array, a NumPy array of polygon vertices), so that a scene holds plain numbers a
 it was built from and saves to TOML as it is.
 
 :meth:`plateqp.scene.Scene.validate` runs these checks first, on construction and again at
-:func:`plateqp.solve`; a part of the wrong type is a SceneError naming it (``supports.0``,
+:func:`plateqp.solve`; a part of the wrong type is a SceneError naming it (``supports.1``,
 ``edges``), never an AttributeError from deeper down.
 """
 
@@ -96,8 +96,8 @@ def check_parts(sc, types: dict) -> None:
         if not isinstance(items, (list, tuple)):
             wrong(key, items, "a list" + ("" if t is object else f" (each {_named(t)})"))
         for i, item in enumerate(items):
-            if not isinstance(item, t):
-                wrong(f"{key}.{i}", item, _named(t))
+            if not isinstance(item, t):  # supports numbered from 1, as in every table
+                wrong(f"{key}.{i + 1 if key == 'supports' else i}", item, _named(t))
     parts = [sc.plate, sc.mesh, *(e for e in sc.edges.values() if isinstance(e, types["edges"])), sc.foundation,
              *sc.openings, *sc.pins, *sc.loads, *sc.supports]
     for part in parts:

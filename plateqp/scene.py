@@ -17,9 +17,10 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any, Callable
 
+from .checks import check_scene
 from .elements import ELEMENTS
 from .errors import SceneError
-from .parts import _short, check_parts, check_path, check_source, check_table
+from .parts import _short, check_parts, check_path, check_table
 
 #: Magnitudes plateqp computes with safely: a non-zero physical number (length, modulus, load,
 #: gap, stiffness, prescribed displacement) must lie in this range, and so must the bending
@@ -30,15 +31,10 @@ from .parts import _short, check_parts, check_path, check_source, check_table
 SAFE_RANGE = (1e-100, 1e100)
 #: The derived quantities' range (wider: products of two or three safe numbers).
 SAFE_DERIVED = (1e-200, 1e200)
-#: No scene needs more cells than this; the memory a mesh needs is checked before assembly
-#: (:func:`plateqp.assembly.check_memory`), this only keeps validation itself small.
-MAX_CELLS = 10_000_000
 #: A scene file larger than this is not a scene (it is read no further).
 MAX_FILE_BYTES = 16 * 2**20
 
-EDGE_KINDS = ("free", "simple", "clamped")
 EDGE_NAMES = ("left", "right", "bottom", "top")  # x = 0, x = a, y = 0, y = b
-GAP_PROFILES = ("uniform", "linear", "trough", "bump")
 
 
 @dataclass
@@ -298,141 +294,10 @@ class Scene:
 
     def validate(self) -> None:
         """Check every field; raises SceneError naming the first bad one. :func:`plateqp.solve`
-        calls it again, so a scene changed after construction gets the same message."""
+        calls it again, so a scene changed after construction gets the same message. The
+        checks: :func:`plateqp.checks.check_scene`."""
         _check_parts(self)
-        p = self.plate
-        for k in ("a", "b", "h", "E"):
-            self._num(f"plate.{k}", getattr(p, k), positive=True, physical=True)
-        self._num("plate.nu", p.nu)
-        if not (-1.0 < p.nu < 0.5):
-            self._fail("plate.nu", f"must lie in (-1, 0.5) (got {p.nu})")
-        m = self.mesh
-        for k in ("nx", "ny"):
-            v = getattr(m, k)
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                self._fail(f"mesh.{k}", f"must be an integer >= 1 (got {_short(v)})")
-            if v > MAX_CELLS:
-                self._fail(f"mesh.{k}", f"{_short(v)} cells is more than any plate needs (at most {MAX_CELLS:.0e})")
-        if m.nx * m.ny > MAX_CELLS:
-            self._fail("mesh", f"{m.nx} x {m.ny} = {m.nx * m.ny:.2g} cells is more than any plate needs "
-                       f"(at most {MAX_CELLS:.0e}); the memory a mesh needs is checked before assembly")
-        if not isinstance(m.element, str) or m.element not in ELEMENTS:
-            self._fail("mesh.element", f"unknown element {_short(m.element)}; choose one of {tuple(ELEMENTS)}")
-        if not self.triangles and (self.plate.shape is not None or m.size is not None):
-            self._fail("plate.shape" if self.plate.shape is not None else "mesh.size",
-                       'needs a triangle mesh: set mesh.element = "dkt"')
-        for name, e in self.edges.items():  # the names: plateqp.constraints.edge_table, below
-            if e.kind not in EDGE_KINDS:
-                self._fail(f"edges.{name}", f"unknown kind {e.kind!r}; choose one of {EDGE_KINDS}")
-            self._num(f"edges.{name}.w", e.w, physical=True)
-            self._num(f"edges.{name}.slope", e.slope, physical=True)
-            if e.kind == "free" and (e.w != 0.0 or e.slope != 0.0):
-                self._fail(f"edges.{name}", "a free edge cannot carry a prescribed w or slope; make it simple or clamped")
-            if e.kind == "simple" and e.slope != 0.0:
-                self._fail(f"edges.{name}.slope", "a slope can only be prescribed on a clamped edge")
-        for i, o in enumerate(self.openings):
-            for k in ("x0", "x1", "y0", "y1"):
-                self._num(f"openings.{i}.{k}", getattr(o, k))
-            if not (o.x0 < o.x1 and o.y0 < o.y1):
-                self._fail(f"openings.{i}", "needs x0 < x1 and y0 < y1")
-        from .geometry import validate_shaped
-        from .mesh import Grid
-
-        grid = validate_shaped(self) if self.triangles else Grid.from_scene(self)
-        if not grid.cell_mask.any():
-            self._fail("openings" if self.openings else "holes", "the cut-outs remove every cell of the plate")
-        from .constraints import edge_table, warn_changed_all
-        from .geometry import scene_domain
-
-        domain = grid.domain if self.triangles else scene_domain(self)
-        edge_table(self, domain)  # every edge name known, and no segment named twice
-        warn_changed_all(self, domain)
-        for i, pin in enumerate(self.pins):
-            self._num(f"pins.{i}.x", pin.x)
-            self._num(f"pins.{i}.y", pin.y)
-            self._num(f"pins.{i}.w", pin.w, physical=True)
-            self._inside(f"pins.{i}", pin.x, pin.y, grid)
-            if grid.node_at(pin.x, pin.y) is None:
-                hx, hy = grid.hx, grid.hy
-                self._fail(f"pins.{i}", f"({pin.x}, {pin.y}) is not a mesh node (node spacing {hx:g} x {hy:g});"
-                           " move the pin or change mesh.nx / mesh.ny")
-        for i, ld in enumerate(self.loads):
-            where = f"loads.{i}"
-            if not isinstance(ld, (UniformLoad, PatchLoad, PointLoad)):
-                self._fail(where, f"not a load: {ld!r}")
-            if isinstance(ld, PointLoad):
-                self._num(f"{where}.P", ld.P, physical=True)
-                self._num(f"{where}.x", ld.x)
-                self._num(f"{where}.y", ld.y)
-                self._inside(where, ld.x, ld.y, grid)
-            else:
-                self._num(f"{where}.q", ld.q, physical=True)
-            if isinstance(ld, PatchLoad):
-                for k in ("x0", "x1", "y0", "y1"):
-                    self._num(f"{where}.{k}", getattr(ld, k))
-                if not (ld.x0 < ld.x1 and ld.y0 < ld.y1):
-                    self._fail(where, "needs x0 < x1 and y0 < y1")
-                if not self.triangles and (ld.x1 <= 0 or ld.x0 >= p.a or ld.y1 <= 0 or ld.y0 >= p.b):
-                    self._fail(where, "the patch does not overlap the plate")
-                if not grid.covers_area(ld.x0, ld.x1, ld.y0, ld.y1):
-                    self._fail(where, "the patch lies entirely in an opening (no plate there to load)")
-        seen: dict[tuple[float, float], int] = {}
-        tol = 1e-9 * max(p.a, p.b)
-        covered = self._covered(grid, [(getattr(s, "x", None), getattr(s, "y", None)) for s in self.supports])
-        for i, s in enumerate(self.supports):
-            where = f"supports.{i + 1}"  # numbered from 1, as in every table
-            self._num(f"{where}.x", s.x)
-            self._num(f"{where}.y", s.y)
-            self._num(f"{where}.gap", s.gap, physical=True)
-            self._inside(where, s.x, s.y, grid, None if covered is None else covered[i])
-            if isinstance(s.stiffness, str):
-                if s.stiffness != "rigid":
-                    self._fail(f"{where}.stiffness", f"must be \"rigid\" or a positive number (got {s.stiffness!r})")
-            else:
-                self._num(f"{where}.stiffness", s.stiffness, positive=True, physical=True)
-            key = (round(s.x / tol), round(s.y / tol))
-            if key in seen:
-                self._fail(where, f"lies on the same point as supports.{seen[key] + 1}; merge them into one support")
-            seen[key] = i
-        if self.foundation is not None:
-            f = self.foundation
-            self._num("foundation.k", f.k, positive=True, physical=True)
-            if isinstance(f.region, dict) and self.triangles:  # a polygon region: plateqp.geometry
-                from .geometry import check_polygon_region
-
-                check_polygon_region(self, grid)
-            elif f.region is not None:
-                if not isinstance(f.region, (list, tuple)) or len(f.region) != 4:
-                    self._fail("foundation.region", "must be [x0, x1, y0, y1]" + (" or { polygon = [[x, y], ...] }"
-                               if self.triangles else "") + f" (got {_short(f.region)})")
-                for j, v in enumerate(f.region):
-                    self._num(f"foundation.region.{j}", v)
-                x0, x1, y0, y1 = f.region
-                if not (x0 < x1 and y0 < y1):
-                    self._fail("foundation.region", "needs x0 < x1 and y0 < y1")
-                if not grid.cells_centred_in(x0, x1, y0, y1).any():
-                    self._fail("foundation.region", f"[{x0}, {x1}, {y0}, {y1}] holds the centre of no cell of "
-                               "the plate (it is off the plate, in an opening, or smaller than a cell): "
-                               "the bed would have no node")
-            g = f.gap
-            if isinstance(g, dict):
-                prof = g.get("profile")
-                if prof not in GAP_PROFILES:
-                    self._fail("foundation.gap.profile", f"unknown profile {prof!r}; choose one of {GAP_PROFILES}")
-                need = {"uniform": ("g0",), "linear": (), "trough": ("x", "y", "radius", "depth"),
-                        "bump": ("x", "y", "radius", "depth")}[prof]
-                allowed = {"profile", *need, *(("gx", "gy", "g0") if prof == "linear" else ())}
-                for k in need:
-                    if k not in g:
-                        self._fail(f"foundation.gap.{k}", f"missing (profile {prof!r} needs {need})")
-                for k, v in g.items():
-                    if k not in allowed:
-                        self._fail(f"foundation.gap.{k}", f"unknown key for profile {prof!r}; allowed {sorted(allowed)}")
-                    if k != "profile":
-                        self._num(f"foundation.gap.{k}", v, positive=(k == "radius"), physical=True)
-            elif not callable(g):
-                self._num("foundation.gap", g, physical=True)
-
+        check_scene(self)
         self._check_scales()
 
     def _check_scales(self) -> None:

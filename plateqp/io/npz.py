@@ -18,7 +18,6 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..backends.base import QP
-from ..errors import ExportError
 from .export import unpack
 
 
