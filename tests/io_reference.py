@@ -74,8 +74,12 @@ def highs_solve(path: Path):
 
 
 def run_cli(capsys, *argv):
-    """``plateqp ARGV...`` in-process: (exit code, stdout, stderr)."""
-    code = main([str(a) for a in argv])
+    """``plateqp ARGV...`` in-process: (exit code, stdout, stderr); argparse's SystemExit read as
+    its exit code."""
+    try:
+        code = main([str(a) for a in argv])
+    except SystemExit as exn:
+        code = exn.code
     out = capsys.readouterr()
     return code, out.out, out.err
 

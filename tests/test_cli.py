@@ -11,15 +11,11 @@ import pytest
 
 import plateqp as pq
 from plateqp import scenes
-from plateqp.cli import main
+from io_reference import run_cli
 
 SLAB_W = 0.0040624  # Timoshenko: SS square, uniform load, centre w × q a⁴/D
 
 
-def run_cli(capsys, *argv):
-    code = main(list(argv))
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def test_solve_json_two_sided(capsys):

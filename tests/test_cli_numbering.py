@@ -12,9 +12,9 @@ import pytest
 
 import plateqp as pq
 from plateqp import scenes
-from plateqp.cli import main
 from plateqp.errors import SceneError
 from plateqp.paths import get_param, set_param
+from io_reference import run_cli
 
 
 def three_supports():
@@ -25,13 +25,6 @@ def three_supports():
                               pq.Support(0.75, 0.5, gap=0.003)])
 
 
-def run_cli(capsys, *argv):
-    try:
-        code = main([str(a) for a in argv])
-    except SystemExit as exn:
-        code = exn.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def one_line(code, err, expect=2):

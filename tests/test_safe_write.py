@@ -15,7 +15,7 @@ import stat
 import numpy as np
 import pytest
 
-from plateqp.cli import main
+from io_reference import run_cli
 
 SMALL = """name = "small"
 [plate]
@@ -42,10 +42,6 @@ HAVE_MESHIO = importlib.util.find_spec("meshio") is not None
 HAVE_XARRAY = importlib.util.find_spec("xarray") is not None
 
 
-def run_cli(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def one_line(code, err, expect=2):

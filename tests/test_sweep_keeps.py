@@ -19,8 +19,8 @@ from pathlib import Path
 import pytest
 
 import plateqp as pq
-from plateqp.cli import main
 from plateqp.studies import SweepInterrupted, sweep
+from io_reference import run_cli
 
 sweep_mod = importlib.import_module("plateqp.studies.sweep")
 worker_mod = importlib.import_module("plateqp.studies.worker")
@@ -38,13 +38,6 @@ def scene_file(tmp_path) -> Path:
     return f
 
 
-def run_cli(capsys, *argv):
-    try:
-        code = main([str(a) for a in argv])
-    except SystemExit as exn:
-        code = exn.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def stored(path: Path) -> int:

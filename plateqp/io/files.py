@@ -14,6 +14,7 @@ import re
 from pathlib import Path, PurePath
 
 from ..errors import ExportError
+from .safe import _usable_parent
 
 #: Characters allowed in a file name made from a scene's name.
 _SAFE = re.compile(r"[^A-Za-z0-9._-]+")
@@ -23,18 +24,6 @@ def safe_filename(name: str) -> str:
     """A scene name as a plain file name: no directories, no leading dot, at most 100 characters."""
     out = _SAFE.sub("_", str(name)).lstrip(".")[:100]
     return out or "scene"
-
-
-def _usable_folder(folder: Path, label: str) -> None:
-    """The nearest of ``folder`` and its parents that exists must be a writable directory (the
-    missing ones are made when writing)."""
-    p = folder
-    while not os.path.lexists(p) and p != p.parent:
-        p = p.parent
-    if not p.is_dir():
-        raise ExportError(f"{label}: {p} is not a directory")
-    if not os.access(p, os.W_OK | os.X_OK):
-        raise ExportError(f"{label}: {p} is not writable")
 
 
 def check_file(path, *, force: bool = False, label: str | None = None, flag: str = "force=True") -> Path:
@@ -49,7 +38,7 @@ def check_file(path, *, force: bool = False, label: str | None = None, flag: str
         raise ExportError(f"{label}: is a directory, not a file")
     if os.path.lexists(path) and not force:
         raise ExportError(f"{label}: exists; use {flag} to overwrite it")
-    _usable_folder(path.parent, label)
+    _usable_parent(path.parent, label)
     return path
 
 
@@ -76,7 +65,7 @@ def check_folder(directory, files=(), folders=(), *, force: bool = False, label:
     if os.path.lexists(directory) and not directory.is_dir():
         raise ExportError(f"{label}: exists and is not a directory")
     if not directory.is_dir():
-        _usable_folder(directory, label)
+        _usable_parent(directory, label)
         return directory
     if any(directory.iterdir()) and not force:
         raise ExportError(f"{label}: exists and is not an empty directory; use {flag} to write into it")

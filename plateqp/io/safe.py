@@ -82,7 +82,7 @@ def _usable_parent(path: Path, label: str) -> None:
     while not os.path.lexists(p) and p != p.parent:
         p = p.parent
     if not p.is_dir():
-        raise ExportError(f"{label}: cannot write ({p} is not a folder)")
+        raise ExportError(f"{label}: cannot write ({p} is not a directory)")
     if not os.access(p, os.W_OK | os.X_OK):
         raise ExportError(f"{label}: cannot write ({p} is not writable)")
 
