@@ -24,6 +24,7 @@ import struct
 import subprocess
 import sys
 import termios
+import threading
 import time
 from pathlib import Path
 
@@ -89,6 +90,11 @@ def run_and_interrupt(tmp_path: Path, workers: int, sig: int, extra=()):
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=slave, stdin=subprocess.DEVNULL, env=env,
                          start_new_session=True)
     os.close(slave)
+    # standard output drained as it comes: the rows done, printed after the interrupt, can be more
+    # than a pipe holds, and the one line on standard error comes after them
+    chunks: list[bytes] = []
+    drain = threading.Thread(target=lambda: chunks.extend(iter(lambda: p.stdout.read(65536), b"")), daemon=True)
+    drain.start()
     err = b""
     first = SERIAL_FIRST if workers == 1 else 1
     seen_workers: set[int] = set()
@@ -116,7 +122,9 @@ def run_and_interrupt(tmp_path: Path, workers: int, sig: int, extra=()):
             except OSError:
                 break
         left_at_message = {q for q in seen_workers if alive(q)}
-        out, _ = p.communicate(timeout=120)
+        p.wait(timeout=120)
+        drain.join(timeout=120)
+        out = b"".join(chunks)
         while True:
             try:
                 ready, _, _ = select.select([master], [], [], 0.5)
