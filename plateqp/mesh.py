@@ -277,8 +277,9 @@ class Grid:
         x = np.atleast_1d(np.asarray(x, dtype=float))
         y = np.atleast_1d(np.asarray(y, dtype=float))
         # clipped: a point far off the plate stays off it, and its cell index cannot overflow
-        fx = np.clip(np.nan_to_num(x / self.hx, nan=-2.0), -2.0, self.nx + 2.0)
-        fy = np.clip(np.nan_to_num(y / self.hy, nan=-2.0), -2.0, self.ny + 2.0)
+        with np.errstate(over="ignore", invalid="ignore"):  # x near the largest double: x / hx is inf
+            fx = np.clip(np.nan_to_num(x / self.hx, nan=-2.0), -2.0, self.nx + 2.0)
+            fy = np.clip(np.nan_to_num(y / self.hy, nan=-2.0), -2.0, self.ny + 2.0)
         cell = np.full(x.shape, -1, dtype=int)
         xi = np.zeros(x.shape)
         eta = np.zeros(x.shape)

@@ -262,21 +262,24 @@ class TriMesh:
         if self._tree is None:
             self._tree = cKDTree(p.mean(axis=1))
         k = min(16, len(self.triangles))
-        _, cand = self._tree.query(np.column_stack([x, y]), k=k)
+        finite = np.isfinite(x) & np.isfinite(y)  # a non-finite point is off the mesh (the tree refuses it)
+        _, cand = self._tree.query(np.column_stack([np.where(finite, x, 0.0), np.where(finite, y, 0.0)]), k=k)
         cand = cand.reshape(len(x), k)
         tri = np.full(len(x), -1)
         lam = np.zeros((len(x), 3))
         best = np.full(len(x), -np.inf)
-        for c in range(k):
-            t = cand[:, c]
-            l_ = _barycentric(p[t], x, y)
-            worst = l_.min(axis=1)
-            better = worst > best
-            tri = np.where(better, t, tri)
-            lam = np.where(better[:, None], l_, lam)
-            best = np.maximum(best, worst)
-        tri = np.where(best >= -1e-9, tri, -1)
-        return tri, np.clip(lam, 0.0, 1.0) / np.clip(lam, 0.0, 1.0).sum(axis=1, keepdims=True)
+        with np.errstate(over="ignore", invalid="ignore"):  # a point near the largest double: off the mesh
+            for c in range(k):
+                t = np.minimum(cand[:, c], len(self.triangles) - 1)  # the tree's "none" (a far point's inf)
+                l_ = _barycentric(p[t], x, y)
+                worst = l_.min(axis=1)
+                better = worst > best
+                tri = np.where(better, t, tri)
+                lam = np.where(better[:, None], l_, lam)
+                best = np.maximum(best, worst)
+        tri = np.where((best >= -1e-9) & finite, tri, -1)
+        lam = np.where(tri[:, None] >= 0, np.clip(np.nan_to_num(lam), 0.0, 1.0), 1.0 / 3.0)
+        return tri, lam / lam.sum(axis=1, keepdims=True)
 
 
 def _barycentric(p, x, y):

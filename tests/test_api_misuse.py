@@ -357,3 +357,19 @@ def test_numpy_polygons_holes_and_regions_are_taken(tmp_path):
 
 def test_no_points_give_no_values(res):
     assert res.deflection(0.0, ()).shape == (0,) and res.moments([], [])[0].shape == (0,)
+
+
+@pytest.mark.parametrize("element", ["acm", "dkt"])
+@pytest.mark.parametrize("point", [(8.98846567431158e307, 0.0), (1.7e308, 1.7e308), (math.inf, 0.0),
+                                   (math.nan, 0.5), (-1e308, 0.3)],
+                         ids=["huge-x", "huge-both", "inf", "nan", "huge-negative"])
+def test_a_point_at_the_edge_of_double_precision_is_off_the_plate(element, point):
+    """Coordinates near the largest double (x / h overflows), infinite or NaN: a SceneError that
+    the point is not on the plate, on either mesh, and no RuntimeWarning (the suite makes
+    plateqp's RuntimeWarnings errors)."""
+    pytest.importorskip("gmsh")
+    mesh = pq.MeshSpec(4, 2, element) if element != "dkt" else pq.MeshSpec(element="dkt", size=0.5)
+    res = pq.solve(pq.Scene(plate=pq.Plate(a=2.0, b=1.0), mesh=mesh, loads=[pq.UniformLoad(1.0)],
+                            supports=[pq.Support(0.5, 0.5), pq.Support(1.5, 0.5), pq.Support(1.0, 0.2)]))
+    with pytest.raises(SceneError, match="is not on the plate"):
+        res.deflection(*point)
