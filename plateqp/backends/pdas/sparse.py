@@ -6,6 +6,7 @@ docstring: "Two ways to solve a step", "Singular steps and no equilibrium")."""
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -401,6 +402,94 @@ def dual_newton(pb: ReducedQP, fac: SpringFactor, kfac: SpringFactor, W: np.ndar
     return u, lam, F, DUAL_STEPS
 
 
+@dataclass
+class _Start:
+    """Where the exact steps start: the first phase's deflection, reactions and set (None: every
+    row), whether its set is solved exactly at once, its steps, and whether it found the plate
+    floating."""
+
+    u: np.ndarray
+    lam: np.ndarray
+    A: np.ndarray | None
+    exact: bool = False
+    newton: int = 0
+    floating: bool = False
+
+
+def _first_phase(pb: ReducedQP, fac, W, sigma, A, feas_tol, steps, kfac, info: dict, lh: bool, dual: bool,
+                 anchor: bool) -> _Start:
+    """The first phase of :func:`run_sparse` (see there), and its account in ``info``."""
+    u, lam = np.zeros(pb.K.shape[0]), np.zeros(pb.m)
+    if np.all(pb.rho * pb.k >= 1.0):  # soft rows only: phase 1, from the warm start's set if any
+        u, A, newton = newton_pcg(pb, fac, W, sigma, steps, A)
+        info.update(first_phase="newton", first_phase_steps=newton)
+        return _Start(u, np.where(A, W * (pb.B @ u - pb.g), 0.0), A, True, newton)
+    if A is not None or kfac is None:
+        return _Start(u, lam, A, exact=A is not None)  # a warm start is meant to be (nearly) right: exact at once
+    # stiff rows, cold start: a first phase on the dual
+    uf = held_plate(pb, kfac, sigma)  # None: a floating plate
+    floating = uf is None
+    anchored = False
+    if uf is None and lh and anchor:  # Lawson–Hanson on the anchored plate's flexibility
+        uf = anchored_plate(pb, kfac, sigma)
+        anchored = uf is not None
+    first = lam0 = None
+    spent = 0  # the sets Lawson–Hanson solved before it gave up (iterations count them)
+    if uf is not None and lh:
+        first = lawson_hanson(pb, kfac, uf, feas_tol, steps, info, anchored)
+        phase = "anchored lawson-hanson" if anchored else "lawson-hanson"
+        if first[0] is None:  # gave up: its reactions start the projected Newton phase
+            first, lam0, spent = None, first[1], first[3]
+    if first is None and uf is not None and dual and not anchored:  # (its ψ is the held plate's)
+        first = dual_newton(pb, fac, kfac, W, sigma, feas_tol, steps, uf, lam0)
+        phase = "dual"
+    if first is not None:
+        u, lam, A, k = first
+        info.update(first_phase=phase, first_phase_steps=k)
+        return _Start(u, lam, A, True, spent + k, floating)
+    if anchored and lam0 is not None and np.any(lam0 > 0):
+        # Lawson–Hanson gave up on the anchored plate: the exact steps start from the rows it
+        # holds and the rows still pressed at its reactions (not from every row)
+        ua = kfac.solve(pb.f - pb.B.T @ lam0)
+        A = (lam0 > 0) | (pb.g + pb.rho * lam0 - pb.B @ ua <= 0)
+        info.update(first_phase="anchored lawson-hanson (gave up)")
+    return _Start(u, lam, A, False, spent, floating)
+
+
+def _judge_motion(pb: ReducedQP, fac, A, null: list, d, left_exact: set):
+    """A free rigid motion ``d`` of the active set ``A``, judged by the load's work along it:
+    ("error", d) where it is no rigid motion of the plate; ("unbounded", the ray) where the load
+    does work along it and no row stops it; (rows, d) where the load pushes along −d into rows
+    not in ``A`` that make a set not already left on its exact step (they enter); (None, d):
+    no work to rounding (or a push at rounding), so ``d`` is kept out as a free motion."""
+    d = free_motion(pb, fac, null, d)  # sharpened: its work and K d judged on rounding
+    exact_d = exact_motion(pb, A, null, d)  # the exact rigid motion, where the QP names them
+    d = d if exact_d is None else exact_d
+    Bd = pb.B @ d
+    scale = np.abs(Bd).max(initial=0.0)
+    Kd_rel = np.abs(pb.K @ d).max() / (pb.Kd.max() * np.abs(d).max())
+    if Kd_rel > 1e-6 or len(null) >= FREE_MOTIONS:
+        return "error", d
+    work = float(pb.f @ d)
+    # rounding: the sum's own (FREE_WORK Σ|f_j d_j|), and d's, which for a load on the axis of d
+    # is all of Σ|f_j d_j| (FREE_FLOOR of the whole load moved by d's largest motion)
+    no_work = (FREE_WORK * float(np.abs(pb.f) @ np.abs(d))
+               + FREE_FLOOR * float(np.abs(pb.f).sum()) * float(np.abs(d).max()))
+    if work > no_work and np.all(Bd <= 1e-9 * scale):
+        return "unbounded", d
+    if work < -no_work:  # the load pushes along −d
+        hit = ~A & (Bd < -1e-9 * scale)
+        if not hit.any():
+            return "unbounded", -d
+        if (A | hit).tobytes() not in left_exact:
+            return hit, d
+        # those rows, in, made a set already solved and left on its exact step: the push is at
+        # rounding (a load 1e-10 inside the hull of four posts at 128² cycled {4} → {3} → {2} →
+        # {4}); d is kept out as a free motion, and the answer's stationarity residual shows the
+        # work left along it
+    return None, d
+
+
 def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter, p, steps,
                kfac: SpringFactor | None = None, info: dict | None = None, lh: bool = True,
                dual: bool = True, floating: bool = False, anchor: bool = True) -> Outcome:
@@ -419,46 +508,9 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
     info.update(first_phase="none", first_phase_steps=0)
     ex = Exchange(p)
     left_exact: set = set()  # sets left on their exact step's verdict
-    u = np.zeros(pb.K.shape[0])
-    lam = np.zeros(pb.m)
-    exact = False
-    newton = 0
-    if np.all(pb.rho * pb.k >= 1.0):  # soft rows only: phase 1, from the warm start's set if any
-        u, A, newton = newton_pcg(pb, fac, W, sigma, steps, A)
-        lam = np.where(A, W * (pb.B @ u - pb.g), 0.0)
-        exact = True
-        info.update(first_phase="newton", first_phase_steps=newton)
-    elif A is None and kfac is not None:  # stiff rows, cold start: a first phase on the dual
-        uf = held_plate(pb, kfac, sigma)  # None: a floating plate
-        floating = floating or uf is None
-        anchored = False
-        if uf is None and lh and anchor:  # Lawson–Hanson on the anchored plate's flexibility
-            uf = anchored_plate(pb, kfac, sigma)
-            anchored = uf is not None
-        first = lam0 = None
-        spent = 0  # the sets Lawson–Hanson solved before it gave up (iterations count them)
-        if uf is not None and lh:
-            first = lawson_hanson(pb, kfac, uf, feas_tol, steps, info, anchored)
-            phase = "anchored lawson-hanson" if anchored else "lawson-hanson"
-            if first[0] is None:  # gave up: its reactions start the projected Newton phase
-                first, lam0, spent = None, first[1], first[3]
-        if first is None and uf is not None and dual and not anchored:  # (its ψ is the held plate's)
-            first = dual_newton(pb, fac, kfac, W, sigma, feas_tol, steps, uf, lam0)
-            phase = "dual"
-        newton = spent
-        if first is None and anchored and lam0 is not None and np.any(lam0 > 0):
-            # Lawson–Hanson gave up on the anchored plate: the exact steps start from the rows it
-            # holds and the rows still pressed at its reactions (not from every row)
-            ua = kfac.solve(pb.f - pb.B.T @ lam0)
-            A = (lam0 > 0) | (pb.g + pb.rho * lam0 - pb.B @ ua <= 0)
-            info.update(first_phase="anchored lawson-hanson (gave up)")
-        if first is not None:
-            u, lam, A, k = first
-            newton += k
-            exact = True
-            info.update(first_phase=phase, first_phase_steps=k)
-    elif A is not None:
-        exact = True  # a warm start is meant to be (nearly) right: solve it exactly at once
+    start = _first_phase(pb, fac, W, sigma, A, feas_tol, steps, kfac, info, lh, dual, anchor)
+    u, lam, A, exact, newton = start.u, start.lam, start.A, start.exact, start.newton
+    floating = floating or start.floating
     A = np.ones(pb.m, dtype=bool) if A is None else A.copy()
     null: list = []  # free rigid motions of A along which the load does no work
     held = True  # the final set's hold on a floating plate checked (or not needed)
@@ -497,39 +549,17 @@ def run_sparse(pb: ReducedQP, fac: SpringFactor, W, sigma, A, feas_tol, max_iter
                 exact = False
                 entered = True
                 break
-            d = free_motion(pb, fac, null, d)  # sharpened: its work and K d judged on rounding
-            exact_d = exact_motion(pb, A, null, d)  # the exact rigid motion, where the QP names them
-            d = d if exact_d is None else exact_d
-            Bd = pb.B @ d
-            scale = np.abs(Bd).max(initial=0.0)
-            Kd_rel = np.abs(pb.K @ d).max() / (pb.Kd.max() * np.abs(d).max())
-            if Kd_rel > 1e-6 or len(null) >= FREE_MOTIONS:
-                return Outcome(Status.ERROR, "the active rows leave a null direction of K that is not a "
-                               "rigid motion of the plate: cannot go on", A, it=newton + it)
-            work = float(pb.f @ d)
-            # rounding: the sum's own (FREE_WORK Σ|f_j d_j|), and d's, which for a load on the axis
-            # of d is all of Σ|f_j d_j| (FREE_FLOOR of the whole load moved by d's largest motion)
-            no_work = (FREE_WORK * float(np.abs(pb.f) @ np.abs(d))
-                       + FREE_FLOOR * float(np.abs(pb.f).sum()) * float(np.abs(d).max()))
-            if work > no_work and np.all(Bd <= 1e-9 * scale):
+            verdict, d = _judge_motion(pb, fac, A, null, d, left_exact)
+            if isinstance(verdict, str):  # "error" or "unbounded": the plate cannot be held
+                if verdict == "error":
+                    return Outcome(Status.ERROR, "the active rows leave a null direction of K that is not a "
+                                   "rigid motion of the plate: cannot go on", A, it=newton + it)
                 ray = np.zeros(pb.n)
                 ray[pb.keep] = d  # (d, 0): P (d, 0) = 0, G (d, 0) = B d ≤ 0, qᵀ(d, 0) = −fᵀd < 0
                 return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
-            if work < -no_work:  # the load pushes along −d
-                hit = ~A & (Bd < -1e-9 * scale)
-                if not hit.any():
-                    ray = np.zeros(pb.n)
-                    ray[pb.keep] = -d
-                    return Outcome(Status.UNBOUNDED, RAY_MESSAGE, A, it=newton + it, ray=ray)
-                if (A | hit).tobytes() not in left_exact:
-                    A = A | hit
-                    exact = False
-                    entered = True
-                    break
-                # those rows, in, made a set already solved and left on its exact step: the
-                # push is at rounding (a load 1e-10 inside the hull of four posts at 128²
-                # cycled {4} → {3} → {2} → {4}); d is kept out as a free motion, and the
-                # answer's stationarity residual shows the work left along it
+            if verdict is not None:  # the rows it presses enter
+                A, exact, entered = A | verdict, False, True
+                break
             # the load does no work along d (to rounding): every u + t d is as good; keep d out of the steps
             null.append(d)
         if entered:
