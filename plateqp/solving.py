@@ -55,7 +55,7 @@ def check_arguments(scene, backend="auto", formulation="auto", accuracy="default
         kind = next((v for k, v in hint.items() if isinstance(scene, k)), "")
         kind = kind or ("; load a file with Scene.from_toml(path)" if isinstance(scene, os.PathLike) else "")
         raise SceneError(f"scene: must be a plateqp Scene (got {_short(scene)}){kind}")
-    scene.validate()
+    scene.revalidate()
     if not isinstance(backend, str) or not backend:
         raise SolverError(f"backend: must be a backend name such as \"auto\" or \"lemke\" (got {_short(backend)})")
     if not isinstance(formulation, str):

@@ -373,3 +373,23 @@ def test_a_point_at_the_edge_of_double_precision_is_off_the_plate(element, point
                             supports=[pq.Support(0.5, 0.5), pq.Support(1.5, 0.5), pq.Support(1.0, 0.2)]))
     with pytest.raises(SceneError, match="is not on the plate"):
         res.deflection(*point)
+
+
+def test_a_scene_unchanged_since_its_validation_is_not_checked_again(monkeypatch):
+    """solve() checks a scene again only where something changed since its last validation:
+    counted on the checks themselves; a change to any part, nested dicts included, is seen."""
+    import plateqp.scene as scene_module
+
+    sc = make_scene()
+    calls = []
+    real = scene_module.check_scene
+    monkeypatch.setattr(scene_module, "check_scene", lambda s: (calls.append(1), real(s)))
+    pq.solve(sc)
+    pq.solve(sc)
+    assert calls == []
+    for change in (lambda s: setattr(s.supports[0], "gap", 1e-4), lambda s: setattr(s.plate, "h", 0.03),
+                   lambda s: s.edges.update(left=pq.Edge("free")), lambda s: s.loads.append(pq.UniformLoad(1.0))):
+        before = len(calls)
+        change(sc)
+        pq.solve(sc)
+        assert len(calls) == before + 1
