@@ -18,6 +18,7 @@ import concurrent.futures as cf
 import os
 import pickle
 import signal
+import threading
 import logging
 
 from ..errors import ClusterError, ProblemError
@@ -136,7 +137,7 @@ class Futures:
                 pass
         if not self.own:
             return
-        self.drain_left = self.drain()  # what the workers sent before they are stopped
+        first = self._drain_within(grace)  # what the workers sent before they are stopped
         procs = list((getattr(self.ex, "_processes", None) or {}).values())
         manager = getattr(self.ex, "_executor_manager_thread", None)  # shutdown() forgets it
         self.ex.shutdown(wait=False, cancel_futures=True)
@@ -150,8 +151,21 @@ class Futures:
                 p.join(grace)
         if manager is not None:
             manager.join(grace)
-        self.drain_left += self.drain()
-        self.rows.close()
+        # the rows sent since (not where the first read is still stuck: it holds the queue)
+        late = self._drain_within(grace) if first is not None else None
+        self.drain_left = (first or []) + (late or [])
+        if late is not None:
+            self.rows.close()
+
+    def _drain_within(self, grace: float):
+        """:meth:`drain` in a thread given ``grace`` seconds, or None where it did not end: a
+        worker stopped while writing a row leaves half a message in the pipe, and reading it
+        would wait for ever (that row was never stored: it is not done)."""
+        got: list = []
+        reader = threading.Thread(target=lambda: got.extend(self.drain()), daemon=True)
+        reader.start()
+        reader.join(grace)
+        return None if reader.is_alive() else got
 
 
 #: In a worker process of ours: the queue its rows go to as they are solved (see :class:`Futures`).
