@@ -455,12 +455,15 @@ class Scene:
         return d
 
     def to_toml(self, path: str | Path | None = None) -> str:
-        """The scene as TOML text; written to ``path`` if given."""
+        """The scene as TOML text; written to ``path`` if given (replacing a file there, and a
+        symbolic link itself rather than its target: :func:`plateqp.io.safe.write`)."""
         import tomli_w
 
         text = tomli_w.dumps(self.to_dict())
         if path is not None:
-            Path(path).write_text(text)
+            from .io.safe import write
+
+            write(path, text, force=True, label=str(path))
         return text
 
 

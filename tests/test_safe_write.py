@@ -228,3 +228,32 @@ def test_write_vtu_makes_its_folder_and_replaces_links_only_when_forced(tmp_path
     os.symlink(out, tmp_path / "linked")
     with pytest.raises(ExportError, match="link"):
         res.write_vtu(tmp_path / "linked", force=True)
+
+
+def test_python_writers_replace_a_link_and_leave_its_target(tmp_path):
+    """Scene.to_toml(path) and plotting.style.save write through no link: a link at the path
+    (dangling, or to a file outside) is replaced by the file, its target left as it was."""
+    import matplotlib
+
+    import plateqp as pq
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    from plateqp.plotting.style import save
+
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    kept = outside / "kept.txt"
+    kept.write_text("mine")
+    work = tmp_path / "work"
+    work.mkdir()
+    for name, write in (("scene.toml", lambda p: pq.Scene(mesh=pq.MeshSpec(4, 4)).to_toml(p)),
+                        ("figure.png", lambda p: save(Figure(), p))):
+        dangling, to_file = work / f"dangling-{name}", work / f"to-file-{name}"
+        dangling.symlink_to(outside / f"new-{name}")
+        to_file.symlink_to(kept)
+        for link in (dangling, to_file):
+            write(link)
+            assert not link.is_symlink() and link.stat().st_size > 0
+        assert not (outside / f"new-{name}").exists() and kept.read_text() == "mine"

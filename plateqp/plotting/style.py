@@ -93,8 +93,10 @@ def save(fig: Figure, path: str | Path, dpi: int = 110) -> Path:
     The figures use constrained layout with everything inside their axes or legends, so only
     the 3D one and the mesh need a "tight" bounding box (a second full draw).
     """
-    path = Path(path)
-    fig.savefig(path, dpi=dpi, format="png", **_bbox(fig))
+    from ..io.safe import write
+
+    path = Path(path)  # replacing a file there, and a symbolic link itself rather than its target
+    write(path, lambda tmp: fig.savefig(tmp, dpi=dpi, format="png", **_bbox(fig)), force=True, label=str(path))
     return path
 
 
