@@ -70,7 +70,7 @@ def check_cutouts(sc):
     the point checks ask (``covers``, ``locate``, ``node_at``, ``covers_area``, ``cells_centred_in``):
     the grid, or on triangles the plate's region."""
     from .constraints import edge_table, warn_changed_all
-    from .geometry import scene_domain, validate_shaped
+    from .geometry import validate_shaped
     from .mesh import Grid
 
     for i, o in enumerate(sc.openings):
@@ -81,9 +81,8 @@ def check_cutouts(sc):
     grid = validate_shaped(sc) if sc.triangles else Grid.from_scene(sc)
     if not grid.cell_mask.any():
         sc._fail("openings" if sc.openings else "holes", "the cut-outs remove every cell of the plate")
-    domain = grid.domain if sc.triangles else scene_domain(sc)
-    edge_table(sc, domain)  # every edge name known, and no segment named twice
-    warn_changed_all(sc, domain)
+    edge_table(sc, grid.domain)  # every edge name known, and no segment named twice
+    warn_changed_all(sc, grid.domain)
     return grid
 
 

@@ -104,11 +104,9 @@ def warn_changed_all(scene, domain) -> None:
 
 def prescribed(scene, mesh, element) -> tuple[np.ndarray, np.ndarray]:
     """(fixed, values): the full dof indices the two-sided supports prescribe and their values
-    (sorted by dof), on any mesh that gives ``boundary_edges()`` and ``node_at``. A dof two
-    supports prescribe differently (beyond 1e-12 relative) is a SceneError naming both."""
-    from .geometry import scene_domain
-
-    table = edge_table(scene, getattr(mesh, "domain", None) or scene_domain(scene))
+    (sorted by dof), on any mesh that gives ``boundary_edges()``, ``node_at`` and its ``domain``.
+    A dof two supports prescribe differently (beyond 1e-12 relative) is a SceneError naming both."""
+    table = edge_table(scene, mesh.domain)
     edges, normals, boundary, segment = mesh.boundary_edges()
     held = [(key, name, e) for key, (name, e) in table.items() if e.kind != "free"]
     who = [f"edges.{name}" for _, name, _ in held] + [f"pins.{i}" for i in range(len(scene.pins))]

@@ -31,12 +31,18 @@ class Grid:
     cell_mask: np.ndarray  # (nx*ny,) bool: cell kept
     #: (nx*ny,) the cut-out that removed each cell (K, the first that holds its centre), −1 if kept
     cutout: np.ndarray | None = field(default=None, repr=False)
-    #: the cut-outs' shapes (:class:`~plateqp.geometry.Polygon` / ``Circle``), K = 0, 1, …
-    cutouts: tuple = ()
+    #: the plate's :class:`~plateqp.geometry.Domain`: the rectangle less its cut-outs (their
+    #: shapes, K = 0, 1, …: ``domain.holes``), parsed once
+    domain: object = field(default=None, repr=False)
+
+    @property
+    def cutouts(self) -> tuple:
+        """The cut-outs' shapes (:class:`~plateqp.geometry.Polygon` / ``Circle``), K = 0, 1, …"""
+        return () if self.domain is None else self.domain.holes
 
     @classmethod
     def from_scene(cls, scene) -> Grid:
-        from .geometry import cutout_shapes
+        from .geometry import scene_domain
 
         p, m = scene.plate, scene.mesh
         nx, ny = m.nx, m.ny
@@ -44,7 +50,8 @@ class Grid:
         cx = (np.arange(nx) + 0.5) * hx
         cy = (np.arange(ny) + 0.5) * hy
         X, Y = (v.ravel() for v in np.meshgrid(cx, cy))  # row j, column i -> index j*nx + i
-        shapes = cutout_shapes(scene)
+        domain = scene_domain(scene)
+        shapes = domain.holes
         cut = np.full(X.shape, -1)
         for k, shape in enumerate(shapes):
             x0, x1, y0, y1 = shape.bbox
@@ -52,7 +59,7 @@ class Grid:
             if near.size:
                 inside = shape.contains(X[near], Y[near], 1e-12 * max(p.a, p.b))
                 cut[near[inside]] = k
-        return cls(p.a, p.b, nx, ny, cut < 0, cut, tuple(shapes))
+        return cls(p.a, p.b, nx, ny, cut < 0, cut, domain)
 
     # -- the generator's side of building a model (plateqp.assembly.build_model) ----------------
     #: the stiffness :meth:`assemble` gives is exactly symmetric, value for value
