@@ -32,6 +32,15 @@ PRESET_TOL: dict[str, float] = {"low": 1e-3, "default": 1e-6, "high": 1e-9}
 #: below what double precision can certify on a plate problem.
 TOL_RANGE = (1e-14, 1e-1)
 
+#: A load (or reactions) below this fraction of the heaves' force (the force that closes the
+#: largest negative gap: plateqp.contact.kkt.heave_force, and pdas's own on its reduced problem)
+#: does no work that double precision can show beside the heaves: a plate lifted as a body onto
+#: heaved posts carries reactions of 1e-16 … 1e-15 of it. Only then are forces measured against
+#: the heaves' force; any larger load keeps its own scale (measured against the heaves, a load
+#: 1e-5 of them, the whole of a floating plate's reactions, would pass with any error below
+#: tol × 1e5 of itself). Shared by the KKT check and the pdas backend.
+NO_WORK = 1e-10
+
 
 class Status(enum.Enum):
     """Outcome of a solve. ``INACCURATE`` marks an answer that missed the asked accuracy."""

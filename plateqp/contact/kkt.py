@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..accuracy import PRESET_TOL, Accuracy
+from ..accuracy import NO_WORK, PRESET_TOL, Accuracy
 from ..errors import MechanismError
 from ..linalg import row_stiffness, solve_saddle
 from ..linalg.pattern import abs_matvec
@@ -148,14 +148,6 @@ def defect_residual(data: Scaled, c: ContactSolution, e: np.ndarray, M: np.ndarr
         except np.linalg.LinAlgError:  # a singular contact set: the gaps' measure alone
             pass
     return float(size)
-
-
-#: A load (or reactions) below this fraction of :func:`heave_force` does no work that double
-#: precision can show beside the heaves: a plate lifted as a body onto heaved posts carries
-#: reactions of 1e-16 … 1e-15 of it. Only then are forces measured against the heaves' force;
-#: any larger load keeps its own scale (measured against the heaves, a load 1e-5 of them, the
-#: whole of a floating plate's reactions, would pass with any error below tol × 1e5 of itself).
-NO_WORK = 1e-10
 
 
 def heave_force(data: Scaled, kb: np.ndarray | None = None) -> float:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..accuracy import Accuracy, Status
+from ..accuracy import NO_WORK, Accuracy, Status
 from ..assembly import Model
 from ..backends import get_backend
 from ..backends.base import RawSolution
@@ -21,7 +21,7 @@ from ..errors import MechanismError, NoEquilibriumError, PlateQPWarning, Problem
 from ..linalg import solve_saddle
 from ..results import Result
 from .formulations import ContactSolution, Formulation, formulate
-from .kkt import NO_WORK, defect_residual, heave_bound, heave_force, kkt_report, reaction_scale
+from .kkt import defect_residual, heave_bound, heave_force, kkt_report, reaction_scale
 from .predict import check_predict, predicted_set, wanted
 from .routing import choose, fallback_routes, formulations_for
 from .scaling import Scaled
@@ -312,7 +312,7 @@ def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, ba
     local = np.maximum.reduce([np.full(R.shape, data.w_load * data.W), np.abs(model.contacts.g0), np.abs(w),
                                np.abs(s)]) if R.size else np.zeros(0)
     # (reactions all below tol of the load are zero to the asked accuracy: kkt.reaction_scale)
-    # the heaves' force counts only where the load does no work beside it (kkt.NO_WORK): its
+    # the heaves' force counts only where the load does no work beside it (accuracy.NO_WORK): its
     # Rayleigh quotients are not computed where a cheap bound says the load does
     heave = heave_force(data) if np.abs(data.f).sum() <= NO_WORK * heave_bound(data) else 0.0
     active = (c.R > tol * reaction_scale(c.R, data.f, tol, heave)) | (np.abs(gaps) <= tol * np.maximum(local, 1e-300))

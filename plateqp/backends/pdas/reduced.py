@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ...accuracy import NO_WORK
 from ...errors import SolverError
 from ...linalg import row_stiffness
 from ...linalg.pattern import abs_matvec, leading
@@ -180,11 +181,6 @@ def heave_force(pb: ReducedQP) -> float:
     """The force that closes the largest negative gap at its row's own stiffness (the row's
     spring left out): max k_i · max(−g_i, 0)."""
     return float((pb.k * np.maximum(-pb.g, 0.0)).max(initial=0.0))
-
-
-#: Load and reactions below this fraction of :func:`heave_force` do no work beside the negative
-#: gaps (plateqp.contact.kkt.NO_WORK): forces are then measured against that force.
-NO_WORK = 1e-10
 
 
 def force_scale(pb: ReducedQP, lam: np.ndarray, tol: float = 0.0) -> float:
