@@ -14,7 +14,7 @@ import re
 from pathlib import Path, PurePath
 
 from ..errors import ExportError
-from .safe import _usable_parent
+from .safe import _usable_parent, check_target
 
 #: Characters allowed in a file name made from a scene's name.
 _SAFE = re.compile(r"[^A-Za-z0-9._-]+")
@@ -28,18 +28,12 @@ def safe_filename(name: str) -> str:
 
 def check_file(path, *, force: bool = False, label: str | None = None, flag: str = "force=True") -> Path:
     """Check that one file may be written at ``path``: not a directory, not there unless
-    ``force``, in a folder that is (or can be made) writable.
+    ``force`` (a symbolic link counts as there), in a folder that is (or can be made) writable:
+    :func:`plateqp.io.safe.check_target`, the rule the writing itself keeps.
 
     ``label`` names the path in messages (default: the path); ``flag`` is how to force.
     """
-    path = Path(path)
-    label = label or str(path)
-    if path.is_dir():
-        raise ExportError(f"{label}: is a directory, not a file")
-    if os.path.lexists(path) and not force:
-        raise ExportError(f"{label}: exists; use {flag} to overwrite it")
-    _usable_parent(path.parent, label)
-    return path
+    return check_target(path, force=force, label=label, flag=flag)
 
 
 def inside(relative: str, what: str) -> PurePath:

@@ -119,7 +119,7 @@ def check_target(path, *, force: bool = False, label: str | None = None, flag: s
     st = _lstat(path)
     if st is not None:
         if stat.S_ISDIR(st.st_mode):
-            raise ExportError(f"{here} is a folder, not a file")
+            raise ExportError(f"{here} is a directory, not a file")
         if not force:
             what = " (a symbolic link)" if stat.S_ISLNK(st.st_mode) else ""
             raise ExportError(f"{here} exists{what}; use {flag} to replace it")
@@ -186,7 +186,7 @@ def _place(tmp: Path, path: Path, force: bool, label: str, flag: str) -> None:
         if force:
             st = _lstat(path)
             if st is not None and stat.S_ISDIR(st.st_mode):
-                raise ExportError(f"{label}: {path.name} is a folder, not a file")
+                raise ExportError(f"{label}: {path.name} is a directory, not a file")
             os.replace(tmp, path)
             return
         try:
@@ -234,7 +234,7 @@ def regular_or_absent(path, label: str | None = None) -> bool:
     if stat.S_ISLNK(st.st_mode):
         raise ExportError(f"{label}: is a symbolic link; name the file itself (plateqp never writes through links)")
     if stat.S_ISDIR(st.st_mode):
-        raise ExportError(f"{label}: is a folder, not a file")
+        raise ExportError(f"{label}: is a directory, not a file")
     if not stat.S_ISREG(st.st_mode):
         raise ExportError(f"{label}: is not a regular file (a FIFO, device or socket)")
     return True
