@@ -70,20 +70,28 @@ def check_cutouts(sc):
     the point checks ask (``covers``, ``locate``, ``node_at``, ``covers_area``, ``cells_centred_in``):
     the grid, or on triangles the plate's region."""
     from .constraints import edge_table, warn_changed_all
-    from .geometry import validate_shaped
-    from .mesh import Grid
 
     for i, o in enumerate(sc.openings):
         for k in ("x0", "x1", "y0", "y1"):
             sc._num(f"openings.{i}.{k}", getattr(o, k))
         if not (o.x0 < o.x1 and o.y0 < o.y1):
             sc._fail(f"openings.{i}", "needs x0 < x1 and y0 < y1")
-    grid = validate_shaped(sc) if sc.triangles else Grid.from_scene(sc)
+    grid = plate_cover(sc)
     if not grid.cell_mask.any():
         sc._fail("openings" if sc.openings else "holes", "the cut-outs remove every cell of the plate")
     edge_table(sc, grid.domain)  # every edge name known, and no segment named twice
     warn_changed_all(sc, grid.domain)
     return grid
+
+
+def plate_cover(sc):
+    """What the point checks ask of the plate (``covers``, ``locate``, ``node_at``,
+    ``covers_area``, ``cells_centred_in``, ``domain``): the grid, or on triangles the plate's
+    region (its shape and cut-outs checked: :func:`plateqp.geometry.validate_shaped`)."""
+    from .geometry import validate_shaped
+    from .mesh import Grid
+
+    return validate_shaped(sc) if sc.triangles else Grid.from_scene(sc)
 
 
 def check_pins(sc, grid) -> None:
@@ -98,7 +106,6 @@ def check_pins(sc, grid) -> None:
 
 
 def check_loads(sc, grid) -> None:
-    p = sc.plate
     for i, ld in enumerate(sc.loads):
         where = f"loads.{i}"
         kind = getattr(ld, "type", None)
@@ -116,7 +123,8 @@ def check_loads(sc, grid) -> None:
                 sc._num(f"{where}.{k}", getattr(ld, k))
             if not (ld.x0 < ld.x1 and ld.y0 < ld.y1):
                 sc._fail(where, "needs x0 < x1 and y0 < y1")
-            if not sc.triangles and (ld.x1 <= 0 or ld.x0 >= p.a or ld.y1 <= 0 or ld.y0 >= p.b):
+            x0, x1, y0, y1 = grid.domain.outer.bbox
+            if ld.x1 <= x0 or ld.x0 >= x1 or ld.y1 <= y0 or ld.y0 >= y1:
                 sc._fail(where, "the patch does not overlap the plate")
             if not grid.covers_area(ld.x0, ld.x1, ld.y0, ld.y1):
                 sc._fail(where, "the patch lies entirely in an opening (no plate there to load)")

@@ -259,14 +259,15 @@ class Scene:
         if covered is None:
             covered = not self.in_opening(x, y) if grid is None else grid.covers(x, y)
         if not covered:
-            self._fail(where, f"point ({x}, {y}) lies " + ("off the plate (outside its shape or in a hole)"
-                                                          if self.triangles else "in an opening (no plate there)"))
+            self._fail(where, f"point ({x}, {y}) lies in an opening, in a hole or outside its shape "
+                       "(no plate there)")
 
     def in_opening(self, x: float, y: float) -> bool:
-        """True if (x, y) lies strictly inside the removed cells of an opening."""
-        from .mesh import Grid
+        """True if (x, y) lies off the plate's cover: inside the removed cells of a cut-out on the
+        grid, in a hole or outside the shape on triangles (:func:`plateqp.checks.plate_cover`)."""
+        from .checks import plate_cover
 
-        return not Grid.from_scene(self).covers(x, y)
+        return not plate_cover(self).covers(x, y)
 
     @staticmethod
     def _covered(grid, points) -> list[bool] | None:

@@ -252,11 +252,8 @@ KNOWN_MESH_KIND_BRANCHES: dict[str, int] = {
     # the scene language's own rules by mesh: a shape or an element size needs triangles, a
     # polygon bed region too; a cut-out is cut exactly on triangles, by cells on the grid
     "plateqp.checks:check_plate_and_mesh": 1,
-    "plateqp.checks:check_cutouts": 1,
-    "plateqp.checks:check_loads": 1,
+    "plateqp.checks:plate_cover": 1,
     "plateqp.checks:check_foundation": 2,
-    "plateqp.scene:Scene._inside": 1,
-    "plateqp.cli.solve:_check_probes": 1,
     "plateqp.constraints:warn_changed_all": 1,
     "plateqp.demo:run_scene": 1,
     "plateqp.io.fields:to_xarray": 1,  # the grid view where the mesh has one

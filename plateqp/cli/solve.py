@@ -21,13 +21,11 @@ def _check_probes(scene, probes) -> None:
     naming it, so that no solve is lost to it."""
     if not probes:
         return
-    grid = None
-    if scene.triangles:
-        from ..geometry import Region, scene_domain
+    from ..checks import plate_cover
 
-        grid = Region(scene_domain(scene), 1.0)
+    cover = plate_cover(scene)
     for px, py in probes:
-        scene._inside(f"--probe {px:g},{py:g}", px, py, grid=grid)
+        scene._inside(f"--probe {px:g},{py:g}", px, py, grid=cover)
 
 
 def _summary(result, probes=()) -> str:
