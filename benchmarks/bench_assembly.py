@@ -58,7 +58,7 @@ CSV_FIELDS = ("table", "element", "n", "method", "n_free", "nnz_K", "assembly_s"
 # helpers that run inside the worker processes
 # ------------------------------------------------------------------------------------------
 def _scene(element: str, n: int):
-    import plateqp.scene as S
+    import plateqp.model.scene as S
 
     return S.Scene(plate=S.Plate(a=1.0, b=1.0, h=0.01, E=1e7, nu=0.3), mesh=S.MeshSpec(n, n, element),
                    edges={k: "simple" for k in S.EDGE_NAMES}, loads=[S.UniformLoad(1.0)])
@@ -216,7 +216,7 @@ def worker_assembly(job: dict) -> dict:
     import numpy as np
     import scipy.sparse as sp
 
-    mod, _, fn = job.get("build", "plateqp.assembly:build_model").partition(":")
+    mod, _, fn = job.get("build", "plateqp.model.assembly:build_model").partition(":")
     build_model = getattr(importlib.import_module(mod), fn)
     sc = _scene(job["element"], job["n"])
     build_model(_scene(job["element"], 4))  # imports and element matrices out of the timing
@@ -308,7 +308,7 @@ def _precision(K, f, F, x0, x3) -> dict:
         x = x + F._raw(r)
     xref = x
     # the same with the residual to ~2⁻⁷⁰ of |K||u| (plateqp.linalg.residual, checked against
-    # rational arithmetic in tests/test_residual.py): the two references' distance bounds both
+    # rational arithmetic in tests/linalg/test_residual.py): the two references' distance bounds both
     from plateqp.linalg.residual import Residual
 
     R = Residual(K)
@@ -400,7 +400,7 @@ def main(argv=None) -> int:
     ap.add_argument("--methods", nargs="+", default=list(ALL_METHODS), help="solvers/precision tables")
     ap.add_argument("--threads", type=int, default=None, help="set OMP/MKL/OPENBLAS_NUM_THREADS in workers")
     ap.add_argument("--tag", default="", help="suffix for the method names (e.g. a BLAS variant)")
-    ap.add_argument("--build", default="plateqp.assembly:build_model", metavar="MODULE:FUNC",
+    ap.add_argument("--build", default="plateqp.model.assembly:build_model", metavar="MODULE:FUNC",
                     help="the assembly to time (e.g. a candidate replacement of build_model on PYTHONPATH)")
     ap.add_argument("--csv", type=Path, default=CSV_PATH)
     ap.add_argument("--no-csv", action="store_true")
@@ -538,7 +538,7 @@ def profile(n: int, element: str) -> int:
     import pstats
 
     sys.path.insert(0, str(ROOT))
-    from plateqp.assembly import build_model
+    from plateqp.model.assembly import build_model
 
     sc = _scene(element, n)
     build_model(_scene(element, 4))  # imports only: the profiled call is a first (cold) call, as in use

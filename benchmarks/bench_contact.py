@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import plateqp as pq
-from plateqp.assembly import build_model
+from plateqp.model.assembly import build_model
 from plateqp.contact import formulations_for, solve_contact
 
 HERE = Path(__file__).parent

@@ -1,4 +1,4 @@
-"""Discretisation error against solver error, on the scene families (plateqp.families).
+"""Discretisation error against solver error, on the scene families (plateqp.scenes.families).
 
 For each family and mesh n² (8 … 128), the scene is solved by an exact in-house solver (pdas on
 the primal: the finite-element answer of that mesh) and by an iterative backend at a ladder of
@@ -71,8 +71,8 @@ def _solve_group(args, out):
     name, n, backend, formulation, tols = args
     warnings.simplefilter("ignore")
     import plateqp as pq
-    from plateqp.assembly import build_model
-    from plateqp.families import family
+    from plateqp.model.assembly import build_model
+    from plateqp.scenes.families import family
 
     sc = family(name, n)
     model = build_model(sc)
@@ -109,7 +109,7 @@ def _element_scene(element: str, n: int):
 def elements_study(meshes, reps: int, out: Path) -> list[dict]:
     """DKT against ACM and BFS on Navier's square: error and CPU time against dofs (see the docstring)."""
     import plateqp as pq
-    from plateqp.assembly import build_model
+    from plateqp.model.assembly import build_model
     from plateqp.solving import solve_two_sided
 
     ref_coef = navier_centre()
@@ -198,7 +198,7 @@ def main(argv=None) -> int:
         elements_study(meshes, args.reps, out)
         return 0
     from plateqp.studies import auto_tolerance
-    from plateqp.families import family
+    from plateqp.scenes.families import family
 
     meshes = [n for n in (8, 16, 32, 64, 128) if n <= args.max_mesh]
     fams = args.families.split(",")

@@ -228,7 +228,7 @@ def _held(scene, active):
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
-    from plateqp.assembly import build_model
+    from plateqp.model.assembly import build_model
     from plateqp.contact import Scaled
 
     model = build_model(scene)
@@ -430,7 +430,7 @@ def _first_rows_child(args, q):
 
 def _first_row(kind, params):
     if kind == "unscaled-clarabel":
-        from plateqp.assembly import build_model
+        from plateqp.model.assembly import build_model
         from plateqp.backends import clarabel_
         from plateqp.backends.base import QP
         from plateqp.contact import ContactSolution as Contact, Scaled

@@ -5,7 +5,7 @@ plate's matrix, written directly against cvxopt's bindings (``cvxopt.cholmod``, 
 of the default install), not through plateqp.linalg; the lower triangle is converted to a
 cvxopt matrix before the clock starts. The matrix is
 
-* grid: ``plateqp.families.grid_rigid(n, 30)`` (benchmarks/bench_contact.py's scene family:
+* grid: ``plateqp.scenes.families.grid_rigid(n, 30)`` (benchmarks/bench_contact.py's scene family:
   an 8 m slab on four walls, a 30 × 30 grid of rigid one-sided posts with mixed gaps): the
   plate's ``K``;
 * bed: a free ACM plate on a tensionless bed (k = 2·10⁴) whose surface falls away towards
@@ -73,8 +73,8 @@ import numpy as np
 import scipy.sparse as sp
 
 import plateqp as pq
-from plateqp.assembly import build_model
-from plateqp.families import grid_rigid
+from plateqp.model.assembly import build_model
+from plateqp.scenes.families import grid_rigid
 from plateqp.linalg import Factor
 from plateqp.progress import track  # bars on a terminal only
 from plateqp.studies.sweep import sweep

@@ -1,7 +1,7 @@
 """A floating slab on a few posts (issue 11, "`auto` never the slow choice"): pdas on the primal
 QP against BPP on the condensed LCP, and what ``backend="auto"`` picks, for single solves.
 
-Scenes: :func:`plateqp.families.floating` ``(n, k)``, the slab held only by a k × k grid of rigid
+Scenes: :func:`plateqp.scenes.families.floating` ``(n, k)``, the slab held only by a k × k grid of rigid
 one-sided posts (edges and corners included; K singular), k = 3, 5, 9, at n = 32, 64, 128.
 Routes, each ``pq.solve(scene, …, accuracy=1e-10)``: ``pdas`` (primal formulation: the anchored
 first set, then exact steps), ``bpp`` (condensed formulation: a contacts-last factorisation of
@@ -78,7 +78,7 @@ def main() -> None:
         ap.error("meshes of at least 4 and at least 2 posts per row")
 
     import plateqp as pq
-    from plateqp.families import floating
+    from plateqp.scenes.families import floating
 
     warnings.simplefilter("ignore", pq.PlateQPWarning)
     rows = []

@@ -11,7 +11,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).parent))
 import numpy as np, plateqp as pq
 from bench_contact import scene
-from plateqp.assembly import build_model
+from plateqp.model.assembly import build_model
 from plateqp.contact import Scaled, formulate
 from plateqp.backends import get_backend
 from plateqp.backends.bpp import natural_residual

@@ -1,7 +1,7 @@
 """Many contacts (issue 11, "no cliff"): pdas against the external backends from 9 posts to a
 post on every interior node, and on the tensionless bed.
 
-Scenes (:mod:`plateqp.families`, kN and m): ``grid_rigid(n, k)``, the slab on four walls and a
+Scenes (:mod:`plateqp.scenes.families`, kN and m): ``grid_rigid(n, k)``, the slab on four walls and a
 k × k grid of rigid one-sided posts with mixed gaps, for k = 3, 10, 30, 45, 63 and ``"all"``
 (n − 1: every interior node a post), and ``bed(n)``, the free slab on a tensionless Winkler bed
 (a one-sided spring at every node). pdas takes its condensed method up to ``max_dense``
@@ -58,7 +58,7 @@ def make_scene(name: str, n: int, k, edges: str = "four"):
     only (``edges="one"``: free to turn about it) or on none (``"free"``: a floating slab on
     the posts alone): K singular in the last two."""
     import plateqp as pq
-    from plateqp.families import bed, grid_rigid
+    from plateqp.scenes.families import bed, grid_rigid
 
     if name == "bed":
         return bed(n)

@@ -86,8 +86,7 @@ def bump_scene(n: int):
 
 def piles_scene(n: int):
     import plateqp as pq
-    from plateqp import families as F
-
+    from plateqp.scenes import families as F
     sc = F.grid_elastic(n, min(30, n - 1))  # (the warm-up at 16²: 15 × 15)
     sc.foundation = pq.Foundation(k=F.BED_MODULUS, gap=0.001)
     sc.validate()
@@ -110,7 +109,7 @@ def cold(kind: str, n: int) -> tuple:
 
 def predicted(kind: str, n: int, d: int) -> tuple:
     import plateqp as pq
-    from plateqp.assembly import build_model
+    from plateqp.model.assembly import build_model
     from plateqp.contact import predict
     from plateqp.contact.pipeline import solve_contact
 
@@ -127,7 +126,7 @@ def predicted(kind: str, n: int, d: int) -> tuple:
 
 
 def raw(kind: str, n: int) -> float:
-    from plateqp.assembly import build_model
+    from plateqp.model.assembly import build_model
 
     K, f = plate_matrix("bed", build_model(SCENES[kind](n)))  # every (soft) row bonded
     A = to_cvxopt(K)

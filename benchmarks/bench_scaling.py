@@ -1,6 +1,6 @@
 """Scaling: time and memory against dofs and against contact points, per backend × formulation.
 
-Two sweeps on ``plateqp.families.grid_rigid`` (an 8 m slab on walls and a k × k grid of rigid
+Two sweeps on ``plateqp.scenes.families.grid_rigid`` (an 8 m slab on walls and a k × k grid of rigid
 one-sided posts with mixed gaps), at one accuracy (``--accuracy``, default 1e-6, "mid"):
 
 * ``dofs``: n = 16, 32, 64, 128, 256 (``--sizes``) at a fixed grid (``--k``, default 7: 49 posts);
@@ -50,7 +50,7 @@ HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 from bench_contact import run_in_subprocess
 
-from plateqp.families import grid_rigid, positions
+from plateqp.scenes.families import grid_rigid, positions
 
 PAIRS = ("pdas/primal", "bpp/condensed", "lemke/condensed", "bpp/dual", "clarabel/primal", "clarabel/condensed",
          "osqp/primal", "osqp/condensed", "qpsolvers:proxqp/primal", "qpsolvers:proxqp/condensed",
@@ -83,7 +83,7 @@ def _case(args, q):
     warnings.simplefilter("ignore")
     import resource
 
-    from plateqp.assembly import build_model
+    from plateqp.model.assembly import build_model
     from plateqp.contact import solve_contact
 
     try:  # pay the first-call imports on a tiny scene

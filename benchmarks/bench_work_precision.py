@@ -1,6 +1,6 @@
 """Work–precision: every backend × formulation × a tolerance ladder, on the scene families.
 
-For each scene (``plateqp.families``: family × mesh n, default k), each installed backend and
+For each scene (``plateqp.scenes.families``: family × mesh n, default k), each installed backend and
 each formulation it takes, and each rung of the ladder 1e-2 … 1e-12 (passed as
 ``accuracy=tol``: the KKT tolerance, each backend maps it with ``preset()``), one row:
 assembly, formulate and solve time, iterations, the backend's own status, ours, every KKT
@@ -57,7 +57,7 @@ sys.path.insert(0, str(HERE))
 from bench_contact import run_in_subprocess
 
 import plateqp as pq
-from plateqp.families import FAMILIES, family, n_contacts
+from plateqp.scenes.families import FAMILIES, family, n_contacts
 
 TOLS = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
 LEVELS = {"low": 1e-4, "mid": 1e-6, "high": 1e-10}
@@ -74,7 +74,7 @@ COLUMNS = ["family", "n", "k", "m", "ndof", "backend", "formulation", "tol", "st
 
 def _warm_up(backend, formulation, accuracy):
     """Pay the first-call imports (solvers, SciPy's LP) on a tiny scene."""
-    from plateqp.assembly import build_model
+    from plateqp.model.assembly import build_model
     from plateqp.contact import solve_contact
 
     try:
@@ -96,7 +96,7 @@ def _ladder(args, q):
     """Child: build the scene once, then solve it at every rung; one message per rung."""
     fam, n, k, backend, formulation, tols = args
     warnings.simplefilter("ignore")
-    from plateqp.assembly import build_model
+    from plateqp.model.assembly import build_model
     from plateqp.backends import get_backend
     from plateqp.contact import solve_contact
 
@@ -133,7 +133,7 @@ def _reference(args, q):
     """Child: the reference pair, each at 1e-12: PDAS/primal and Lemke (or BPP)/condensed."""
     fam, n, k, lemke_max = args
     warnings.simplefilter("ignore")
-    from plateqp.assembly import build_model
+    from plateqp.model.assembly import build_model
     from plateqp.contact import solve_contact
 
     model = build_model(family(fam, n, k))

@@ -24,7 +24,7 @@ nondimensional data, solve each, and check the KKT conditions ourselves with Num
 code("""import numpy as np
 import cvxpy as cp
 import plateqp as pq
-from plateqp.assembly import build_model
+from plateqp.model.assembly import build_model
 from plateqp.contact import Scaled, formulate
 
 # a free plate on a 3 x 3 grid of rigid supports; one corner support settled, a point load
@@ -103,7 +103,7 @@ reaction enters: it presses) until the pre-compression z0 reaches zero."""),
 code("""import numpy as np
 import plateqp as pq
 from plateqp.backends import lemke
-from plateqp.assembly import build_model
+from plateqp.model.assembly import build_model
 from plateqp.contact import Scaled, formulate
 
 supports = [pq.Support(x, y, gap=(-0.05 if (x, y) in ((0.5, 0.0), (1.0, 0.0)) else 0.0))
@@ -459,7 +459,7 @@ it still converged on every scene but the tight clusters. A heuristic reading, n
 posts far apart are weakly coupled, so dropping one moves its neighbours' reactions little.
 Posts a fraction of a mesh cell apart are the opposite: dropping one throws its whole reaction onto its neighbours, which may then go into
 tension, and so on round the cluster. The same happens on the 4 × 4 matrix of
-tests/test_toggle.py. The cures are the ones above: pivot one support at a time (Lemke, the
+tests/backends/test_toggle.py. The cures are the ones above: pivot one support at a time (Lemke, the
 least-index rule), fall back to it when progress stalls (BPP), or safeguard the step (PDAS)."""),
 ])
 
@@ -619,7 +619,7 @@ code("""import numpy as np
 import matplotlib.pyplot as plt  # the notebook's own (inline) backend: the figure shows
 import plateqp as pq
 from plateqp.backends import lemke
-from plateqp.assembly import build_model
+from plateqp.model.assembly import build_model
 from plateqp.contact import Scaled, formulate
 
 def lcp_of(scene):
@@ -1015,7 +1015,7 @@ posts under it, a uniform load and a point load off the centre line."""),
 code("""import numpy as np
 import matplotlib.pyplot as plt
 import plateqp as pq
-from plateqp.assembly import build_model
+from plateqp.model.assembly import build_model
 from plateqp.contact import Scaled, formulate
 
 posts = [(0.375, 0.5), (0.625, 0.5)]
@@ -1205,7 +1205,7 @@ code("""import warnings
 import numpy as np
 import matplotlib.pyplot as plt
 import plateqp as pq
-from plateqp.assembly import build_model
+from plateqp.model.assembly import build_model
 
 pts = [(x, y) for x in (0.25, 0.5, 0.75) for y in (0.25, 0.5, 0.75)]
 gaps = [0.0, 1e-3, -1e-3, 2e-3, 0.0, -2e-3, 1e-3, 0.0, 0.0]      # m: + settled, − heaved
@@ -1391,7 +1391,7 @@ code("""import numpy as np
 import scipy.linalg as sla
 import matplotlib.pyplot as plt
 import plateqp as pq
-from plateqp.assembly import build_model
+from plateqp.model.assembly import build_model
 from plateqp.contact import Scaled, formulate
 from plateqp.backends.lemke import lemke
 

@@ -24,7 +24,7 @@ from .errors import (
     SolverError,
 )
 from .results import KKTReport, Result
-from .scene import (
+from .model.scene import (
     Edge,
     Foundation,
     MeshSpec,

@@ -19,14 +19,14 @@ and uses it two ways:
   estimated error of max |w| and of the reactions is below REL, solving each mesh at a solver
   tolerance of a tenth of REL: the coarsest mesh and the loosest setting that reach it.
 
-On triangles a mesh of n cells a side has element size L / n (:func:`plateqp.assembly.mesh_cells`);
+On triangles a mesh of n cells a side has element size L / n (:func:`plateqp.model.assembly.mesh_cells`);
 the meshes are not nested, so the change of w is read from max |w| alone.
 
 The quantities are the ones engineers read: the largest deflection max |w|, and the
 reactions (discrete supports: the largest change of any support's reaction, relative to the
 largest reaction; a tensionless bed: the largest bed pressure). The order p defaults to 1.5:
 below the elements' order 2 under the point-like reactions of contact (measured 1.73 for
-ACM under a point load, tests/test_plate.py), so the estimate errs on the safe side.
+ACM under a point load, tests/model/test_plate.py), so the estimate errs on the safe side.
 """
 
 from __future__ import annotations
@@ -38,10 +38,10 @@ import numpy as np
 
 from collections.abc import Callable
 
-from .assembly import mesh_cells, with_cells
+from .model.assembly import mesh_cells, with_cells
 from .errors import MechanismError, PlateQPWarning, ProblemError, SceneError, SolverError
 from .results import Result
-from .scene import Scene
+from .model.scene import Scene
 
 #: What a coarse mesh may fail with (too few dofs for the supports, a pin off its nodes): skipped.
 COARSE_FAILURES = (SceneError, ProblemError, SolverError, MechanismError)
@@ -172,7 +172,7 @@ def confirm(est: ErrorEstimate, final: Result, order: float = ORDER) -> ErrorEst
 
 def with_mesh(scene: Scene, nx: int, ny: int) -> Scene:
     """A validated copy of ``scene`` meshed nx × ny cells a side: on a grid nx × ny cells, on
-    triangles of element size h = L / nx (:func:`plateqp.assembly.with_cells`)."""
+    triangles of element size h = L / nx (:func:`plateqp.model.assembly.with_cells`)."""
     return with_cells(scene, nx, ny)
 
 

@@ -1,6 +1,6 @@
 """Result of a solve, and the recovery of fields from the nodal dofs.
 
-Moments follow the convention of :mod:`plateqp.elements.base` (M = −D_b κ, Mx > 0 sags).
+Moments follow the convention of :mod:`plateqp.model.elements.base` (M = −D_b κ, Mx > 0 sags).
 Surface stresses are those of the bottom face (z = +h/2, the face on the side of positive w):
 σx = 6 Mx / h², σy = 6 My / h², τxy = 6 Mxy / h²; the top face has the opposite signs.
 Principal stresses σ1 ≥ σ2 of the bottom face, with the angle of σ1 from the x axis.
@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from . import post
+from .model import recovery as post
 from .accuracy import Status
 from .errors import ArgumentError
 
@@ -125,7 +125,7 @@ class Result:
         return self._eval(x, y, 2, 0), self._eval(x, y, 0, 2), self._eval(x, y, 1, 1)
 
     def moments(self, x, y):
-        """(Mx, My, Mxy) per unit length at points: M = −D_b κ (:func:`plateqp.post.moments`)."""
+        """(Mx, My, Mxy) per unit length at points: M = −D_b κ (:func:`plateqp.model.recovery.moments`)."""
         return tuple(_unwrap(m) for m in post.moments(self.scene.plate, *self.curvatures(x, y)))
 
     def stresses(self, x, y):
@@ -167,7 +167,7 @@ class Result:
     def nodal(self, quantity: str = "w") -> np.ndarray:
         """(n,) smoothed nodal values, one per node of the plate in ``mesh.nodes`` order, on
         every mesh: each cell's own value at its corner, averaged over the cells around the node
-        (:class:`plateqp.post.NodalOperator`). On the structured grid ``model.grid.to_grid``
+        (:class:`plateqp.model.recovery.NodalOperator`). On the structured grid ``model.grid.to_grid``
         gives the (ny+1, nx+1) view (NaN off the plate), and :meth:`to_xarray` the same on x, y.
         ``quantity`` as for :meth:`section`."""
         return post.nodal_operator(self.model)(self.u, self.scene.plate, _quantity(quantity))
@@ -294,5 +294,5 @@ def _probes(probes) -> list[tuple[float, float]]:
 
 
 def _short(v, n: int = 60) -> str:
-    from .parts import _short as short
+    from .model.parts import _short as short
     return short(v, n)

@@ -15,15 +15,15 @@ import warnings
 import numpy as np
 
 from .accuracy import Accuracy
-from .assembly import Model, build_model
+from .model.assembly import Model, build_model
 from .contact import solve_bilateral as _solve_bilateral
 from .contact import solve_contact
 from .errors import ArgumentError, MechanismError, PlateQPWarning, ProblemError, SceneError, SolverError
 from .estimate import auto_tolerance, confirm
 from .linalg import Factor
-from .parts import _short, plain
+from .model.parts import _short, plain
 from .results import Result
-from .scene import Scene
+from .model.scene import Scene
 
 
 def describe_modes(model: Model, modes: np.ndarray) -> str:
@@ -68,7 +68,7 @@ def check_arguments(scene, backend="auto", formulation="auto", accuracy="default
     if options is not None and (not isinstance(options, dict) or not all(isinstance(k, str) for k in options)):
         raise ArgumentError(f"options: must be a dict of option names to values, or None (got {_short(options)})")
     if model is not None and not isinstance(model, Model):
-        raise ArgumentError(f"model: must be a Model built from this scene (plateqp.assembly.build_model), "
+        raise ArgumentError(f"model: must be a Model built from this scene (plateqp.model.assembly.build_model), "
                             f"or None (got {_short(model)})")
     if not isinstance(plain(check_statics), bool):
         raise ArgumentError(f"check_statics: must be True or False (got {_short(check_statics)})")
@@ -81,7 +81,7 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
 
     Parameters
     ----------
-    scene : the :class:`~plateqp.scene.Scene`
+    scene : the :class:`~plateqp.model.scene.Scene`
     backend : a name from :func:`plateqp.available_backends` ("auto": pdas on the sparse
         primal; bpp on the condensed problem in a sweep (which re-uses the condensation) with
         at most 100 contact points; the rule and its measurements:

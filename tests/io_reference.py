@@ -1,6 +1,6 @@
 """The reference problem of the io tests: a small scene exported in every formulation, solved by
 plateqp's exact solvers, and HiGHS as an independent reader and solver of QPS files (imported by
-tests/test_export.py, test_qps.py, test_qpbenchmark.py; pytest puts tests/ on sys.path)."""
+tests/io/test_export.py, test_qps.py, test_qpbenchmark.py; pytest puts tests/ on sys.path)."""
 
 from __future__ import annotations
 

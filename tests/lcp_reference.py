@@ -2,7 +2,7 @@
 BVLS, the complementarity conditions and Farkas' certificate checked by their definitions, and
 generators of problems with known answers.
 
-Shared by tests/test_lemke.py, test_lcp.py, test_bpp.py and test_pgs.py (imported by module
+Shared by tests/backends/test_lemke.py, test_lcp.py, test_bpp.py and test_pgs.py (imported by module
 name: pytest puts tests/ on sys.path).
 """
 

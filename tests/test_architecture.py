@@ -39,8 +39,8 @@ MAX_FUNCTION_LINES = 80
 MAX_DOCSTRING_LINES = 60
 #: The model floor (scene to matrices) and the contact floor (the contact problem and its
 #: answer): the modules whose functions :data:`MAX_FUNCTION_LINES` holds.
-FLOORS = ("plateqp.scene", "plateqp.checks", "plateqp.parts", "plateqp.geometry", "plateqp.crossings", "plateqp.paths", "plateqp.mesh", "plateqp.trimesh",
-          "plateqp.elements", "plateqp.constraints", "plateqp.assembly",
+FLOORS = ("plateqp.model.scene", "plateqp.model.checks", "plateqp.model.parts", "plateqp.model.geometry", "plateqp.model.crossings", "plateqp.model.paths", "plateqp.model.grid", "plateqp.model.trimesh",
+          "plateqp.model.elements", "plateqp.model.constraints", "plateqp.model.assembly",
           "plateqp.contact")
 KNOWN_LONG_FUNCTIONS: set[str] = set()
 KNOWN_LONG_DOCSTRINGS: set[str] = set()
@@ -147,7 +147,7 @@ def test_the_checker_sees_a_cycle():
 def test_relative_imports_are_resolved():
     mods = sources()
     imps = imports_of("plateqp.contact.pipeline", mods["plateqp.contact.pipeline"])
-    assert "plateqp.assembly" in imps and "plateqp.contact.kkt" in imps
+    assert "plateqp.model.assembly" in imps and "plateqp.contact.kkt" in imps
 
 
 def test_no_import_cycle():
@@ -234,16 +234,16 @@ def test_module_docstrings_state_contracts():
 def test_the_length_checks_see_a_long_function(tmp_path, monkeypatch):
     """The function-length check finds a planted long function (a check that cannot fail is no check)."""
     pkg = tmp_path / "plateqp"
-    pkg.mkdir()
-    (pkg / "scene.py").write_text("def f():\n" + "    x = 1\n" * MAX_FUNCTION_LINES + "    return x\n")
+    (pkg / "model").mkdir(parents=True)
+    (pkg / "model" / "scene.py").write_text("def f():\n" + "    x = 1\n" * MAX_FUNCTION_LINES + "    return x\n")
     monkeypatch.setattr(__import__(__name__), "ROOT", pkg)
-    assert long_functions() == {"plateqp.scene:f": MAX_FUNCTION_LINES + 2}
+    assert long_functions() == {"plateqp.model.scene:f": MAX_FUNCTION_LINES + 2}
 
 
 # -- which mesh a module holds: asked only where meshes are made and elements chosen -------------
 #: The mesh generators and element families: the only modules that may ask which kind of mesh
 #: they hold.
-MESH_KIND_MODULES = ("plateqp.mesh", "plateqp.trimesh", "plateqp.elements")
+MESH_KIND_MODULES = ("plateqp.model.grid", "plateqp.model.trimesh", "plateqp.model.elements")
 #: Names a scene goes by, whose ``.triangles`` read asks which generator meshes it.
 SCENE_NAMES = {"scene", "sc", "a", "b", "s", "self"}
 #: Known remaining questions about the mesh kind, ``module:function`` → how many, declared as
@@ -251,10 +251,10 @@ SCENE_NAMES = {"scene", "sc", "a", "b", "s", "self"}
 KNOWN_MESH_KIND_BRANCHES: dict[str, int] = {
     # the scene language's own rules by mesh: a shape or an element size needs triangles, a
     # polygon bed region too; a cut-out is cut exactly on triangles, by cells on the grid
-    "plateqp.checks:check_plate_and_mesh": 1,
-    "plateqp.checks:plate_cover": 1,
-    "plateqp.checks:check_foundation": 2,
-    "plateqp.constraints:warn_changed_all": 1,
+    "plateqp.model.checks:check_plate_and_mesh": 1,
+    "plateqp.model.checks:plate_cover": 1,
+    "plateqp.model.checks:check_foundation": 2,
+    "plateqp.model.constraints:warn_changed_all": 1,
     "plateqp.demo:run_scene": 1,
     "plateqp.io.fields:to_xarray": 1,  # the grid view where the mesh has one
     "plateqp.plotting.charts:plot_reactions": 1,
@@ -327,6 +327,7 @@ def test_the_mesh_kind_check_sees_a_branch(tmp_path, monkeypatch):
         "    if sc.triangles or on_triangles(result) or mesh.cell_type == 'quad':\n"
         "        return isinstance(mesh, (Grid, int)) or mesh.grid_shape is None\n"
         "    return mesh.triangles\n")
-    (pkg / "trimesh.py").write_text("def g(sc):\n    return sc.triangles\n")
+    (pkg / "model").mkdir()
+    (pkg / "model" / "trimesh.py").write_text("def g(sc):\n    return sc.triangles\n")
     monkeypatch.setattr(__import__(__name__), "ROOT", pkg)
     assert mesh_kind_branches() == {"plateqp.plotting.plan:f": 5}

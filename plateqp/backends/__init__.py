@@ -18,7 +18,7 @@ from .base import ACCURACIES, LCP, PRESET_TOL, QP, Backend, RawSolution, Status,
 # order they are imported and listed: plateqp's own first
 _MODULES = ("lemke", "bpp", "pgs", "pdas", "toggle", "osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
 #: plateqp's own backends (the first modules of ``_MODULES``): their modules import no
-#: third-party solver. Every backend declared ``exact`` is among them (tests/test_backends.py
+#: third-party solver. Every backend declared ``exact`` is among them (tests/backends/test_backends.py
 #: checks), so ``backend="auto"`` chooses from these alone and a solve with one of them never
 #: imports cvxpy, qpsolvers, OSQP or Clarabel (cvxpy's import alone took 0.3-0.5 s of a fresh
 #: process's first solve).

@@ -5,7 +5,7 @@ The QP is written as a cvxpy problem::
     minimise   ½ xᵀ psd_wrap(P) x + qᵀ x
     subject to G x ≤ h,  A x == b,  x[i] ≥ lb[i],  x[j] ≤ ub[j]   (finite bounds only)
 
-Multiplier signs, checked on problems with known answers (tests/test_backends_qp.py):
+Multiplier signs, checked on problems with known answers (tests/backends/test_backends_qp.py):
 cvxpy's ``dual_value`` is ≥ 0 for ``G x ≤ h`` (our ``z`` as is); for ``A x == b`` it is
 the ``y`` of ``… + yᵀ(A x − b)`` (our ``y`` as is); for ``x ≥ lb`` it is ≥ 0 (our
 ``z_box`` is its negative) and for ``x ≤ ub`` it is ≥ 0 (our ``z_box`` as is).

@@ -13,7 +13,7 @@ tension, switch on those that are penetrated, solve again, until nothing changes
 When ``A`` no longer changes, ``z`` solves the LCP exactly (status ``OPTIMAL`` once the
 natural residual confirms it). It is a primal-dual active-set step without safeguards: every
 sign change flips at once, and even for a symmetric positive definite ``M`` the sets can
-**cycle** (a 4 × 4 example in tests/test_toggle.py). A set seen before ends the iteration
+**cycle** (a 4 × 4 example in tests/backends/test_toggle.py). A set seen before ends the iteration
 with status ``MAX_ITER`` and "cycled" in ``solver_status`` (``extras["cycle"]`` its length);
 so does ``max_iter``. A singular ``M_AA`` (a floating plate held by too few supports) is
 status ``ERROR`` with no answer (:func:`plateqp.solve` raises a SolverError that says which round). :mod:`~plateqp.backends.pdas` is this method with the safeguards that make

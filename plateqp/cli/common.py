@@ -20,7 +20,7 @@ from .. import scenes
 from ..backends import get_backend
 from ..accuracy import accuracy_tol
 from ..errors import PlateQPError, ProblemError, SceneError, SolverError
-from ..scene import Scene
+from ..model.scene import Scene
 from .. import progress
 
 #: The log of the command line itself (notes such as "meshio is not installed").
@@ -156,7 +156,7 @@ def _stdout_to_stderr():
 
 def _set_memory_limit(text: str | None) -> None:
     if text:
-        from ..assembly import MEMORY_ENV, parse_bytes
+        from ..model.assembly import MEMORY_ENV, parse_bytes
 
         parse_bytes(text, "--max-memory")
         os.environ[MEMORY_ENV] = text  # worker processes inherit it

@@ -21,7 +21,7 @@ def _check_probes(scene, probes) -> None:
     naming it, so that no solve is lost to it."""
     if not probes:
         return
-    from ..checks import plate_cover
+    from ..model.checks import plate_cover
 
     cover = plate_cover(scene)
     for px, py in probes:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..accuracy import NO_WORK, Accuracy, Status
-from ..assembly import Model
+from ..model.assembly import Model
 from ..backends import get_backend
 from ..backends.base import RawSolution
 from ..errors import MechanismError, NoEquilibriumError, PlateQPWarning, ProblemError, SolverError

@@ -22,10 +22,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..accuracy import Status
-from ..assembly import Model, build_model
+from ..model.assembly import Model, build_model
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError
 from ..estimate import COARSE_FAILURES, with_mesh
-from ..assembly import mesh_cells
+from ..model.assembly import mesh_cells
 from ..linalg import row_stiffness
 from .scaling import Scaled
 

@@ -25,7 +25,7 @@ from .scaling import Scaled
 #   :func:`repeated_solves`): the condensed route while m ≤ AUTO_LCP_MAX. Its condensation is
 #   cached and re-used by every solve that shares the model (a dense m × m solve per value
 #   instead of a factorisation: a sweep of 10 gaps at 128² took 0.45× PDAS's time), and BPP's answer did not depend on its warm start
-#   (bit-identical serial and parallel sweeps in tests/test_parallel.py, where warm-started
+#   (bit-identical serial and parallel sweeps in tests/studies/test_parallel.py, where warm-started
 #   PDAS differed at 1e-13). A single solve of a floating plate went to the condensed route
 #   too while m ≤ AUTO_LCP_MAX, while PDAS had no first phase for a singular K; since issue
 #   11's seventh session (the anchored first set) it goes to PDAS like any other: measured

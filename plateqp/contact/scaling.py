@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import Model
+from ..model.assembly import Model
 from ..errors import ProblemError
 from ..linalg import pattern, row_stiffness
 

@@ -8,7 +8,7 @@ quantitative statements for our scenes (:func:`compare`), and writes the figures
 JSON file per scene and a self-contained ``report.html`` (figures embedded as base64 PNG)
 into the output folder. Progress goes to stderr: a bar on a terminal (:mod:`plateqp.progress`),
 log messages (``logging``, logger ``plateqp.demo``; skipped parts as warnings). The figures come from
-:mod:`plateqp.plotting`, the summary table and the HTML from :mod:`plateqp.report`;
+:mod:`plateqp.plotting`, the summary table and the HTML from :mod:`plateqp.demo.report`;
 :func:`output_files` lists every file a run may write, so that the command line can check
 the folder before any work and refuse to overwrite without ``--force``.
 
@@ -69,7 +69,7 @@ from .. import scenes
 from ..errors import PlateQPWarning, SceneError
 from ..plotting.data import support_spacing
 from ..progress import Progress
-from ..report import _json_safe, format_table, summary_row, write_files  # noqa: F401 - _json_safe: its old home
+from .report import _json_safe, format_table, summary_row, write_files  # noqa: F401 - _json_safe: its old home
 from .paper import STUDIES, TITLES, run_study
 
 DEFAULT_OUT = "plateqp-demo"

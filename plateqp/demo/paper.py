@@ -43,9 +43,9 @@ import numpy as np
 
 from .. import scenes
 from ..errors import PlateQPWarning
-from ..paths import set_param
+from ..model.paths import set_param
 from ..plotting.data import support_spacing
-from ..scene import Scene
+from ..model.scene import Scene
 
 #: The studies ``plateqp demo`` knows besides the scenes, and the figures each draws.
 STUDIES = {"fig5": ("schemes", "sections"), "fig6": ("pressure", "uniformity"), "regulate": ("reactions",)}
@@ -162,7 +162,7 @@ def stiffness_path(scene: Scene | None = None, kappa_max: float = 1e4, kappa_min
         sets.append(tuple(i + 1 in b["after"] for i in range(m)))
     edges = [math.inf] + [b["kappa"] if b["kappa"] is not None else math.sqrt(b["bracket"][0] * b["bracket"][1])
                           if all(map(math.isfinite, b["bracket"])) else b["bracket"][-1] for b in bps] + [kappa_min]
-    from ..assembly import build_model
+    from ..model.assembly import build_model
     from ..studies.reuse import adapt_model
 
     base = build_model(scene)
@@ -249,7 +249,7 @@ def contour_pressure(scene: Scene | None = None, kappas=FIG6_KAPPAS, kappa_range
     """Reactions along the contour of ``scene`` (default: the built-in ``contour``) for
     ``kappas``, the three uniformity measures on a log grid of ``scan`` κ over ``kappa_range``,
     and the κ minimising each (``most_uniform_stiffness(..., measure=...)``)."""
-    from ..assembly import build_model
+    from ..model.assembly import build_model
     from ..studies.design import UNIFORMITY_MEASURES, most_uniform_stiffness, uniformity
     from ..studies.reuse import adapt_model
 

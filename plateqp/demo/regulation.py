@@ -23,9 +23,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import scenes
-from ..paths import set_param
+from ..model.paths import set_param
 from ..results import Result
-from ..scene import Scene
+from ..model.scene import Scene
 
 #: The four supports around the machine foot of the ``heave`` scene (0-based: 12, 13, 17, 18).
 FOOT = (11, 12, 16, 17)
@@ -46,7 +46,7 @@ class Regulation:
     @property
     def error(self) -> float:
         """max |R − target| at the regulated supports in the check solve, relative to the load."""
-        from ..families import total_load
+        from ..scenes.families import total_load
 
         scale = abs(total_load(self.check.scene)) or float(np.abs(self.target).max())
         return float(np.abs(self.check.reactions[self.supports] - self.target).max() / scale)

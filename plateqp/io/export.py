@@ -110,11 +110,11 @@ def contact_qp(scene_or_model, formulation: str = "primal", name: str | None = N
 
     Parameters
     ----------
-    scene_or_model : a :class:`~plateqp.scene.Scene` or a :class:`~plateqp.assembly.Model`
+    scene_or_model : a :class:`~plateqp.model.scene.Scene` or a :class:`~plateqp.model.assembly.Model`
     formulation : "primal", "condensed" or "dual" (no "auto": an export says what it is)
     name : problem name (default: the scene's name and the formulation)
     """
-    from ..assembly import Model, build_model
+    from ..model.assembly import Model, build_model
     from ..contact import FORMULATIONS, Scaled, equilibrium_possible, formulate
 
     if formulation not in FORMULATIONS:

@@ -1,6 +1,6 @@
 """A solved plate as the tables and arrays users already work with: xarray and pandas.
 
-:func:`node_fields` gives every named field (:data:`plateqp.post.QUANTITIES`) at the plate's
+:func:`node_fields` gives every named field (:data:`plateqp.model.recovery.QUANTITIES`) at the plate's
 nodes, (n,) arrays in ``mesh.nodes`` order on every mesh; :func:`to_xarray` wraps them in an
 :class:`xarray.Dataset`; :func:`supports_frame` is one row per one-sided contact
 point (discrete supports in scene order, 1-based as in the figures, then bed nodes) as a
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import PlateQPError
-from ..post import QUANTITIES, NodalOperator, nodal_w
+from ..model.recovery import QUANTITIES, NodalOperator, nodal_w
 
 #: (long name, units in the scene's length L and force F) of each nodal field.
 FIELD_ATTRS = {
@@ -48,7 +48,7 @@ def _optional(name: str, extra: str = "results"):
 def node_fields(result, quantities=QUANTITIES) -> dict[str, np.ndarray]:
     """Each field of ``quantities`` at the plate's nodes: (n,) arrays in ``mesh.nodes`` order
     on every mesh; w is the nodal dof itself, the others are averaged over the cells around a
-    node (:class:`plateqp.post.NodalOperator`)."""
+    node (:class:`plateqp.model.recovery.NodalOperator`)."""
     op = NodalOperator(result.model)
     return {q: nodal_w(result.model, result.u) if q == "w" else op(result.u, result.scene.plate, q)
             for q in quantities}

@@ -2,18 +2,18 @@ r"""The graded family of plate contact problems of the qpbenchmark test set (iss
 
 One instance per (mesh, support kind, gap pattern), each exported in the three formulations,
 named ``n<mesh>_<kind>_<gaps>_<form>`` (:func:`grade_name`) so that the grade reads from the
-name. The slab is :mod:`plateqp.families`' (8 m × 8 m, 20 cm concrete, kN and m, self-weight
+name. The slab is :mod:`plateqp.scenes.families`' (8 m × 8 m, 20 cm concrete, kN and m, self-weight
 and floor load q = 10 kN/m² plus a 300 kN column at (5, 4.5)), simply supported on its four
 walls so that K is nonsingular and the dual form exists; the one-sided supports are
 
 =========  ===================================================================================
 rigid      a 7 × 7 grid of rigid posts at a·(i + 1)/8 (on nodes for every mesh of the grid)
-elastic    the same posts as elastic piles, c = :data:`plateqp.families.PILE_STIFFNESS`
-bed        a tensionless Winkler bed (k = :data:`plateqp.families.BED_MODULUS`) under the whole
+elastic    the same posts as elastic piles, c = :data:`plateqp.scenes.families.PILE_STIFFNESS`
+bed        a tensionless Winkler bed (k = :data:`plateqp.scenes.families.BED_MODULUS`) under the whole
            slab: every interior node a one-sided spring ((n − 1)² contact points)
 =========  ===================================================================================
 
-with initial gaps g0 (positive: settlement; δ = :data:`plateqp.families.GAP`, 1 mm)
+with initial gaps g0 (positive: settlement; δ = :data:`plateqp.scenes.families.GAP`, 1 mm)
 
 =========  ===================================================================================
 zero       g0 = 0 everywhere
@@ -37,8 +37,8 @@ from collections.abc import Iterator
 import numpy as np
 
 from ..errors import ProblemError
-from ..families import BED_MODULUS, GAP, PILE_STIFFNESS, WALLS, A, _loads, _plate, positions
-from ..scene import Foundation, MeshSpec, Scene, Support
+from ..scenes.families import BED_MODULUS, GAP, PILE_STIFFNESS, WALLS, A, _loads, _plate, positions
+from ..model.scene import Foundation, MeshSpec, Scene, Support
 
 MESHES = (8, 16, 32, 64)
 SUPPORT_KINDS = ("rigid", "elastic", "bed")
@@ -129,7 +129,7 @@ def graded_scene(mesh: int, kind: str, gaps: str) -> Scene:
     ref = solve(mixed, backend="pdas", formulation="primal", accuracy="high")
     if not ref.kkt.ok:
         raise ProblemError(f"{mixed.name}: the exact solve for the lift-off gaps missed its KKT check")
-    from ..assembly import build_model
+    from ..model.assembly import build_model
 
     xy = build_model(mixed).contacts.xy
     lifted = ~np.asarray(ref.active)
@@ -184,7 +184,7 @@ def graded_problems(meshes=MESHES, kinds=SUPPORT_KINDS, gaps=GAP_PATTERNS, forms
     dict (:func:`reference_solution`) also holds ``meta``: the grade, the route, its status and
     worst KKT residual, the contact count.
     """
-    from ..assembly import build_model
+    from ..model.assembly import build_model
     from ..solving import solve
     from .export import contact_qp
 

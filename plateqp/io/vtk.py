@@ -4,7 +4,7 @@
 
 - ``<stem>.vtu``: the plate's cells (``mesh.cells``: the kept quads of the structured grid, or the
   triangles of a triangle mesh) on its nodes (``mesh.nodes``), z = 0, with the nodal fields
-  (:data:`plateqp.post.QUANTITIES`: w, moments, surface stresses, σ1, σ2; averaged over the
+  (:data:`plateqp.model.recovery.QUANTITIES`: w, moments, surface stresses, σ1, σ2; averaged over the
   cells around a node) and ``displacement`` = (0, 0, −w) for ParaView's "Warp By Vector" (w is
   positive downward, z up); for a tensionless bed also the bed's ``reaction`` and ``contact``
   (1 in contact, 0 lifted, NaN where the bed does not reach) at its nodes;

@@ -40,7 +40,7 @@ def plot_mesh_tri(result: Result, units=None, *, sections=None, annotate: bool =
     from matplotlib.collections import LineCollection
     from matplotlib.lines import Line2D
 
-    from ..constraints import edge_table
+    from ..model.constraints import edge_table
     from .marks import _draw_supports, _legend_handles, _norm_sections
 
     L, F = _units(units)

@@ -6,7 +6,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import SceneError
-from ..scene import Scene
+from ..model.scene import Scene
 
 
 def names() -> list[str]:

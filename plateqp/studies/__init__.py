@@ -19,13 +19,13 @@ module                 job
                        so that a stopped sweep resumes; ``SweepResult.to_xarray`` for netCDF
 =====================  ==========================================================================
 
-Scene fields are named by dotted paths (:mod:`plateqp.paths`: :func:`get_param`,
+Scene fields are named by dotted paths (:mod:`plateqp.model.paths`: :func:`get_param`,
 :func:`set_param`, re-exported here).
 """
 
 from __future__ import annotations
 
-from ..paths import get_param, set_param
+from ..model.paths import get_param, set_param
 from .homotopy import ExactPath, ExactSweepResult, exact_path, exact_sweep
 from .design import GapRegulation, UniformStiffness, most_uniform_stiffness, regulate_gaps
 from .refinement import (ConvergenceTable, TargetResult, auto_tolerance, convergence, quantity, solve_to_target,

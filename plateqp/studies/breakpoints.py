@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import ProblemError
-from ..paths import as_number
+from ..model.paths import as_number
 from .worker import Context, next_start, solve_value
 
 

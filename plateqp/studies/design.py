@@ -43,13 +43,13 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import Model, build_model
+from ..model.assembly import Model, build_model
 from ..backends import LCP, get_backend
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError, SceneError
 from ..linalg import Factor, solve_saddle
-from ..paths import set_param
+from ..model.paths import set_param
 from ..progress import Progress
-from ..scene import PointLoad, Scene
+from ..model.scene import PointLoad, Scene
 from ..solving import solve
 from .reuse import adapt_model
 

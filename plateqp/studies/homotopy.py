@@ -34,12 +34,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..assembly import Model, build_model
+from ..model.assembly import Model, build_model
 from ..contact.scaling import Scaled
 from ..errors import MechanismError, ProblemError
-from ..paths import as_number, get_param, set_param
+from ..model.paths import as_number, get_param, set_param
 from ..progress import Progress
-from ..scene import Scene
+from ..model.scene import Scene
 from ..sensitivity import MAX_DEGENERATE, classify, held_solve, one_direction
 from ..solving import solve
 from .reuse import adapt_model
@@ -133,7 +133,7 @@ def linear_data(scene: Scene, path: str, start: float, stop: float):
     """(model at ``start``, df/dt on the free dofs, dg0/dt at the contact points, d(shift)/dt)
     if PATH enters the problem linearly between ``start`` and ``stop``; a ProblemError saying
     why not otherwise. ``shift`` is the deflection the prescribed dofs give each contact point
-    (:class:`plateqp.assembly.ContactOperator`): it moves with a prescribed displacement."""
+    (:class:`plateqp.model.assembly.ContactOperator`): it moves with a prescribed displacement."""
     get_param(scene, path)  # a bad path names what exists
     leaf = path.rsplit(".", 1)[-1]
     if leaf == "stiffness" or path.startswith("foundation.k"):

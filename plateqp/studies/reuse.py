@@ -12,8 +12,8 @@ import dataclasses
 
 import numpy as np
 
-from ..assembly import Model, mesh_generator
-from ..scene import Scene
+from ..model.assembly import Model, mesh_generator
+from ..model.scene import Scene
 
 
 def same_structure(a: Scene, b: Scene) -> bool:
@@ -32,7 +32,7 @@ def same_structure(a: Scene, b: Scene) -> bool:
 
 
 def _point_loads(scene: Scene) -> list:
-    from ..scene import PointLoad
+    from ..model.scene import PointLoad
 
     return [(ld.x, ld.y) for ld in scene.loads if isinstance(ld, PointLoad)]
 
@@ -43,7 +43,7 @@ def adapt_model(base: Model, scene: Scene) -> Model | None:
     Gaps, support stiffnesses, the bed's modulus and gap field and the loads are changed in
     copies of the arrays; the stiffness matrix and contact operator B are shared. The gaps are
     the scene's, shifted by the prescribed dofs as in ``base``
-    (:meth:`plateqp.assembly.ContactOperator.with_gaps`).
+    (:meth:`plateqp.model.assembly.ContactOperator.with_gaps`).
     """
     old = base.scene
     if not same_structure(old, scene):

@@ -6,7 +6,7 @@ sets differ, the change is located by bisection (:mod:`plateqp.studies.breakpoin
 the model (stiffness matrix, contact operator) is built once per worker and only the gaps,
 support flexibilities or loads are changed in a copy when the parameter does not change K
 (:func:`plateqp.studies.reuse.adapt_model`); the max nodal σ1 of each row is then computed
-with operators built once per mesh (:class:`plateqp.post.NodalOperator`). Warm starts
+with operators built once per mesh (:class:`plateqp.model.recovery.NodalOperator`). Warm starts
 (``options={"active": ...}``: the previous solve's own final state, ``Result.extras["active"]``,
 else its contact set) go only to backends that take them (:data:`WARM_START_BACKENDS`), with
 re-use on; ``warm_start=False`` turns them off alone. Where the values are solved:
@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ProblemError
-from ..paths import as_number, check_values, get_param
-from ..scene import Scene
+from ..model.paths import as_number, check_values, get_param
+from ..model.scene import Scene
 from .breakpoints import Bisection, contact_set, refine_bracket
 from ..progress import Progress
 from .parallel import SERIAL_BELOW, make_runner
@@ -191,11 +191,11 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
 
     Parameters
     ----------
-    scene, path : the scene and the field to vary (see :func:`plateqp.paths.set_param`; the
+    scene, path : the scene and the field to vary (see :func:`plateqp.model.paths.set_param`; the
         same path language as ``plateqp sweep --param``: ``supports.1.gap`` is the first
         support, supports being numbered from 1 as in every table)
     values : the values, in sweep order ("rigid" allowed for a stiffness); every one is
-        checked against the scene before any solve (:func:`plateqp.paths.check_values`)
+        checked against the scene before any solve (:func:`plateqp.model.paths.check_values`)
     backend, formulation, accuracy, options : as for :func:`plateqp.solve`
     executor : None (local processes, ``max_workers`` of them, or this process for fewer
         than :data:`SERIAL_BELOW` values), "serial", "process", any

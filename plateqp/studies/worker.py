@@ -1,7 +1,7 @@
 """The work of a sweep's worker: solve the scene with PATH = value, and record the row.
 
 A worker (this process or another) keeps, per sweep, the base model built once and the
-nodal operator of its mesh (:func:`plateqp.post.nodal_operator`); with re-use each value's
+nodal operator of its mesh (:func:`plateqp.model.recovery.nodal_operator`); with re-use each value's
 model is the base adapted to it (:func:`plateqp.studies.reuse.adapt_model`). Warm starts
 (``options={"active": ...}``: the previous solve's own final state, ``Result.extras["active"]``,
 else its contact set) go only to backends that take them (:data:`WARM_START_BACKENDS`).
@@ -18,12 +18,12 @@ from typing import Any
 
 import numpy as np
 
-from ..assembly import Model, build_model
+from ..model.assembly import Model, build_model
 from ..contact.routing import repeated_solves
 from ..errors import NoEquilibriumError, PlateQPWarning
-from ..paths import set_param
-from ..post import NodalOperator, nodal_operator
-from ..scene import Scene
+from ..model.paths import set_param
+from ..model.recovery import NodalOperator, nodal_operator
+from ..model.scene import Scene
 from ..solving import solve
 from .reuse import adapt_model
 
@@ -49,7 +49,7 @@ class Context:
 @dataclass
 class Base:
     """What a worker keeps of a sweep: the base model and, built on first use, the operator
-    of the rows' nodal fields on its mesh (:class:`plateqp.post.NodalOperator`)."""
+    of the rows' nodal fields on its mesh (:class:`plateqp.model.recovery.NodalOperator`)."""
 
     model: Model
     nodal: NodalOperator | None = None

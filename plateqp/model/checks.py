@@ -1,0 +1,197 @@
+"""The scene's field checks, in the order a reader meets the fields: plate and mesh, edges,
+cut-outs (and the mesh they leave), pins, loads, supports, foundation. Each raises a
+:class:`~plateqp.errors.SceneError` naming the first bad field (through the scene's ``_fail``
+and ``_num``: the file, where the scene came from one). :meth:`plateqp.model.scene.Scene.validate`
+runs them after the parts' types are checked (:mod:`plateqp.model.parts`)."""
+
+from __future__ import annotations
+
+from .elements import ELEMENTS
+from .parts import _short
+
+#: No scene needs more cells than this; the memory a mesh needs is checked before assembly
+#: (:func:`plateqp.model.assembly.check_memory`), this only keeps validation itself small.
+MAX_CELLS = 10_000_000
+EDGE_KINDS = ("free", "simple", "clamped")
+GAP_PROFILES = ("uniform", "linear", "trough", "bump")
+
+
+def check_scene(sc) -> None:
+    """Every field of the scene ``sc``; the checks that need the mesh's cover use one built once."""
+    check_plate_and_mesh(sc)
+    check_edges(sc)
+    grid = check_cutouts(sc)
+    check_pins(sc, grid)
+    check_loads(sc, grid)
+    check_supports(sc, grid)
+    if sc.foundation is not None:
+        check_foundation(sc, grid)
+
+
+def check_plate_and_mesh(sc) -> None:
+    p, m = sc.plate, sc.mesh
+    for k in ("a", "b", "h", "E"):
+        sc._num(f"plate.{k}", getattr(p, k), positive=True, physical=True)
+    sc._num("plate.nu", p.nu)
+    if not (-1.0 < p.nu < 0.5):
+        sc._fail("plate.nu", f"must lie in (-1, 0.5) (got {p.nu})")
+    for k in ("nx", "ny"):
+        v = getattr(m, k)
+        if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+            sc._fail(f"mesh.{k}", f"must be an integer >= 1 (got {_short(v)})")
+        if v > MAX_CELLS:
+            sc._fail(f"mesh.{k}", f"{_short(v)} cells is more than any plate needs (at most {MAX_CELLS:.0e})")
+    if m.nx * m.ny > MAX_CELLS:
+        sc._fail("mesh", f"{m.nx} x {m.ny} = {m.nx * m.ny:.2g} cells is more than any plate needs "
+                 f"(at most {MAX_CELLS:.0e}); the memory a mesh needs is checked before assembly")
+    if not isinstance(m.element, str) or m.element not in ELEMENTS:
+        sc._fail("mesh.element", f"unknown element {_short(m.element)}; choose one of {tuple(ELEMENTS)}")
+    if not sc.triangles and (p.shape is not None or m.size is not None):
+        sc._fail("plate.shape" if p.shape is not None else "mesh.size",
+                 'needs a triangle mesh: set mesh.element = "dkt"')
+
+
+def check_edges(sc) -> None:
+    """Each edge's kind and values (its name: :func:`check_cutouts`, once the boundaries are known)."""
+    for name, e in sc.edges.items():
+        if e.kind not in EDGE_KINDS:
+            sc._fail(f"edges.{name}", f"unknown kind {e.kind!r}; choose one of {EDGE_KINDS}")
+        sc._num(f"edges.{name}.w", e.w, physical=True)
+        sc._num(f"edges.{name}.slope", e.slope, physical=True)
+        if e.kind == "free" and (e.w != 0.0 or e.slope != 0.0):
+            sc._fail(f"edges.{name}", "a free edge cannot carry a prescribed w or slope; make it simple or clamped")
+        if e.kind == "simple" and e.slope != 0.0:
+            sc._fail(f"edges.{name}.slope", "a slope can only be prescribed on a clamped edge")
+
+
+def check_cutouts(sc):
+    """The openings' boxes, the shape and holes (on triangles), what they leave of the plate, and
+    the edge names on its boundaries (:func:`plateqp.model.constraints.edge_table`). Returns the cover
+    the point checks ask (``covers``, ``locate``, ``node_at``, ``covers_area``, ``cells_centred_in``):
+    the grid, or on triangles the plate's region."""
+    from .constraints import edge_table, warn_changed_all
+
+    for i, o in enumerate(sc.openings):
+        for k in ("x0", "x1", "y0", "y1"):
+            sc._num(f"openings.{i}.{k}", getattr(o, k))
+        if not (o.x0 < o.x1 and o.y0 < o.y1):
+            sc._fail(f"openings.{i}", "needs x0 < x1 and y0 < y1")
+    grid = plate_cover(sc)
+    if not grid.cell_mask.any():
+        sc._fail("openings" if sc.openings else "holes", "the cut-outs remove every cell of the plate")
+    edge_table(sc, grid.domain)  # every edge name known, and no segment named twice
+    warn_changed_all(sc, grid.domain)
+    return grid
+
+
+def plate_cover(sc):
+    """What the point checks ask of the plate (``covers``, ``locate``, ``node_at``,
+    ``covers_area``, ``cells_centred_in``, ``domain``): the grid, or on triangles the plate's
+    region (its shape and cut-outs checked: :func:`plateqp.model.geometry.validate_shaped`)."""
+    from .geometry import validate_shaped
+    from .grid import Grid
+
+    return validate_shaped(sc) if sc.triangles else Grid.from_scene(sc)
+
+
+def check_pins(sc, grid) -> None:
+    for i, pin in enumerate(sc.pins):
+        sc._num(f"pins.{i}.x", pin.x)
+        sc._num(f"pins.{i}.y", pin.y)
+        sc._num(f"pins.{i}.w", pin.w, physical=True)
+        sc._inside(f"pins.{i}", pin.x, pin.y, grid)
+        if grid.node_at(pin.x, pin.y) is None:
+            sc._fail(f"pins.{i}", f"({pin.x}, {pin.y}) is not a mesh node (node spacing {grid.hx:g} x {grid.hy:g});"
+                     " move the pin or change mesh.nx / mesh.ny")
+
+
+def check_loads(sc, grid) -> None:
+    for i, ld in enumerate(sc.loads):
+        where = f"loads.{i}"
+        kind = getattr(ld, "type", None)
+        if kind not in ("uniform", "patch", "point"):
+            sc._fail(where, f"not a load: {ld!r}")
+        if kind == "point":
+            sc._num(f"{where}.P", ld.P, physical=True)
+            sc._num(f"{where}.x", ld.x)
+            sc._num(f"{where}.y", ld.y)
+            sc._inside(where, ld.x, ld.y, grid)
+            continue
+        sc._num(f"{where}.q", ld.q, physical=True)
+        if kind == "patch":
+            for k in ("x0", "x1", "y0", "y1"):
+                sc._num(f"{where}.{k}", getattr(ld, k))
+            if not (ld.x0 < ld.x1 and ld.y0 < ld.y1):
+                sc._fail(where, "needs x0 < x1 and y0 < y1")
+            x0, x1, y0, y1 = grid.domain.outer.bbox
+            if ld.x1 <= x0 or ld.x0 >= x1 or ld.y1 <= y0 or ld.y0 >= y1:
+                sc._fail(where, "the patch does not overlap the plate")
+            if not grid.covers_area(ld.x0, ld.x1, ld.y0, ld.y1):
+                sc._fail(where, "the patch lies entirely in an opening (no plate there to load)")
+
+
+def check_supports(sc, grid) -> None:
+    """Each support's place (on the plate, not on another's point), gap and stiffness; supports
+    are numbered from 1, as in every table."""
+    seen: dict[tuple[float, float], int] = {}
+    tol = 1e-9 * max(sc.plate.a, sc.plate.b)
+    covered = sc._covered(grid, [(getattr(s, "x", None), getattr(s, "y", None)) for s in sc.supports])
+    for i, s in enumerate(sc.supports):
+        where = f"supports.{i + 1}"
+        sc._num(f"{where}.x", s.x)
+        sc._num(f"{where}.y", s.y)
+        sc._num(f"{where}.gap", s.gap, physical=True)
+        sc._inside(where, s.x, s.y, grid, None if covered is None else covered[i])
+        if isinstance(s.stiffness, str):
+            if s.stiffness != "rigid":
+                sc._fail(f"{where}.stiffness", f"must be \"rigid\" or a positive number (got {s.stiffness!r})")
+        else:
+            sc._num(f"{where}.stiffness", s.stiffness, positive=True, physical=True)
+        key = (round(s.x / tol), round(s.y / tol))
+        if key in seen:
+            sc._fail(where, f"lies on the same point as supports.{seen[key] + 1}; merge them into one support")
+        seen[key] = i
+
+
+def check_foundation(sc, grid) -> None:
+    """The bed's modulus, region (a box, or on triangles a polygon) and gap (a number or a profile)."""
+    f = sc.foundation
+    sc._num("foundation.k", f.k, positive=True, physical=True)
+    if isinstance(f.region, dict) and sc.triangles:  # a polygon region: plateqp.model.geometry
+        from .geometry import check_polygon_region
+
+        check_polygon_region(sc, grid)
+    elif f.region is not None:
+        if not isinstance(f.region, (list, tuple)) or len(f.region) != 4:
+            sc._fail("foundation.region", "must be [x0, x1, y0, y1]" + (" or { polygon = [[x, y], ...] }"
+                     if sc.triangles else "") + f" (got {_short(f.region)})")
+        for j, v in enumerate(f.region):
+            sc._num(f"foundation.region.{j}", v)
+        x0, x1, y0, y1 = f.region
+        if not (x0 < x1 and y0 < y1):
+            sc._fail("foundation.region", "needs x0 < x1 and y0 < y1")
+        if not grid.cells_centred_in(x0, x1, y0, y1).any():
+            sc._fail("foundation.region", f"[{x0}, {x1}, {y0}, {y1}] holds the centre of no cell of "
+                     "the plate (it is off the plate, in an opening, or smaller than a cell): "
+                     "the bed would have no node")
+    check_gap(sc, f.gap)
+
+
+def check_gap(sc, g) -> None:
+    if isinstance(g, dict):
+        prof = g.get("profile")
+        if prof not in GAP_PROFILES:
+            sc._fail("foundation.gap.profile", f"unknown profile {prof!r}; choose one of {GAP_PROFILES}")
+        need = {"uniform": ("g0",), "linear": (), "trough": ("x", "y", "radius", "depth"),
+                "bump": ("x", "y", "radius", "depth")}[prof]
+        allowed = {"profile", *need, *(("gx", "gy", "g0") if prof == "linear" else ())}
+        for k in need:
+            if k not in g:
+                sc._fail(f"foundation.gap.{k}", f"missing (profile {prof!r} needs {need})")
+        for k, v in g.items():
+            if k not in allowed:
+                sc._fail(f"foundation.gap.{k}", f"unknown key for profile {prof!r}; allowed {sorted(allowed)}")
+            if k != "profile":
+                sc._num(f"foundation.gap.{k}", v, positive=(k == "radius"), physical=True)
+    elif not callable(g):
+        sc._num("foundation.gap", g, physical=True)
