@@ -27,7 +27,7 @@ from ..io.files import safe_filename
 from .common import _accuracy, _out_dir, _output, _probe, _target
 from .solve import cmd_solve
 from .studies import cmd_regulate, cmd_sweep
-from .tools import cmd_backends, cmd_demo, cmd_export
+from .tools import cmd_backends, cmd_demo, cmd_export, cmd_verify
 
 
 #: Options whose value may start with a minus sign (a heave, a negative range or probe).
@@ -156,6 +156,12 @@ def main(argv=None) -> int:
     r.add_argument("--json", action="store_true")
     r.add_argument("--out", metavar="FILE.toml", help="write the regulated scene (checked before any work)")
     r.add_argument("--force", action="store_true", help="--out: overwrite the file if it exists")
+    v = sub.add_parser("verify", help="the verification ladder: closed forms and independent references on "
+                       "meshes that halve (error, observed rate, pass/fail); exit code 5 if a case fails")
+    v.add_argument("--quick", action="store_true", help="two meshes per case (a few seconds) instead of three or four")
+    v.add_argument("--case", action="append", metavar="NAME", help="run only this case (repeatable; names: "
+                   "the first column of the table)")
+    v.add_argument("--json", action="store_true", help="the rows as JSON")
     b = sub.add_parser("backends", help="list the backends and the formulations each takes")
     b.add_argument("--json", action="store_true")
     for p in sub.choices.values():
@@ -168,7 +174,7 @@ def main(argv=None) -> int:
     try:
         with _output(args.quiet, args.verbose):
             return {"demo": cmd_demo, "solve": cmd_solve, "sweep": cmd_sweep, "backends": cmd_backends,
-                    "export": cmd_export, "regulate": cmd_regulate}[args.cmd](args)
+                    "export": cmd_export, "regulate": cmd_regulate, "verify": cmd_verify}[args.cmd](args)
     except KeyboardInterrupt:
         print("plateqp: interrupted", file=sys.stderr)
         return 130

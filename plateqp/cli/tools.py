@@ -1,4 +1,4 @@
-"""``plateqp demo``, ``plateqp backends``, ``plateqp export``.
+"""``plateqp demo``, ``plateqp backends``, ``plateqp export``, ``plateqp verify``.
 """
 
 from __future__ import annotations
@@ -63,3 +63,21 @@ def cmd_export(args) -> int:
           f"{0 if qp.G is None else qp.G.shape[0]} inequality rows, "
           f"{'sparse' if qp.sparse else 'dense'} P ({qp.P.nnz if qp.sparse else np.count_nonzero(qp.P)} nonzeros)")
     return 0
+
+
+#: ``plateqp verify``'s exit code when a case fails (0: every case passes).
+VERIFY_FAILED = 5
+
+
+def cmd_verify(args) -> int:
+    """``plateqp verify``: the verification ladder as a table (or JSON rows); 5 if a case fails."""
+    from ..studies.verify import format_rows, verify
+
+    rows = verify(quick=args.quick, names=args.case)
+    finals = [r for r in rows if r.passed is not None]
+    if args.json:
+        print(json.dumps({"quick": bool(args.quick), "passed": sum(r.passed for r in finals),
+                          "cases": len(finals), "rows": [r.to_dict() for r in rows]}, indent=1))
+    else:
+        print(format_rows(rows))
+    return 0 if all(r.passed for r in finals) else VERIFY_FAILED
