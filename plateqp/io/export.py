@@ -93,7 +93,7 @@ class ExportedQP:
 
 
 def safe_name(name: str) -> str:
-    """A problem name safe for file names and MPS records: letters, digits, ``_ . -`` only."""
+    """A problem name safe for file names and MPS records: letters, digits, ``_``, ``.`` and ``-`` only."""
     out = _NAME_OK.sub("_", str(name)).strip("_")
     return out or "plateqp"
 

@@ -200,7 +200,8 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
                       densify_max_n: int | None = None, known_timeouts: dict | None = None,
                       settings=tuple(QPBENCHMARK_TOLERANCES), force: bool = False) -> Path:
     """Write a qpbenchmark test set: ``directory/<name>.py``, ``directory/<data_dir>/*.npz`` (and
-    ``directory/<solutions_dir>/*.npz`` with references).
+    ``directory/<solutions_dir>/*.npz`` with references). Everything is checked
+    (:func:`check_testset_dir`) before anything is written.
 
     Parameters
     ----------
@@ -222,8 +223,9 @@ def write_qpbenchmark(problems, directory, name: str = "plateqp_contact", *, tit
         the set defines, so a run of fewer settings needs a set of fewer)
     force : write into a non-empty directory (files of the same names are replaced)
 
-    Everything is checked (:func:`check_testset_dir`) before anything is written. Returns the
-    path of the module.
+    Returns
+    -------
+    The path of the module.
     """
     items = [(safe_name(p.name), p) if isinstance(p, ExportedQP) else (safe_name(p[0]), p[1]) for p in problems]
     names = [n for n, _ in items]
