@@ -247,7 +247,7 @@ def local_stiffness(data: Scaled) -> np.ndarray:
     # Rayleigh: for u = b/(b·b), b·u = 1 and uᵀKu = bKbᵀ/(b·b)² bounds the condensed stiffness
     # 1/(b K⁻¹ bᵀ) from above, whatever K is. Σ b_j² K_jj is no bound where most of a support's
     # interpolation weight sits on prescribed dofs (a support beside a clamped edge: it said 11.9
-    # where the plate's stiffness is about 8e4, and wrong reactions passed; issue 10).
+    # where the plate's stiffness is about 8e4, and wrong reactions passed).
     kb = plate_stiffness(data)
     return kb / (1.0 + data.rho * kb)
 

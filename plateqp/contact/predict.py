@@ -2,7 +2,7 @@
 
 A bed's (or a field of soft supports') contact set moves little when the mesh is refined: the
 benchmark bed solved at a quarter of the cells a side gets 8 of 16 641 springs wrong at 128²,
-5 of 66 049 at 256² (benchmarks/README.md, "Where issue 11 stands"). pdas's sparse method on
+5 of 66 049 at 256² (benchmarks/README.md). pdas's sparse method on
 soft rows (springs no stiffer than the plate under them) then builds its one factorisation for
 that set instead of for every row: its first step finds (nearly) nothing to change, the few
 wrong rows are taken by a low-rank correction, and the second factorisation a cold start needs

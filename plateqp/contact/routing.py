@@ -27,12 +27,12 @@ from .scaling import Scaled
 #   instead of a factorisation: a sweep of 10 gaps at 128² took 0.45× PDAS's time), and BPP's answer did not depend on its warm start
 #   (bit-identical serial and parallel sweeps in tests/studies/test_parallel.py, where warm-started
 #   PDAS differed at 1e-13). A single solve of a floating plate went to the condensed route
-#   too while m ≤ AUTO_LCP_MAX, while PDAS had no first phase for a singular K; since issue
-#   11's seventh session (the anchored first set) it goes to PDAS like any other: measured
+#   too while m ≤ AUTO_LCP_MAX, while PDAS had no first phase for a singular K; with the
+#   anchored first set it goes to PDAS like any other: measured
 #   on families.floating(n, k), 9–81 posts, CPU medians of 3, accuracy 1e-10, PDAS took
 #   1.05–1.4× BPP's time then (0.04–0.05 s at 32², 0.13–0.15 s at 64², 0.76–1.0 s at 128²),
 #   but at 128² BPP's answers were INACCURATE (KKT 1–2e-10: the condensation of a singular K,
-#   shifted and unshifted, costs digits) where PDAS's were at 1–2e-11. Since the eighth session
+#   shifted and unshifted, costs digits) where PDAS's were at 1–2e-11. Now
 #   PDAS's exact steps run on the anchored factorisation itself (pdas.factor.TrailingFactor):
 #   0.67–0.96× BPP's time (benchmarks/bench_floating.py, interleaved, results/floating-s26.csv).
 # * which backend, read from the declared capabilities (plateqp.backends.base.Backend): an

@@ -1,7 +1,7 @@
 """Where an export may write, checked before any work is done (the writing itself, and the rules
 for links: :mod:`plateqp.io.safe`).
 
-The promise (issue 10): nothing is written outside the path asked for, nothing that exists is
+The promise: nothing is written outside the path asked for, nothing that exists is
 overwritten unless forced, and a path that cannot be written says so in one line before the
 problem is built, not with a traceback after. A symbolic link at the path counts as something
 that exists (a dangling one too: writing through it would write somewhere else).

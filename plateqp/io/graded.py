@@ -1,4 +1,4 @@
-r"""The graded family of plate contact problems of the qpbenchmark test set (issue 15).
+r"""The graded family of plate contact problems of the qpbenchmark test set.
 
 One instance per (mesh, support kind, gap pattern), each exported in the three formulations,
 named ``n<mesh>_<kind>_<gaps>_<form>`` (:func:`grade_name`) so that the grade reads from the
