@@ -26,6 +26,10 @@ def check_scene(sc) -> None:
     check_supports(sc, grid)
     if sc.foundation is not None:
         check_foundation(sc, grid)
+    if sc.mesh.symmetry is not None:
+        from .symmetry import check_symmetry
+
+        check_symmetry(sc, grid.domain)
 
 
 def check_plate_and_mesh(sc) -> None:
@@ -46,6 +50,11 @@ def check_plate_and_mesh(sc) -> None:
                  f"(at most {MAX_CELLS:.0e}); the memory a mesh needs is checked before assembly")
     if not isinstance(m.element, str) or m.element not in ELEMENTS:
         sc._fail("mesh.element", f"unknown element {_short(m.element)}; choose one of {tuple(ELEMENTS)}")
+    if m.symmetry in ("none", ""):  # a path's way to ask for none
+        m.symmetry = None
+    if m.symmetry is not None and m.symmetry not in ("x", "y", "xy"):
+        sc._fail("mesh.symmetry", f'must be "x", "y" or "xy" (a mesh mirrored in the plate\'s centre line x = xc, '
+                 f"y = yc or both) or absent (got {_short(m.symmetry)})")
     if not sc.triangles and (p.shape is not None or m.size is not None):
         sc._fail("plate.shape" if p.shape is not None else "mesh.size",
                  'needs a triangle mesh: set mesh.element = "dkt"')
