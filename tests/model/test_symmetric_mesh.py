@@ -58,6 +58,19 @@ def slab_scene(symmetry="x", **kw):
     return pq.Scene(**base)
 
 
+def hexagon_scene(dx=-10.0, dy=-5.0):
+    """A hexagon centred at (dx, dy) (lines at negative coordinates: the part kept is the one
+    below and left of them), vertices and posts on the lines, openings across the line x = dx,
+    a bed box across both."""
+    hexa = [[-3, -1], [-1, -2], [1, -2], [3, -1], [3, 1], [1, 2], [-1, 2], [-3, 1]]
+    posts = [(0, 2), (0, -2), (3, 0), (-3, 0), (1, 0.5), (-1, 0.5), (1, -0.5), (-1, -0.5)]
+    return pq.Scene(plate=pq.Plate(h=0.2, E=3e7, nu=0.2, shape={"polygon": [[x + dx, y + dy] for x, y in hexa]}),
+                    mesh=pq.MeshSpec(element="dkt", size=0.25, symmetry="xy"), loads=[pq.UniformLoad(1.0)],
+                    openings=[pq.Opening(dx - 0.5, dx + 0.5, dy + 0.8, dy + 1.2), pq.Opening(dx - 0.5, dx + 0.5, dy - 1.2, dy - 0.8)],
+                    supports=[pq.Support(x=x + dx, y=y + dy) for x, y in posts],
+                    foundation=pq.Foundation(k=10.0, region=[dx - 2, dx + 2, dy - 1.5, dy + 1.5]))
+
+
 def mirrored(nodes, axis, c):
     out = nodes.copy()
     out[:, axis] = 2 * c - nodes[:, axis]
@@ -86,7 +99,8 @@ def assert_mirror_symmetric(mesh, axis, c):
     (lambda: disc_scene("xy"), [(0, 0.0), (1, 0.0)]),
     (lambda: slab_scene("x"), [(0, 2.0)]),
     (lambda: slab_scene("xy"), [(0, 2.0), (1, 1.0)]),
-], ids=["disc-y", "disc-x", "disc-xy", "slab-x", "slab-xy"])
+    (hexagon_scene, [(0, -10.0), (1, -5.0)]),
+], ids=["disc-y", "disc-x", "disc-xy", "slab-x", "slab-xy", "hexagon-xy"])
 def test_the_mesh_is_its_own_mirror_image_bit_for_bit(make, lines):
     mesh = TriMesh.from_scene(make())
     assert np.all(mesh.areas() > 0)
