@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from .elements import ELEMENTS
 from .parts import _short
+from .symmetry import MODES, check_symmetry
 
 #: No scene needs more cells than this; the memory a mesh needs is checked before assembly
 #: (:func:`plateqp.model.assembly.check_memory`), this only keeps validation itself small.
@@ -26,6 +27,8 @@ def check_scene(sc) -> None:
     check_supports(sc, grid)
     if sc.foundation is not None:
         check_foundation(sc, grid)
+    if sc.mesh.symmetry is not None:
+        check_symmetry(sc, grid.domain)
 
 
 def check_plate_and_mesh(sc) -> None:
@@ -46,6 +49,11 @@ def check_plate_and_mesh(sc) -> None:
                  f"(at most {MAX_CELLS:.0e}); the memory a mesh needs is checked before assembly")
     if not isinstance(m.element, str) or m.element not in ELEMENTS:
         sc._fail("mesh.element", f"unknown element {_short(m.element)}; choose one of {tuple(ELEMENTS)}")
+    if m.symmetry in ("none", ""):  # a path's way to ask for none
+        m.symmetry = None
+    if m.symmetry is not None and m.symmetry not in MODES:
+        sc._fail("mesh.symmetry", f'must be "x", "y" or "xy" (a mesh mirrored in the plate\'s centre line x = xc, '
+                 f"y = yc or both) or absent (got {_short(m.symmetry)})")
     if not sc.triangles and (p.shape is not None or m.size is not None):
         sc._fail("plate.shape" if p.shape is not None else "mesh.size",
                  'needs a triangle mesh: set mesh.element = "dkt"')

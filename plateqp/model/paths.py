@@ -155,7 +155,7 @@ def _coerce(where: str, old, value):
         if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isinf(value) and value > 0:
             return "rigid"
     edge_itself = where.startswith("edges.") and where.count(".") == 1
-    if isinstance(value, str) and leaf not in ("name", "element", "kind", "profile") and not edge_itself:
+    if isinstance(value, str) and leaf not in ("name", "element", "kind", "profile", "symmetry") and not edge_itself:
         try:
             value = float(value)
         except ValueError:

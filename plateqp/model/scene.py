@@ -56,12 +56,15 @@ class Plate:
 
 @dataclass
 class MeshSpec:
-    """An nx × ny grid of equal rectangles and the element; "dkt": triangles of size ``size``."""
+    """An nx × ny grid of equal rectangles and the element; "dkt": triangles of size ``size``.
+    ``symmetry``: "x", "y" or "xy", a mesh that is its own mirror image in the plate's centre
+    line x = xc, y = yc or both (:mod:`plateqp.model.symmetry`); None: no such demand."""
 
     nx: int = 16
     ny: int = 16
     element: str = "acm"
     size: float | None = None
+    symmetry: str | None = None
 
 
 @dataclass
@@ -438,6 +441,8 @@ class Scene:
         d: dict[str, Any] = {"name": self.name, "plate": asdict(self.plate), "mesh": asdict(self.mesh)}
         from .geometry import tidy_dict
         tidy_dict(self, d)  # the shape, holes and mesh size when set
+        if self.mesh.symmetry is None:
+            del d["mesh"]["symmetry"]
         if self.edges:
             d["edges"] = {k: (e.kind if (e.w == 0.0 and e.slope == 0.0) else asdict(e)) for k, e in self.edges.items()}
         for key in ("openings", "pins", "supports"):

@@ -45,6 +45,9 @@ WORDS: dict[type, dict[str, tuple[str, str]]] = {
         "ny": ("1", "cells along y"),
         "element": ("", "the plate element: \"acm\" or \"bfs\" (rectangles, the grid), \"dkt\" (triangles, gmsh)"),
         "size": ("L", "target element size h on triangle meshes (default: the plate's size / 16)"),
+        "symmetry": ("", "\"x\", \"y\" or \"xy\": a mesh that is its own mirror image in the plate's centre "
+                         "line x = xc, y = yc or both (triangles: one part meshed and mirrored); the scene must be "
+                         "symmetric; \"none\" or absent: no such demand"),
     },
     S.Edge: {
         "kind": ("", "\"free\", \"simple\" (w prescribed) or \"clamped\" (w and the outward slope prescribed); "

@@ -29,6 +29,8 @@ import scipy.sparse as sp
 
 from ..errors import SceneError
 from .geometry import Domain, Polygon, _point_segment, inner_segments, lumped_region, region_outline
+from .symmetry import TOL as SYMMETRY_TOL
+from .symmetry import boundary_of, build_part, mirror_lines, read_triangles, unfold
 
 #: refinement around embedded points: size REFINE·h at the point, h from 2h away
 REFINE = 0.25
@@ -121,7 +123,8 @@ class TriMesh:
                                                          if isinstance(ld, PointLoad)] + [(p.x, p.y) for p in scene.pins]
         lines = [] if scene.foundation is None or scene.foundation.region is None else inner_segments(
             domain, region_outline(scene.foundation.region))
-        return mesh_domain(domain, mesh_size(scene), points, lines)
+        mirrors = mirror_lines(domain, scene.mesh.symmetry) if scene.mesh.symmetry else ()
+        return mesh_domain(domain, mesh_size(scene), points, lines, mirrors)
 
     # the meshes of a refinement ladder, counted in cells a side (plateqp.studies.refinement)
     @staticmethod
@@ -290,23 +293,26 @@ def _barycentric(p, x, y):
     return np.column_stack([1.0 - l2 - l3, l2, l3])
 
 
-def mesh_domain(domain: Domain, size: float, points=(), lines=()) -> TriMesh:
+def mesh_domain(domain: Domain, size: float, points=(), lines=(), mirrors=()) -> TriMesh:
     """Mesh ``domain`` with gmsh at target size ``size``; every point of ``points`` becomes a node,
     every segment of ``lines`` ((x0, y0), (x1, y1)) runs along element edges.
 
     Points on the boundary are embedded in its curve, points inside in the surface (or in a line
     they lie on); a point at a polygon vertex is that vertex. Duplicates are merged. A line must
     lie inside the plate (:func:`plateqp.model.geometry.inner_segments`); its ends may touch the boundary.
+    ``mirrors``: lines ((axis, c), ...) the domain, points and lines are symmetric about (checked
+    by the scene: :func:`plateqp.model.symmetry.check_symmetry`); the mesh is then one part's,
+    mirrored (:mod:`plateqp.model.symmetry`).
     """
     with _GMSH_LOCK:  # gmsh is one global session: one mesh at a time (threaded executors)
-        return _mesh_domain(domain, size, points, lines)
+        return _mesh_domain(domain, size, points, lines, tuple(mirrors))
 
 
 #: gmsh keeps one global session and model list: two threads meshing at once would clash.
 _GMSH_LOCK = threading.RLock()
 
 
-def _mesh_domain(domain: Domain, size: float, points=(), lines=()) -> TriMesh:
+def _mesh_domain(domain: Domain, size: float, points=(), lines=(), mirrors=()) -> TriMesh:
     gmsh = import_gmsh()
     owner = not gmsh.isInitialized()
     if owner:
@@ -325,6 +331,8 @@ def _mesh_domain(domain: Domain, size: float, points=(), lines=()) -> TriMesh:
         gmsh.option.setNumber("Mesh.ElementOrder", 1)
         gmsh.model.add(name)
         try:
+            if mirrors:
+                return _mesh_mirrored(gmsh, domain, float(size), points, lines, mirrors)
             return _mesh(gmsh, domain, float(size), points, lines)
         except Exception as exn:  # gmsh raises plain Exceptions with its own message
             raise SceneError(f"mesh: gmsh could not mesh the plate at size {size:g} ({str(exn).splitlines()[0]})") from exn
@@ -347,6 +355,17 @@ def _mesh(gmsh, domain: Domain, h: float, points, lines=()) -> TriMesh:
     _size_field(gmsh, h, [t for t, _ in embedded])
     gmsh.model.mesh.generate(2)
     return _read_mesh(gmsh, surf, curves.owner, h, domain)
+
+
+def _mesh_mirrored(gmsh, domain: Domain, h: float, points, lines, mirrors) -> TriMesh:
+    """The steps of :func:`mesh_domain` for a symmetric domain: one part of it cut, meshed with the
+    refinement of the whole, read back and mirrored in each line (:mod:`plateqp.model.symmetry`)."""
+    tol = SYMMETRY_TOL * domain.size
+    refined = build_part(gmsh, domain, points, lines, mirrors, tol)
+    _size_field(gmsh, h, refined)
+    gmsh.model.mesh.generate(2)
+    nodes, tris = unfold(*read_triangles(gmsh), mirrors, tol)
+    return TriMesh(nodes, tris, *boundary_of(nodes, tris, domain, h), h, domain)
 
 
 @dataclass
