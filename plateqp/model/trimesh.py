@@ -28,6 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SceneError
+from .blocks import assemble_blocks
 from .geometry import Domain, Polygon, _point_segment, inner_segments, lumped_region, region_outline
 
 #: refinement around embedded points: size REFINE·h at the point, h from 2h away
@@ -105,8 +106,8 @@ class TriMesh:
         return self.edges, self.normals, self.boundary, self.segment
 
     # -- the generator's side of building a model (plateqp.model.assembly.build_model) ----------------
-    #: the summed element matrices are symmetric to rounding, not value for value
-    symmetric_assembly = False
+    #: the assembled stiffness is symmetric value for value (:meth:`assemble`: summed by node blocks)
+    symmetric_assembly = True
     estimate_nodes = staticmethod(lambda scene: estimate_nodes(scene))
 
     @classmethod
@@ -187,18 +188,12 @@ class TriMesh:
         return np.arange(len(self.triangles))
 
     def assemble(self, element, D: float, nu: float, pos: np.ndarray, ncol: int) -> sp.csr_matrix:
-        """The stiffness on the dofs with ``pos`` ≥ 0 (``pos``: each dof's new index; ``ncol`` of
-        them), in CSR: the element matrices of every triangle (``element.cell_stiffness``, batched)
-        summed."""
-        nd = element.ndof_node
+        """The stiffness on the dofs with ``pos`` ≥ 0 (``pos``: each dof's new index, increasing;
+        ``ncol`` of them), in canonical CSR, exactly symmetric: the element matrices of every
+        triangle (``element.cell_stiffness``, batched) summed by node blocks
+        (:func:`plateqp.model.blocks.assemble_blocks`)."""
         Ke = element.cell_stiffness(self.nodes[self.triangles], D, nu)
-        dofs = pos[(self.triangles[:, :, None] * nd + np.arange(nd)).reshape(len(self.triangles), -1)]
-        rows = np.repeat(dofs, dofs.shape[1], axis=1).ravel()
-        cols = np.tile(dofs, (1, dofs.shape[1])).ravel()
-        keep = (rows >= 0) & (cols >= 0)
-        K = sp.csr_matrix((Ke.ravel()[keep], (rows[keep], cols[keep])), shape=(ncol, ncol))
-        K.sum_duplicates()
-        return K
+        return assemble_blocks(Ke, self.triangles, len(self.nodes), pos, ncol)
 
     def tributary_areas(self, region) -> np.ndarray:
         """(n_nodes,) each node's tributary area of a bed on ``region`` (a box [x0, x1, y0, y1] or a
