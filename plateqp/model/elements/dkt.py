@@ -84,11 +84,32 @@ class DKT:
                     T[:, row, 3 * v + 2] = P[:, r, 1]
         return T
 
-    def curvature_matrix(self, xy, lam) -> np.ndarray:
-        """(nt, npts, 3, 9): κ = (w,xx, w,yy, 2 w,xy) = B u_e at barycentric points ``lam``: (npts, 3),
-        the same in every triangle, or (nt, npts, 3), each triangle its own."""
-        xy = _as_tris(xy)
-        lam = np.atleast_2d(np.asarray(lam, dtype=float))
+    @staticmethod
+    def _apply_slopes(B12, xy) -> np.ndarray:
+        """``B12 @ slope_transform(xy)`` with the 12 slopes first: B12 (12, 3, nt, npts) → (9, 3, nt,
+        npts), without forming the transform: its vertex rows pick a slope dof, its midside rows
+        (β_mid = 1.5 s (w_j − w_i)/L + (I/2 − 3/4 s sᵀ)(β_i + β_j)) have six entries each."""
+        out = np.zeros((9,) + B12.shape[1:])
+        out[1::3] = B12[0:3]  # βx at the vertices: the dofs wx
+        out[2::3] = B12[6:9]  # βy: wy
+        for e, (i, j) in enumerate(EDGES):
+            d = xy[:, j] - xy[:, i]
+            L = np.hypot(d[:, 0], d[:, 1])[:, None]
+            sx, sy = d[:, 0:1] / L, d[:, 1:2] / L  # (nt, 1): broadcast over the points
+            bx, by = B12[3 + e], B12[9 + e]  # the rows' weights on βx, βy of midside e
+            w = 1.5 * (bx * (sx / L) + by * (sy / L))
+            px = bx * (0.5 - 0.75 * sx * sx) - by * (0.75 * sx * sy)  # (bx, by)ᵀ (I/2 − 3/4 s sᵀ)
+            py = by * (0.5 - 0.75 * sy * sy) - bx * (0.75 * sx * sy)
+            out[3 * j] += w
+            out[3 * i] -= w
+            for v in (i, j):
+                out[3 * v + 1] += px
+                out[3 * v + 2] += py
+        return out
+
+    def _curvature_first(self, xy, lam) -> np.ndarray:
+        """(9, 3, nt, npts): :meth:`curvature_matrix` with the dofs and the components first (each
+        slab contiguous over the triangles and points)."""
         G, _ = self._grad_l(xy)  # (nt, 3, 2)
         # quadratic 6-node shape functions: N_v = L_v (2 L_v − 1), N_{3+e} = 4 L_i L_j
         dN_dL = np.zeros(lam.shape[:-1] + (6, 3))
@@ -97,24 +118,39 @@ class DKT:
         for e, (i, j) in enumerate(EDGES):
             dN_dL[..., 3 + e, i] = 4.0 * lam[..., j]
             dN_dL[..., 3 + e, j] = 4.0 * lam[..., i]
-        dN = np.einsum("pnk,tkd->tpnd" if lam.ndim == 2 else "tpnk,tkd->tpnd", dN_dL, G)  # (nt, npts, 6, 2)
-        nt, npts = dN.shape[:2]
-        B12 = np.zeros((nt, npts, 3, 12))
-        B12[..., 0, :6] = dN[..., 0]
-        B12[..., 1, 6:] = dN[..., 1]
-        B12[..., 2, :6] = dN[..., 1]
-        B12[..., 2, 6:] = dN[..., 0]
-        return B12 @ self.slope_transform(xy)[:, None]  # (nt, npts, 3, 12) @ (nt, 1, 12, 9)
+        nt = len(xy)
+        if lam.ndim == 2:  # the same points in every triangle: one product
+            npts = len(lam)
+            dN = (np.swapaxes(G, 1, 2).reshape(2 * nt, 3) @ dN_dL.transpose(2, 0, 1).reshape(3, -1))
+            dN = dN.reshape(nt, 2, npts, 6).transpose(1, 3, 0, 2)  # (2, 6, nt, npts)
+        else:
+            npts = lam.shape[1]
+            dN = np.einsum("tpnk,tkd->dntp", dN_dL, G)
+        B12 = np.zeros((12, 3, nt, npts))
+        B12[:6, 0] = dN[0]  # κ1 = βx,x
+        B12[6:, 1] = dN[1]  # κ2 = βy,y
+        B12[:6, 2] = dN[1]  # κ3 = βx,y + βy,x
+        B12[6:, 2] = dN[0]
+        return self._apply_slopes(B12, xy)
+
+    def curvature_matrix(self, xy, lam) -> np.ndarray:
+        """(nt, npts, 3, 9): κ = (w,xx, w,yy, 2 w,xy) = B u_e at barycentric points ``lam``: (npts, 3),
+        the same in every triangle, or (nt, npts, 3), each triangle its own."""
+        xy = _as_tris(xy)
+        lam = np.atleast_2d(np.asarray(lam, dtype=float))
+        return np.ascontiguousarray(self._curvature_first(xy, lam).transpose(2, 3, 1, 0))
 
     # -- element matrices -------------------------------------------------------------------
     def stiffness(self, xy, D: float, nu: float) -> np.ndarray:
         """(nt, 9, 9) element stiffness ∫ Bᵀ D_b B dA (exact: B is linear, 3-point rule)."""
         xy = _as_tris(xy)
         _, area = self._grad_l(xy)
-        B = self.curvature_matrix(xy, MID_POINTS)
-        # Σ_p w_p B_pᵀ D_b B_p by matrix products (a four-operand einsum runs unoptimised, 20× slower)
-        K = (np.swapaxes(B, 2, 3) * MID_WEIGHTS[None, :, None, None]) @ (bending_matrix(D, nu) @ B)
-        K = K.sum(axis=1) * area[:, None, None]
+        nt = len(xy)
+        B = self._curvature_first(xy, MID_POINTS)  # (9 dofs, 3 components, nt, 3 points)
+        DB = np.tensordot(bending_matrix(D, nu), B, axes=([1], [1]))  # (3, 9, nt, 3): D_b κ
+        # Σ_p w_p B_pᵀ D_b B_p (equal weights): one product over the (component, point) pairs
+        K = B.transpose(2, 0, 1, 3).reshape(nt, 9, 9) @ DB.transpose(2, 0, 3, 1).reshape(nt, 9, 9)
+        K *= (MID_WEIGHTS[0] * area)[:, None, None]
         return 0.5 * (K + np.swapaxes(K, 1, 2))
 
     def shape(self, xy, lam) -> np.ndarray:
