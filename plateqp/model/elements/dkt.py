@@ -85,21 +85,26 @@ class DKT:
         return T
 
     @staticmethod
-    def _apply_slopes(B12, xy) -> np.ndarray:
-        """``B12 @ slope_transform(xy)`` with the 12 slopes first: B12 (12, 3, nt, npts) → (9, 3, nt,
-        npts), without forming the transform: its vertex rows pick a slope dof, its midside rows
-        (β_mid = 1.5 s (w_j − w_i)/L + (I/2 − 3/4 s sᵀ)(β_i + β_j)) have six entries each."""
-        out = np.zeros((9,) + B12.shape[1:])
-        out[1::3] = B12[0:3]  # βx at the vertices: the dofs wx
-        out[2::3] = B12[6:9]  # βy: wy
+    def _apply_slopes(bx, by, edges, out) -> np.ndarray:
+        """A row on the 12 nodal slopes (weights ``bx`` on βx, ``by`` on βy at the 6 nodes, each
+        (6, nt, npts), or None for zero) on the 9 dofs: the row times :meth:`slope_transform`,
+        without forming it: its vertex rows pick a slope dof, its midside rows (β_mid =
+        1.5 s (w_j − w_i)/L + (I/2 − 3/4 s sᵀ)(β_i + β_j)) have six entries each. Written into
+        ``out`` (9, nt, npts), zeros on entry."""
+        if bx is not None:
+            out[1::3] = bx[:3]  # βx at the vertices: the dofs wx
+        if by is not None:
+            out[2::3] = by[:3]  # βy: wy
         for e, (i, j) in enumerate(EDGES):
-            d = xy[:, j] - xy[:, i]
-            L = np.hypot(d[:, 0], d[:, 1])[:, None]
-            sx, sy = d[:, 0:1] / L, d[:, 1:2] / L  # (nt, 1): broadcast over the points
-            bx, by = B12[3 + e], B12[9 + e]  # the rows' weights on βx, βy of midside e
-            w = 1.5 * (bx * (sx / L) + by * (sy / L))
-            px = bx * (0.5 - 0.75 * sx * sx) - by * (0.75 * sx * sy)  # (bx, by)ᵀ (I/2 − 3/4 s sᵀ)
-            py = by * (0.5 - 0.75 * sy * sy) - bx * (0.75 * sx * sy)
+            sxl, syl, axx, axy, ayy = edges[e]
+            if by is None:
+                w, px, py = bx[3 + e] * sxl, bx[3 + e] * axx, bx[3 + e] * axy
+            elif bx is None:
+                w, px, py = by[3 + e] * syl, by[3 + e] * axy, by[3 + e] * ayy
+            else:
+                w = bx[3 + e] * sxl + by[3 + e] * syl
+                px = bx[3 + e] * axx + by[3 + e] * axy
+                py = bx[3 + e] * axy + by[3 + e] * ayy
             out[3 * j] += w
             out[3 * i] -= w
             for v in (i, j):
@@ -124,14 +129,18 @@ class DKT:
             dN = (np.swapaxes(G, 1, 2).reshape(2 * nt, 3) @ dN_dL.transpose(2, 0, 1).reshape(3, -1))
             dN = dN.reshape(nt, 2, npts, 6).transpose(1, 3, 0, 2)  # (2, 6, nt, npts)
         else:
-            npts = lam.shape[1]
             dN = np.einsum("tpnk,tkd->dntp", dN_dL, G)
-        B12 = np.zeros((12, 3, nt, npts))
-        B12[:6, 0] = dN[0]  # κ1 = βx,x
-        B12[6:, 1] = dN[1]  # κ2 = βy,y
-        B12[:6, 2] = dN[1]  # κ3 = βx,y + βy,x
-        B12[6:, 2] = dN[0]
-        return self._apply_slopes(B12, xy)
+        edges = []  # per edge, (nt, 1) to broadcast over the points: 1.5 s / L and I/2 − 3/4 s sᵀ
+        for i, j in EDGES:
+            d = xy[:, j] - xy[:, i]
+            L = np.hypot(d[:, 0], d[:, 1])[:, None]
+            sx, sy = d[:, 0:1] / L, d[:, 1:2] / L
+            edges.append((1.5 * sx / L, 1.5 * sy / L, 0.5 - 0.75 * sx * sx, -0.75 * sx * sy, 0.5 - 0.75 * sy * sy))
+        out = np.zeros((9, 3) + dN.shape[2:])
+        self._apply_slopes(dN[0], None, edges, out[:, 0])  # κ1 = βx,x
+        self._apply_slopes(None, dN[1], edges, out[:, 1])  # κ2 = βy,y
+        self._apply_slopes(dN[1], dN[0], edges, out[:, 2])  # κ3 = βx,y + βy,x
+        return out
 
     def curvature_matrix(self, xy, lam) -> np.ndarray:
         """(nt, npts, 3, 9): κ = (w,xx, w,yy, 2 w,xy) = B u_e at barycentric points ``lam``: (npts, 3),
@@ -146,10 +155,11 @@ class DKT:
         xy = _as_tris(xy)
         _, area = self._grad_l(xy)
         nt = len(xy)
-        B = self._curvature_first(xy, MID_POINTS)  # (9 dofs, 3 components, nt, 3 points)
-        DB = np.tensordot(bending_matrix(D, nu), B, axes=([1], [1]))  # (3, 9, nt, 3): D_b κ
-        # Σ_p w_p B_pᵀ D_b B_p (equal weights): one product over the (component, point) pairs
-        K = B.transpose(2, 0, 1, 3).reshape(nt, 9, 9) @ DB.transpose(2, 0, 3, 1).reshape(nt, 9, 9)
+        # (nt, 9 rows: component and point, 9 dofs)
+        B = np.ascontiguousarray(self._curvature_first(xy, MID_POINTS).transpose(2, 1, 3, 0)).reshape(nt, 9, 9)
+        DB = np.matmul(bending_matrix(D, nu), B.reshape(nt, 3, 27)).reshape(nt, 9, 9)  # D_b κ
+        # Σ_p w_p B_pᵀ D_b B_p (equal weights): one product over the (component, point) rows
+        K = np.swapaxes(B, 1, 2) @ DB
         K *= (MID_WEIGHTS[0] * area)[:, None, None]
         return 0.5 * (K + np.swapaxes(K, 1, 2))
 
