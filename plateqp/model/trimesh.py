@@ -7,8 +7,8 @@ the mesh refined around them (size h/4 at the point, growing to h at 2h away), a
 segments (a bed region's outline) followed by element edges: the boundary curves are split where
 such a line ends on them, so that the line's end is a point of the boundary.
 
-The mesh is deterministic: gmsh runs on one thread with fixed options (Frontal-Delaunay, no
-random factor changes, no configuration files read), so the same scene gives the same mesh. gmsh
+The mesh is deterministic: gmsh runs on one thread with fixed options (Frontal-Delaunay without
+Laplacian smoothing, no random factor changes, no configuration files read), so the same scene gives the same mesh. gmsh
 is initialised and finalised around every call (a session the caller opened is left open, and
 only the model made here is removed), and never prints (``General.Terminal = 0``).
 
@@ -313,6 +313,7 @@ def _mesh_domain(domain: Domain, size: float, points=(), lines=()) -> TriMesh:
         gmsh.option.setNumber("General.NumThreads", 1)
         gmsh.option.setNumber("Mesh.MaxNumThreads2D", 1)
         gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay
+        gmsh.option.setNumber("Mesh.Smoothing", 0)  # no Laplacian passes: a third of the time, same accuracy
         gmsh.option.setNumber("Mesh.RandomFactor", 1e-9)
         gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
