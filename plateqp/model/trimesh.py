@@ -7,8 +7,8 @@ the mesh refined around them (size h/4 at the point, growing to h at 2h away), a
 segments (a bed region's outline) followed by element edges: the boundary curves are split where
 such a line ends on them, so that the line's end is a point of the boundary.
 
-The mesh is deterministic: gmsh runs on one thread with fixed options (Frontal-Delaunay, no
-random factor changes, no configuration files read), so the same scene gives the same mesh. gmsh
+The mesh is deterministic: gmsh runs on one thread with fixed options (Frontal-Delaunay without
+Laplacian smoothing, no random factor changes, no configuration files read), so the same scene gives the same mesh. gmsh
 is initialised and finalised around every call (a session the caller opened is left open, and
 only the model made here is removed), and never prints (``General.Terminal = 0``).
 
@@ -28,6 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SceneError
+from .blocks import assemble_blocks
 from .geometry import Domain, Polygon, _point_segment, inner_segments, lumped_region, region_outline
 from .symmetry import TOL as SYMMETRY_TOL
 from .symmetry import boundary_of, build_part, mirror_lines, read_triangles, unfold
@@ -107,8 +108,8 @@ class TriMesh:
         return self.edges, self.normals, self.boundary, self.segment
 
     # -- the generator's side of building a model (plateqp.model.assembly.build_model) ----------------
-    #: the summed element matrices are symmetric to rounding, not value for value
-    symmetric_assembly = False
+    #: the assembled stiffness is symmetric value for value (:meth:`assemble`: summed by node blocks)
+    symmetric_assembly = True
     estimate_nodes = staticmethod(lambda scene: estimate_nodes(scene))
 
     @classmethod
@@ -190,18 +191,12 @@ class TriMesh:
         return np.arange(len(self.triangles))
 
     def assemble(self, element, D: float, nu: float, pos: np.ndarray, ncol: int) -> sp.csr_matrix:
-        """The stiffness on the dofs with ``pos`` ≥ 0 (``pos``: each dof's new index; ``ncol`` of
-        them), in CSR: the element matrices of every triangle (``element.cell_stiffness``, batched)
-        summed."""
-        nd = element.ndof_node
+        """The stiffness on the dofs with ``pos`` ≥ 0 (``pos``: each dof's new index, increasing;
+        ``ncol`` of them), in canonical CSR, exactly symmetric: the element matrices of every
+        triangle (``element.cell_stiffness``, batched) summed by node blocks
+        (:func:`plateqp.model.blocks.assemble_blocks`)."""
         Ke = element.cell_stiffness(self.nodes[self.triangles], D, nu)
-        dofs = pos[(self.triangles[:, :, None] * nd + np.arange(nd)).reshape(len(self.triangles), -1)]
-        rows = np.repeat(dofs, dofs.shape[1], axis=1).ravel()
-        cols = np.tile(dofs, (1, dofs.shape[1])).ravel()
-        keep = (rows >= 0) & (cols >= 0)
-        K = sp.csr_matrix((Ke.ravel()[keep], (rows[keep], cols[keep])), shape=(ncol, ncol))
-        K.sum_duplicates()
-        return K
+        return assemble_blocks(Ke, self.triangles, len(self.nodes), pos, ncol)
 
     def tributary_areas(self, region) -> np.ndarray:
         """(n_nodes,) each node's tributary area of a bed on ``region`` (a box [x0, x1, y0, y1] or a
@@ -324,6 +319,7 @@ def _mesh_domain(domain: Domain, size: float, points=(), lines=(), mirrors=()) -
         gmsh.option.setNumber("General.NumThreads", 1)
         gmsh.option.setNumber("Mesh.MaxNumThreads2D", 1)
         gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay
+        gmsh.option.setNumber("Mesh.Smoothing", 0)  # no Laplacian passes: no gain in accuracy (benchmarks/README.md)
         gmsh.option.setNumber("Mesh.RandomFactor", 1e-9)
         gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)

@@ -84,11 +84,37 @@ class DKT:
                     T[:, row, 3 * v + 2] = P[:, r, 1]
         return T
 
-    def curvature_matrix(self, xy, lam) -> np.ndarray:
-        """(nt, npts, 3, 9): κ = (w,xx, w,yy, 2 w,xy) = B u_e at barycentric points ``lam``: (npts, 3),
-        the same in every triangle, or (nt, npts, 3), each triangle its own."""
-        xy = _as_tris(xy)
-        lam = np.atleast_2d(np.asarray(lam, dtype=float))
+    @staticmethod
+    def _apply_slopes(bx, by, edges, out) -> np.ndarray:
+        """A row on the 12 nodal slopes (weights ``bx`` on βx, ``by`` on βy at the 6 nodes, each
+        (6, nt, npts), or None for zero) on the 9 dofs: the row times :meth:`slope_transform`,
+        without forming it: its vertex rows pick a slope dof, its midside rows (β_mid =
+        1.5 s (w_j − w_i)/L + (I/2 − 3/4 s sᵀ)(β_i + β_j)) have six entries each. Written into
+        ``out`` (9, nt, npts), zeros on entry."""
+        if bx is not None:
+            out[1::3] = bx[:3]  # βx at the vertices: the dofs wx
+        if by is not None:
+            out[2::3] = by[:3]  # βy: wy
+        for e, (i, j) in enumerate(EDGES):
+            sxl, syl, axx, axy, ayy = edges[e]
+            if by is None:
+                w, px, py = bx[3 + e] * sxl, bx[3 + e] * axx, bx[3 + e] * axy
+            elif bx is None:
+                w, px, py = by[3 + e] * syl, by[3 + e] * axy, by[3 + e] * ayy
+            else:
+                w = bx[3 + e] * sxl + by[3 + e] * syl
+                px = bx[3 + e] * axx + by[3 + e] * axy
+                py = bx[3 + e] * axy + by[3 + e] * ayy
+            out[3 * j] += w
+            out[3 * i] -= w
+            for v in (i, j):
+                out[3 * v + 1] += px
+                out[3 * v + 2] += py
+        return out
+
+    def _curvature_first(self, xy, lam) -> np.ndarray:
+        """(9, 3, nt, npts): :meth:`curvature_matrix` with the dofs and the components first (each
+        slab contiguous over the triangles and points)."""
         G, _ = self._grad_l(xy)  # (nt, 3, 2)
         # quadratic 6-node shape functions: N_v = L_v (2 L_v − 1), N_{3+e} = 4 L_i L_j
         dN_dL = np.zeros(lam.shape[:-1] + (6, 3))
@@ -97,24 +123,44 @@ class DKT:
         for e, (i, j) in enumerate(EDGES):
             dN_dL[..., 3 + e, i] = 4.0 * lam[..., j]
             dN_dL[..., 3 + e, j] = 4.0 * lam[..., i]
-        dN = np.einsum("pnk,tkd->tpnd" if lam.ndim == 2 else "tpnk,tkd->tpnd", dN_dL, G)  # (nt, npts, 6, 2)
-        nt, npts = dN.shape[:2]
-        B12 = np.zeros((nt, npts, 3, 12))
-        B12[..., 0, :6] = dN[..., 0]
-        B12[..., 1, 6:] = dN[..., 1]
-        B12[..., 2, :6] = dN[..., 1]
-        B12[..., 2, 6:] = dN[..., 0]
-        return B12 @ self.slope_transform(xy)[:, None]  # (nt, npts, 3, 12) @ (nt, 1, 12, 9)
+        nt = len(xy)
+        if lam.ndim == 2:  # the same points in every triangle: one product
+            npts = len(lam)
+            dN = (np.swapaxes(G, 1, 2).reshape(2 * nt, 3) @ dN_dL.transpose(2, 0, 1).reshape(3, -1))
+            dN = dN.reshape(nt, 2, npts, 6).transpose(1, 3, 0, 2)  # (2, 6, nt, npts)
+        else:
+            dN = np.einsum("tpnk,tkd->dntp", dN_dL, G)
+        edges = []  # per edge, (nt, 1) to broadcast over the points: 1.5 s / L and I/2 − 3/4 s sᵀ
+        for i, j in EDGES:
+            d = xy[:, j] - xy[:, i]
+            L = np.hypot(d[:, 0], d[:, 1])[:, None]
+            sx, sy = d[:, 0:1] / L, d[:, 1:2] / L
+            edges.append((1.5 * sx / L, 1.5 * sy / L, 0.5 - 0.75 * sx * sx, -0.75 * sx * sy, 0.5 - 0.75 * sy * sy))
+        out = np.zeros((9, 3) + dN.shape[2:])
+        self._apply_slopes(dN[0], None, edges, out[:, 0])  # κ1 = βx,x
+        self._apply_slopes(None, dN[1], edges, out[:, 1])  # κ2 = βy,y
+        self._apply_slopes(dN[1], dN[0], edges, out[:, 2])  # κ3 = βx,y + βy,x
+        return out
+
+    def curvature_matrix(self, xy, lam) -> np.ndarray:
+        """(nt, npts, 3, 9): κ = (w,xx, w,yy, 2 w,xy) = B u_e at barycentric points ``lam``: (npts, 3),
+        the same in every triangle, or (nt, npts, 3), each triangle its own."""
+        xy = _as_tris(xy)
+        lam = np.atleast_2d(np.asarray(lam, dtype=float))
+        return np.ascontiguousarray(self._curvature_first(xy, lam).transpose(2, 3, 1, 0))
 
     # -- element matrices -------------------------------------------------------------------
     def stiffness(self, xy, D: float, nu: float) -> np.ndarray:
         """(nt, 9, 9) element stiffness ∫ Bᵀ D_b B dA (exact: B is linear, 3-point rule)."""
         xy = _as_tris(xy)
         _, area = self._grad_l(xy)
-        B = self.curvature_matrix(xy, MID_POINTS)
-        # Σ_p w_p B_pᵀ D_b B_p by matrix products (a four-operand einsum runs unoptimised, 20× slower)
-        K = (np.swapaxes(B, 2, 3) * MID_WEIGHTS[None, :, None, None]) @ (bending_matrix(D, nu) @ B)
-        K = K.sum(axis=1) * area[:, None, None]
+        nt = len(xy)
+        # (nt, 9 rows: component and point, 9 dofs)
+        B = np.ascontiguousarray(self._curvature_first(xy, MID_POINTS).transpose(2, 1, 3, 0)).reshape(nt, 9, 9)
+        DB = np.matmul(bending_matrix(D, nu), B.reshape(nt, 3, 27)).reshape(nt, 9, 9)  # D_b κ
+        # Σ_p w_p B_pᵀ D_b B_p (equal weights): one product over the (component, point) rows
+        K = np.swapaxes(B, 1, 2) @ DB
+        K *= (MID_WEIGHTS[0] * area)[:, None, None]
         return 0.5 * (K + np.swapaxes(K, 1, 2))
 
     def shape(self, xy, lam) -> np.ndarray:
