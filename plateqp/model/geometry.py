@@ -278,7 +278,7 @@ def parse_region(value, where: str, fail: Fail) -> Shape:
     return Polygon(((x0, y0), (x1, y0), (x1, y1), (x0, y1)))
 
 
-def sample_points(shape: Shape, n: int = 32) -> tuple[np.ndarray, np.ndarray]:
+def sample_points(shape: Shape, n: int = 16) -> tuple[np.ndarray, np.ndarray]:
     """Points inside a region, to ask whether it covers some plate: the centres of an n × n
     lattice of its bounding box that it contains (and a circle's centre); a region too thin for
     them, its vertices."""

@@ -332,6 +332,9 @@ class Grid:
     def cells_in(self, shape) -> np.ndarray:
         """Indices of the kept cells whose centre lies in the region ``shape`` (a
         :class:`~plateqp.model.geometry.Polygon` or ``Circle``; its boundary included)."""
+        x0, x1, y0, y1 = shape.bbox
+        if getattr(shape, "vertices", ()) and len(shape.vertices) == 4 and shape.area == (x1 - x0) * (y1 - y0):
+            return self.cells_centred_in(x0, x1, y0, y1)  # a box
         cc = np.flatnonzero(self.cell_mask)
         cx = (cc % self.nx + 0.5) * self.hx
         cy = (cc // self.nx + 0.5) * self.hy

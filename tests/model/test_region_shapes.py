@@ -150,19 +150,19 @@ def test_circular_bed_statics(element, n):
     assert len(bed) > 0
     assert np.all(np.hypot(bed[:, 0] - 0.5, bed[:, 1] - 0.45) <= 0.3 + 1.5 / n)
     area = res.model.bed_areas().sum()
-    assert area == pytest.approx(math.pi * 0.09, rel=0.1 if element == "acm" else 1e-12)
+    assert area == pytest.approx(math.pi * 0.09, rel=1e-12)  # the hats over each cell's part: exact
 
 
 def test_circular_bed_agrees_between_grid_and_triangles():
     """A simply supported square on a circular bed under a uniform load: the centre deflection
-    on the grid (ACM n × n) and on triangles (DKT 1/n) differ by less than 2 % at n = 16 and
-    by less at n = 32."""
+    on the grid (ACM n × n) and on triangles (DKT 1/n) differ by less than 1 % at n = 16 and
+    by less than half that at n = 32 (measured 0.60 %, 0.21 %; 0.04 % at n = 64)."""
     diffs = []
     for n in (16, 32):
         w = [pq.solve(rect(el, n, [pq.UniformLoad(1.0)], foundation=pq.Foundation(k=2.0e3, region={
             "circle": [0.5, 0.5, 0.31]}))).deflection(0.5, 0.5) for el in ("acm", "dkt")]
         diffs.append(abs(w[0] / w[1] - 1))
-    assert diffs[0] < 0.02 and diffs[1] < diffs[0]
+    assert diffs[0] < 0.01 and diffs[1] < diffs[0] / 2
 
 
 def test_polygon_bed_on_the_grid():
