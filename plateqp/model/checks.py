@@ -140,6 +140,7 @@ def check_patch(sc, ld, where: str, grid) -> None:
     else:
         where = f"{where}.region"
         shape = parse_region(ld.region, where, sc._fail)
+        ld.region = _scene_form(ld.region, shape)
     xs, ys = _inside_points(shape)
     x0, x1, y0, y1 = grid.domain.outer.bbox
     near = (xs > x0) & (xs < x1) & (ys > y0) & (ys < y1)
@@ -150,8 +151,13 @@ def check_patch(sc, ld, where: str, grid) -> None:
                  "(no plate there to load)")
 
 
+def _scene_form(value, shape):
+    """A region given in Python as a Polygon or Circle kept in its scene form (as TOML gives it)."""
+    return shape.to_dict() if hasattr(value, "to_dict") else value
+
+
 def _inside_points(shape):
-    """Points strictly inside a region (:func:`plateqp.model.geometry.sample_points`)."""
+    """Points inside a region (:func:`plateqp.model.geometry.sample_points`)."""
     from .geometry import sample_points
 
     return sample_points(shape)
@@ -190,6 +196,7 @@ def check_foundation(sc, grid) -> None:
     sc._num("foundation.k", f.k, positive=True, physical=True)
     if f.region is not None:
         shape = parse_region(f.region, "foundation.region", sc._fail)
+        f.region = _scene_form(f.region, shape)
         if not grid.domain.outer.contains(*_inside_points(shape)).any() or not grid.cells_in(shape).any():
             sc._fail("foundation.region", f"{_short(f.region)} does not overlap the plate or holds the centre of "
                      "no cell of it (it is off the plate, in an opening, or smaller than a cell): the bed would "

@@ -242,3 +242,15 @@ def test_openings_share_the_region_checks():
         rect("acm", 8, [pq.UniformLoad(1.0)], openings=[pq.Opening(0.6, 0.2, 0.1, 0.3)])
     with pytest.raises(pq.SceneError, match=r"loads\.0\.region: needs x0 < x1 and y0 < y1"):
         rect("acm", 8, [pq.PatchLoad(1.0, region=[0.6, 0.2, 0.1, 0.3])])
+
+
+def test_shapes_given_in_python_keep_their_scene_form():
+    """A Polygon or a Circle object given in Python is kept as its TOML form and saves."""
+    from plateqp.model.geometry import Circle, Polygon
+
+    sc = rect("acm", 8, [pq.PatchLoad(Q, region=Circle(0.4, 0.5, 0.2))],
+              foundation=pq.Foundation(k=1.0e3, region=Polygon(((0.1, 0.1), (0.9, 0.1), (0.5, 0.8)))))
+    assert sc.loads[0].region == {"circle": [0.4, 0.5, 0.2]}
+    assert sc.foundation.region == {"polygon": [[0.1, 0.1], [0.9, 0.1], [0.5, 0.8]]}
+    back = pq.Scene.from_dict(sc.to_dict())
+    assert back.loads == sc.loads and back.foundation.region == sc.foundation.region
