@@ -65,17 +65,18 @@ def check_edges(sc) -> None:
 
 
 def check_cutouts(sc):
-    """The openings' boxes, the shape and holes (on triangles), what they leave of the plate, and
+    """The openings' boxes (regions: :func:`plateqp.model.geometry.parse_region`), the shape and
+    holes (on triangles), what they leave of the plate, and
     the edge names on its boundaries (:func:`plateqp.model.constraints.edge_table`). Returns the cover
-    the point checks ask (``covers``, ``locate``, ``node_at``, ``covers_area``, ``cells_centred_in``):
+    the point checks ask (``covers``, ``locate``, ``node_at``, ``cells_in``):
     the grid, or on triangles the plate's region."""
     from .constraints import edge_table, warn_changed_all
+    from .geometry import parse_region
 
     for i, o in enumerate(sc.openings):
         for k in ("x0", "x1", "y0", "y1"):
             sc._num(f"openings.{i}.{k}", getattr(o, k))
-        if not (o.x0 < o.x1 and o.y0 < o.y1):
-            sc._fail(f"openings.{i}", "needs x0 < x1 and y0 < y1")
+        parse_region([o.x0, o.x1, o.y0, o.y1], f"openings.{i}", sc._fail)  # a box region, as a patch's
     grid = plate_cover(sc)
     if not grid.cell_mask.any():
         sc._fail("openings" if sc.openings else "holes", "the cut-outs remove every cell of the plate")
@@ -86,7 +87,7 @@ def check_cutouts(sc):
 
 def plate_cover(sc):
     """What the point checks ask of the plate (``covers``, ``locate``, ``node_at``,
-    ``covers_area``, ``cells_centred_in``, ``domain``): the grid, or on triangles the plate's
+    ``cells_in``, ``domain``): the grid, or on triangles the plate's
     region (its shape and cut-outs checked: :func:`plateqp.model.geometry.validate_shaped`)."""
     from .geometry import validate_shaped
     from .grid import Grid

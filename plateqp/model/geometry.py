@@ -318,11 +318,6 @@ class Domain:
             ok &= ~h.contains(x, y) | (h.distance(x, y) <= tol)
         return ok
 
-    def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
-        """True if the box [x0, x1] × [y0, y1] overlaps the plate (checked on a 33 × 33 lattice)."""
-        X, Y = np.meshgrid(np.linspace(x0, x1, 33), np.linspace(y0, y1, 33))
-        return bool(self.covers(X.ravel(), Y.ravel()).any())
-
 
 # -- the scene's side: a shaped (triangle-meshed) scene's checks ------------------------------
 
@@ -366,7 +361,7 @@ def nearest_segment(shape: Shape, points: np.ndarray, normals: np.ndarray, h: fl
 
 class Region:
     """A Domain with the names the scene's point checks ask a grid for (``covers``, ``locate``,
-    ``node_at``, ``covers_area``): any point of the plate can carry a pin, the mesher puts a node
+    ``node_at``, ``cells_in``): any point of the plate can carry a pin, the mesher puts a node
     there."""
 
     def __init__(self, domain: Domain, size: float):
@@ -385,17 +380,9 @@ class Region:
     def node_at(self, x: float, y: float) -> int:
         return 0
 
-    def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
-        return self.domain.covers_area(x0, x1, y0, y1)
-
-    def cells_centred_in(self, x0: float, x1: float, y0: float, y1: float) -> np.ndarray:
-        """Not empty if the box overlaps the plate (a bed region there has triangles, at a mesh
-        size below the box's)."""
-        return np.ones(int(self.covers_area(x0, x1, y0, y1)), dtype=int)
-
     def cells_in(self, shape: Shape) -> np.ndarray:
-        """Not empty if the region ``shape`` overlaps the plate (points strictly inside it lie
-        on the plate: :func:`sample_points`); the mesh follows its outline."""
+        """Not empty if the region ``shape`` overlaps the plate (points inside it lie on the
+        plate: :func:`sample_points`): a bed there has triangles, the mesh following its outline."""
         return np.ones(int(self.domain.covers(*sample_points(shape)).any()), dtype=int)
 
 
