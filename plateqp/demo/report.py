@@ -205,8 +205,11 @@ def _scene_facts(r) -> str:
             loads.append(f"point P = {ld.P:g} {F} at ({ld.x:g}, {ld.y:g})")
         elif ld.type == "uniform":
             loads.append(f"uniform q = {ld.q:g} {F}/{L}²" if r.units else f"uniform q = {ld.q:g}")
-        else:
+        elif ld.region is None:
             loads.append(f"patch q = {ld.q:g} on [{ld.x0:g}, {ld.x1:g}] × [{ld.y0:g}, {ld.y1:g}]")
+        else:
+            loads.append(f"patch q = {ld.q:g} on {', '.join(f'{k} {v}' for k, v in ld.region.items())}"
+                         if isinstance(ld.region, dict) else f"patch q = {ld.q:g} on {ld.region}")
     n = len(sc.supports)
     Eu, Du = (f" {F}/{L}²", f" {F}·{L}") if r.units else ("", "")
     shape = ", ".join(f"{k} {v}" for k, v in (p.shape or {}).items()) or f"{p.a:g} × {p.b:g}"

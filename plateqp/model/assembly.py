@@ -170,16 +170,16 @@ def interpolation(mesh, element, cell_dofs: np.ndarray, n_full: int, x, y, dx: i
 
 def load_vector(scene: Scene, mesh, element, cell_dofs: np.ndarray, n_full: int) -> np.ndarray:
     """The load vector (all ``n_full`` dofs) of ``scene.loads`` on any mesh and element: a uniform
-    pressure by the element's load of each cell (``element.cell_load``), a patch by the element's
-    integral over each cell's part in it (``element.region_load``), a point load by the
-    interpolation at its point (:func:`interpolation`)."""
+    pressure by the element's load of each cell (``element.cell_load``), a patch (a box, a polygon
+    or a circle) by the element's integral over each cell's part in it (``element.region_load``),
+    a point load by the interpolation at its point (:func:`interpolation`)."""
     f = np.zeros(n_full)
     xy = mesh.nodes[mesh.cells] if any(not isinstance(ld, PointLoad) for ld in scene.loads) else None
     for ld in scene.loads:
         if isinstance(ld, UniformLoad):
             f += np.bincount(cell_dofs.ravel(), weights=(ld.q * element.cell_load(xy)).ravel(), minlength=n_full)
         elif isinstance(ld, PatchLoad):
-            hit, fe = element.region_load(xy, (ld.x0, ld.x1, ld.y0, ld.y1))
+            hit, fe = element.region_load(xy, ld.extent)
             np.add.at(f, cell_dofs[hit], ld.q * fe)
         elif isinstance(ld, PointLoad):
             f += ld.P * interpolation(mesh, element, cell_dofs, n_full, ld.x, ld.y).toarray().ravel()

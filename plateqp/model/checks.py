@@ -73,17 +73,18 @@ def check_edges(sc) -> None:
 
 
 def check_cutouts(sc):
-    """The openings' boxes, the shape and holes (on triangles), what they leave of the plate, and
+    """The openings' boxes (regions: :func:`plateqp.model.geometry.parse_region`), the shape and
+    holes (on triangles), what they leave of the plate, and
     the edge names on its boundaries (:func:`plateqp.model.constraints.edge_table`). Returns the cover
-    the point checks ask (``covers``, ``locate``, ``node_at``, ``covers_area``, ``cells_centred_in``):
+    the point checks ask (``covers``, ``locate``, ``node_at``, ``cells_in``):
     the grid, or on triangles the plate's region."""
     from .constraints import edge_table, warn_changed_all
+    from .geometry import parse_region
 
     for i, o in enumerate(sc.openings):
         for k in ("x0", "x1", "y0", "y1"):
             sc._num(f"openings.{i}.{k}", getattr(o, k))
-        if not (o.x0 < o.x1 and o.y0 < o.y1):
-            sc._fail(f"openings.{i}", "needs x0 < x1 and y0 < y1")
+        parse_region([o.x0, o.x1, o.y0, o.y1], f"openings.{i}", sc._fail)  # a box region, as a patch's
     grid = plate_cover(sc)
     if not grid.cell_mask.any():
         sc._fail("openings" if sc.openings else "holes", "the cut-outs remove every cell of the plate")
@@ -94,7 +95,7 @@ def check_cutouts(sc):
 
 def plate_cover(sc):
     """What the point checks ask of the plate (``covers``, ``locate``, ``node_at``,
-    ``covers_area``, ``cells_centred_in``, ``domain``): the grid, or on triangles the plate's
+    ``cells_in``, ``domain``): the grid, or on triangles the plate's
     region (its shape and cut-outs checked: :func:`plateqp.model.geometry.validate_shaped`)."""
     from .geometry import validate_shaped
     from .grid import Grid
@@ -127,15 +128,48 @@ def check_loads(sc, grid) -> None:
             continue
         sc._num(f"{where}.q", ld.q, physical=True)
         if kind == "patch":
-            for k in ("x0", "x1", "y0", "y1"):
-                sc._num(f"{where}.{k}", getattr(ld, k))
-            if not (ld.x0 < ld.x1 and ld.y0 < ld.y1):
-                sc._fail(where, "needs x0 < x1 and y0 < y1")
-            x0, x1, y0, y1 = grid.domain.outer.bbox
-            if ld.x1 <= x0 or ld.x0 >= x1 or ld.y1 <= y0 or ld.y0 >= y1:
-                sc._fail(where, "the patch does not overlap the plate")
-            if not grid.covers_area(ld.x0, ld.x1, ld.y0, ld.y1):
-                sc._fail(where, "the patch lies entirely in an opening (no plate there to load)")
+            check_patch(sc, ld, where, grid)
+
+
+def check_patch(sc, ld, where: str, grid) -> None:
+    """A patch's region: the box x0, x1, y0, y1 or ``region`` (a box, a polygon or a circle:
+    :func:`plateqp.model.geometry.parse_region`), not both, over some of the plate."""
+    from .geometry import parse_region
+
+    box = (ld.x0, ld.x1, ld.y0, ld.y1)
+    given = [v is not None for v in box]
+    if ld.region is not None and any(given):
+        sc._fail(where, "give the patch either x0, x1, y0, y1 or region (a box, a polygon or a circle), not both")
+    if ld.region is None and not all(given):
+        sc._fail(where, "needs x0, x1, y0, y1 or region (a box, a polygon or a circle)")
+    if ld.region is None:
+        for k, v in zip(("x0", "x1", "y0", "y1"), box):
+            sc._num(f"{where}.{k}", v)
+        shape = parse_region(list(box), where, sc._fail)
+    else:
+        where = f"{where}.region"
+        shape = parse_region(ld.region, where, sc._fail)
+        ld.region = _scene_form(ld.region, shape)
+    xs, ys = _inside_points(shape)
+    x0, x1, y0, y1 = grid.domain.outer.bbox
+    near = (xs > x0) & (xs < x1) & (ys > y0) & (ys < y1)
+    if not near.any():
+        sc._fail(where, "the patch does not overlap the plate")
+    if not (grid.locate(xs[near], ys[near])[0] >= 0).any():
+        sc._fail(where, "the patch lies entirely in an opening, a hole or outside the plate's shape "
+                 "(no plate there to load)")
+
+
+def _scene_form(value, shape):
+    """A region given in Python as a Polygon or Circle kept in its scene form (as TOML gives it)."""
+    return shape.to_dict() if hasattr(value, "to_dict") else value
+
+
+def _inside_points(shape):
+    """Points inside a region (:func:`plateqp.model.geometry.sample_points`)."""
+    from .geometry import sample_points
+
+    return sample_points(shape)
 
 
 def check_supports(sc, grid) -> None:
@@ -162,26 +196,20 @@ def check_supports(sc, grid) -> None:
 
 
 def check_foundation(sc, grid) -> None:
-    """The bed's modulus, region (a box, or on triangles a polygon) and gap (a number or a profile)."""
+    """The bed's modulus, region (a box, a polygon or a circle:
+    :func:`plateqp.model.geometry.parse_region`, over some cell of the plate) and gap (a number
+    or a profile)."""
+    from .geometry import parse_region
+
     f = sc.foundation
     sc._num("foundation.k", f.k, positive=True, physical=True)
-    if isinstance(f.region, dict) and sc.triangles:  # a polygon region: plateqp.model.geometry
-        from .geometry import check_polygon_region
-
-        check_polygon_region(sc, grid)
-    elif f.region is not None:
-        if not isinstance(f.region, (list, tuple)) or len(f.region) != 4:
-            sc._fail("foundation.region", "must be [x0, x1, y0, y1]" + (" or { polygon = [[x, y], ...] }"
-                     if sc.triangles else "") + f" (got {_short(f.region)})")
-        for j, v in enumerate(f.region):
-            sc._num(f"foundation.region.{j}", v)
-        x0, x1, y0, y1 = f.region
-        if not (x0 < x1 and y0 < y1):
-            sc._fail("foundation.region", "needs x0 < x1 and y0 < y1")
-        if not grid.cells_centred_in(x0, x1, y0, y1).any():
-            sc._fail("foundation.region", f"[{x0}, {x1}, {y0}, {y1}] holds the centre of no cell of "
-                     "the plate (it is off the plate, in an opening, or smaller than a cell): "
-                     "the bed would have no node")
+    if f.region is not None:
+        shape = parse_region(f.region, "foundation.region", sc._fail)
+        f.region = _scene_form(f.region, shape)
+        if not grid.domain.outer.contains(*_inside_points(shape)).any() or not grid.cells_in(shape).any():
+            sc._fail("foundation.region", f"{_short(f.region)} does not overlap the plate or holds the centre of "
+                     "no cell of it (it is off the plate, in an opening, or smaller than a cell): the bed would "
+                     "have no node")
     check_gap(sc, f.gap)
 
 

@@ -16,6 +16,10 @@ hole lies strictly inside the plate and that no two holes touch or overlap. Ever
 SceneError through the ``fail(where, what)`` callable the scene passes in (it names the field and
 the file). :class:`Domain` answers "is this point on the plate?" for the scene's other checks.
 
+A region (a patch load's, a bed's, a cut-out's) is a box [x0, x1, y0, y1], a polygon or a circle
+in the same spelling: :func:`parse_region` reads and checks every one of them (the integrals
+over a mesh's cells: :mod:`plateqp.model.regions`).
+
 Boundaries are numbered for the mesh and the edge supports: 0 the outer boundary, k ≥ 1 hole
 k − 1; a polygon's segment i runs from vertex i to vertex i + 1.
 """
@@ -30,6 +34,7 @@ from typing import Callable
 import numpy as np
 
 from .crossings import check_simple, cross_any
+from .parts import _short
 
 Fail = Callable[[str, str], None]
 
@@ -245,6 +250,50 @@ def check_holes(outer: Shape, holes: list[Shape], fail: Fail, names: list[str] |
                 fail(names[i], f"overlaps or touches {names[j]}; merge them into one hole or move them apart")
 
 
+#: How a region (a patch load's, a bed's, a cut-out's) is written: the message of a value that is none of them
+FORMS = "[x0, x1, y0, y1], { polygon = [[x, y], ...] } or { circle = [xc, yc, r] }"
+
+
+def parse_region(value, where: str, fail: Fail) -> Shape:
+    """The shape of a region in any of its forms, [x0, x1, y0, y1] (its rectangle),
+    {polygon = [[x, y], ...]} or {circle = [xc, yc, r]} (a Polygon or Circle given in Python too),
+    checked: a box's bounds finite and increasing, a polygon simple and counter-clockwise, a
+    circle's radius > 0 (:func:`parse_shape`). Failures name ``where`` through ``fail``."""
+    if isinstance(value, (Polygon, Circle)):
+        return parse_shape(value, where, fail)
+    if isinstance(value, dict):
+        if len(value) != 1 or next(iter(value)) not in ("polygon", "circle"):
+            fail(where, f"must be {FORMS} (got {_short(value)})")
+        return parse_shape(value, where, fail)
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if not isinstance(value, (list, tuple)) or len(value) != 4:
+        fail(where, f"must be {FORMS} (got {_short(value)})")
+    for j, v in enumerate(value):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(float(v)):
+            fail(f"{where}.{j}", f"must be a finite number (got {_short(v)})")
+    x0, x1, y0, y1 = (float(v) for v in value)
+    if not (x0 < x1 and y0 < y1):
+        fail(where, "needs x0 < x1 and y0 < y1")
+    return Polygon(((x0, y0), (x1, y0), (x1, y1), (x0, y1)))
+
+
+def sample_points(shape: Shape, n: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """Points inside a region, to ask whether it covers some plate: the centres of an n × n
+    lattice of its bounding box that it contains (and a circle's centre); a region too thin for
+    them, its vertices."""
+    x0, x1, y0, y1 = shape.bbox
+    X, Y = np.meshgrid(x0 + (np.arange(n) + 0.5) * (x1 - x0) / n, y0 + (np.arange(n) + 0.5) * (y1 - y0) / n)
+    X, Y = X.ravel(), Y.ravel()
+    keep = shape.contains(X, Y)
+    xs, ys = X[keep], Y[keep]
+    if isinstance(shape, Circle):
+        xs, ys = np.append(xs, shape.xc), np.append(ys, shape.yc)
+    elif not keep.any():
+        xs, ys = shape.xy[:, 0], shape.xy[:, 1]
+    return xs, ys
+
+
 @dataclass(frozen=True)
 class Domain:
     """The plate's region: ``outer`` less ``holes`` (boundaries belong to the plate)."""
@@ -269,11 +318,6 @@ class Domain:
             ok &= ~h.contains(x, y) | (h.distance(x, y) <= tol)
         return ok
 
-    def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
-        """True if the box [x0, x1] × [y0, y1] overlaps the plate (checked on a 33 × 33 lattice)."""
-        X, Y = np.meshgrid(np.linspace(x0, x1, 33), np.linspace(y0, y1, 33))
-        return bool(self.covers(X.ravel(), Y.ravel()).any())
-
 
 # -- the scene's side: a shaped (triangle-meshed) scene's checks ------------------------------
 
@@ -283,7 +327,8 @@ def cutout_shapes(scene) -> list[Shape]:
     ``[[openings]]`` (each the box [x0, x1] × [y0, y1]). One concept with two spellings: the
     edges of cut-out K are ``holeK`` on every mesh."""
     holes = [parse_shape(h, f"holes.{i}", scene._fail) for i, h in enumerate(scene.holes)]
-    return holes + [Polygon(((o.x0, o.y0), (o.x1, o.y0), (o.x1, o.y1), (o.x0, o.y1))) for o in scene.openings]
+    return holes + [parse_region([o.x0, o.x1, o.y0, o.y1], f"openings.{i}", scene._fail)
+                    for i, o in enumerate(scene.openings)]
 
 
 def scene_domain(scene) -> Domain:
@@ -316,7 +361,7 @@ def nearest_segment(shape: Shape, points: np.ndarray, normals: np.ndarray, h: fl
 
 class Region:
     """A Domain with the names the scene's point checks ask a grid for (``covers``, ``locate``,
-    ``node_at``, ``covers_area``): any point of the plate can carry a pin, the mesher puts a node
+    ``node_at``, ``cells_in``): any point of the plate can carry a pin, the mesher puts a node
     there."""
 
     def __init__(self, domain: Domain, size: float):
@@ -335,13 +380,10 @@ class Region:
     def node_at(self, x: float, y: float) -> int:
         return 0
 
-    def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
-        return self.domain.covers_area(x0, x1, y0, y1)
-
-    def cells_centred_in(self, x0: float, x1: float, y0: float, y1: float) -> np.ndarray:
-        """Not empty if the box overlaps the plate (a bed region there has triangles, at a mesh
-        size below the box's)."""
-        return np.ones(int(self.covers_area(x0, x1, y0, y1)), dtype=int)
+    def cells_in(self, shape: Shape) -> np.ndarray:
+        """Not empty if the region ``shape`` overlaps the plate (points inside it lie on the
+        plate: :func:`sample_points`): a bed there has triangles, the mesh following its outline."""
+        return np.ones(int(self.domain.covers(*sample_points(shape)).any()), dtype=int)
 
 
 def validate_shaped(scene) -> Region:
@@ -378,102 +420,6 @@ def mesh_size(scene) -> float:
     one the larger cell side of its nx × ny grid."""
     m, p = scene.mesh, scene.plate
     return float(m.size) if m.size is not None else max(p.a / m.nx, p.b / m.ny)
-
-
-def clip_to_polygon(tris: np.ndarray, outline) -> tuple[np.ndarray, np.ndarray]:
-    """Area and centroid of each triangle's part in a simple polygon (``outline``: (n, 2)
-    vertices, either orientation; convex or not).
-
-    ``tris``: (nt, 3, 2) counter-clockwise vertices. Returns ((nt,) areas, (nt, 2) centroids; a
-    triangle outside has area 0 and its own centroid). Exact: a triangle farther from the outline
-    than its own size is wholly in or out (its centroid decides); the others are clipped one by
-    one (Sutherland–Hodgman: the polygon clipped by the triangle's three half-planes, the
-    triangle being convex), then the clipped polygon's area and centroid.
-    """
-    tris = np.asarray(tris, dtype=float)
-    poly = Polygon(tuple(map(tuple, np.asarray(outline, dtype=float))))
-    p = tris
-    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                        - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
-    cent = p.mean(axis=1)
-    reach = np.hypot(*(p - cent[:, None]).transpose(2, 0, 1)).max(axis=1)
-    x0, x1, y0, y1 = poly.bbox
-    near_box = (cent[:, 0] >= x0 - reach) & (cent[:, 0] <= x1 + reach) & (cent[:, 1] >= y0 - reach) \
-        & (cent[:, 1] <= y1 + reach)
-    cut = np.zeros(len(p), dtype=bool)
-    cut[near_box] = poly.distance(cent[near_box, 0], cent[near_box, 1]) <= reach[near_box] * (1 + 1e-9)
-    whole = ~cut & poly.contains(cent[:, 0], cent[:, 1])
-    out_a = np.where(whole, area, 0.0)
-    out_c = cent.copy()
-    subject = [tuple(v) for v in poly.xy]
-    for t in np.flatnonzero(cut):
-        pts = subject
-        for k in range(3):  # keep the left of each counter-clockwise edge a → b
-            a, b = tris[t, k], tris[t, (k + 1) % 3]
-            side = lambda q: (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])  # noqa: E731
-            new = []
-            for j, cur in enumerate(pts):
-                prev = pts[j - 1]
-                dc, dp = side(cur), side(prev)
-                if (dc >= 0) != (dp >= 0):
-                    f = dp / (dp - dc)
-                    new.append((prev[0] + f * (cur[0] - prev[0]), prev[1] + f * (cur[1] - prev[1])))
-                if dc >= 0:
-                    new.append(cur)
-            pts = new
-            if not pts:
-                break
-        if len(pts) >= 3:
-            q = np.array(pts)
-            xs, ys = q[:, 0], q[:, 1]
-            cr = xs * np.roll(ys, -1) - np.roll(xs, -1) * ys
-            a2 = cr.sum()
-            if abs(a2) > 1e-12 * area[t]:  # not a sliver of round-off along a shared edge
-                out_a[t] = min(0.5 * abs(a2), area[t])
-                out_c[t] = [((xs + np.roll(xs, -1)) * cr).sum() / (3 * a2), ((ys + np.roll(ys, -1)) * cr).sum() / (3 * a2)]
-    return out_a, out_c
-
-
-def lumped_region(tris: np.ndarray, region) -> tuple[np.ndarray, np.ndarray]:
-    """(hit, weights): the triangles (nt, 3, 2) a unit pressure on ``region`` (:func:`region_outline`)
-    covers in part, and each one's vertex weights (len(hit), 3): over the triangle's part A_t in the
-    region, ∫ λ_i dA = |A_t| λ_i(centroid of A_t) (λ the barycentric coordinates). Statically
-    exact: the weights sum to the region's area on the triangles, their moment is its moment."""
-    tris = np.asarray(tris, dtype=float)
-    area, cent = clip_to_polygon(tris, region_outline(region))
-    hit = np.flatnonzero(area > 0.0)
-    p = tris[hit]
-    (x1, y1), (x2, y2), (x3, y3) = p[:, 0].T, p[:, 1].T, p[:, 2].T
-    det = (x2 - x1) * (y3 - y1) - (x3 - x1) * (y2 - y1)
-    x, y = cent[hit, 0], cent[hit, 1]
-    l2 = ((x - x1) * (y3 - y1) - (x3 - x1) * (y - y1)) / det
-    l3 = ((x2 - x1) * (y - y1) - (x - x1) * (y2 - y1)) / det
-    return hit, area[hit, None] * np.column_stack([1.0 - l2 - l3, l2, l3])
-
-
-def box_outline(box) -> np.ndarray:
-    """The counter-clockwise outline (4, 2) of the box [x0, x1, y0, y1]."""
-    x0, x1, y0, y1 = (float(v) for v in box)
-    return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
-
-
-def region_outline(region) -> np.ndarray:
-    """The outline of a bed region: a box [x0, x1, y0, y1] or a scene polygon {polygon = [...]}."""
-    if isinstance(region, dict):
-        return np.array(region["polygon"], dtype=float)
-    return box_outline(region)
-
-
-def check_polygon_region(scene, grid) -> None:
-    """A bed region given as a polygon (triangle meshes): a valid polygon that overlaps the plate."""
-    shape = parse_shape(scene.foundation.region, "foundation.region", scene._fail)
-    if not isinstance(shape, Polygon):
-        scene._fail("foundation.region", "must be a box [x0, x1, y0, y1] or { polygon = [[x, y], ...] }")
-    X, Y = np.meshgrid(np.linspace(*shape.bbox[:2], 33), np.linspace(*shape.bbox[2:], 33))
-    keep = shape.contains(X.ravel(), Y.ravel())  # the polygon sampled on a 33 × 33 lattice, and its vertices
-    xs, ys = np.concatenate([X.ravel()[keep], shape.xy[:, 0]]), np.concatenate([Y.ravel()[keep], shape.xy[:, 1]])
-    if not grid.domain.covers(xs, ys).any():
-        scene._fail("foundation.region", "the polygon does not overlap the plate: the bed would have no node")
 
 
 def _crossings(shape: Shape, p: np.ndarray, q: np.ndarray) -> list[float]:

@@ -134,12 +134,24 @@ class Grid:
         return _csr_from_blocks(V, cnode, pos, ncol)
 
     def tributary_areas(self, region) -> np.ndarray:
-        """(n_nodes,) each node's tributary area of a bed on ``region`` (a box [x0, x1, y0, y1];
-        None: the whole plate): a quarter of every kept cell centred in it that has the node as a
-        corner."""
-        x0, x1, y0, y1 = region if region is not None else (0.0, self.a, 0.0, self.b)
+        """(n_nodes,) each node's tributary area of a bed on ``region`` (None: the whole plate):
+        a box [x0, x1, y0, y1] keeps the grid's cell rule, a quarter of every kept cell centred
+        in it (:meth:`cells_centred_in`); a polygon or a circle
+        (:func:`plateqp.model.geometry.parse_region`) gives each node the integral of its bilinear
+        hat over each kept cell's part in the region (:func:`plateqp.model.regions.cell_hat_areas`:
+        a quarter of each cell wholly in it; the areas sum to the region's area on the kept cells
+        exactly, a circle's to rounding)."""
+        from .regions import box_of, cell_hat_areas
+
+        box = box_of(region)
         area = np.zeros(self.n_nodes)
-        np.add.at(area, self.cell_nodes()[self.cells_centred_in(x0, x1, y0, y1)].ravel(), 0.25 * self.hx * self.hy)
+        if region is None or box is not None:
+            cells = np.flatnonzero(self.cell_mask) if region is None else self.cells_centred_in(*box)
+            np.add.at(area, self.cell_nodes()[cells].ravel(), 0.25 * self.hx * self.hy)
+            return area
+        cells = np.flatnonzero(self.cell_mask)
+        hit, weights = cell_hat_areas(self.nodes[self.cell_nodes()[cells]], region)
+        np.add.at(area, self.cell_nodes()[cells[hit]].ravel(), weights.ravel())
         return area
 
     def boundary_edges(self):
@@ -316,6 +328,17 @@ class Grid:
         cx = (cc % self.nx + 0.5) * self.hx
         cy = (cc // self.nx + 0.5) * self.hy
         return cc[(cx >= x0) & (cx <= x1) & (cy >= y0) & (cy <= y1)]
+
+    def cells_in(self, shape) -> np.ndarray:
+        """Indices of the kept cells whose centre lies in the region ``shape`` (a
+        :class:`~plateqp.model.geometry.Polygon` or ``Circle``; its boundary included)."""
+        x0, x1, y0, y1 = shape.bbox
+        if getattr(shape, "vertices", ()) and len(shape.vertices) == 4 and shape.area == (x1 - x0) * (y1 - y0):
+            return self.cells_centred_in(x0, x1, y0, y1)  # a box
+        cc = np.flatnonzero(self.cell_mask)
+        cx = (cc % self.nx + 0.5) * self.hx
+        cy = (cc // self.nx + 0.5) * self.hy
+        return cc[shape.contains(cx, cy, 1e-12 * max(self.a, self.b))]
 
     def covers_area(self, x0: float, x1: float, y0: float, y1: float) -> bool:
         """True if the box [x0, x1] × [y0, y1] overlaps a kept cell with positive area."""

@@ -24,8 +24,12 @@ def _load_force_log(scene, ld) -> float:
     outer = scene_domain(scene).outer  # the plate's outline, its cut-outs not taken off: a bound
     X0, X1, Y0, Y1 = outer.bbox
     area = outer.area
-    if kind == "patch":
-        area = max(min(ld.x1, X1) - max(ld.x0, X0), 1e-300) * max(min(ld.y1, Y1) - max(ld.y0, Y0), 1e-300)
+    if kind == "patch":  # its area, at most its bounding box's overlap with the plate's
+        from .regions import as_shape
+
+        shape = as_shape(ld.extent)
+        x0, x1, y0, y1 = shape.bbox
+        area = min(shape.area, max(min(x1, X1) - max(x0, X0), 1e-300) * max(min(y1, Y1) - max(y0, Y0), 1e-300))
     return math.log10(abs(ld.q)) + math.log10(area)
 
 

@@ -110,14 +110,23 @@ class UniformLoad:
 
 @dataclass
 class PatchLoad:
-    """Pressure q over the rectangle [x0, x1] × [y0, y1]."""
+    """Pressure q over the box [x0, x1] × [y0, y1], or over ``region`` instead: a box
+    [x0, x1, y0, y1], ``{polygon = [[x, y], ...]}`` or ``{circle = [xc, yc, r]}``, on every mesh
+    (:func:`plateqp.model.geometry.parse_region`), integrated exactly over each cell's part in it
+    (a circle's arcs to rounding: :mod:`plateqp.model.regions`)."""
 
     q: float
-    x0: float
-    x1: float
-    y0: float
-    y1: float
+    x0: float | None = None
+    x1: float | None = None
+    y0: float | None = None
+    y1: float | None = None
+    region: list[float] | dict | None = None
     type: str = field(default="patch", init=False)
+
+    @property
+    def extent(self) -> list[float] | dict:
+        """The patch's region in its scene form: ``region``, or the box [x0, x1, y0, y1]."""
+        return self.region if self.region is not None else [self.x0, self.x1, self.y0, self.y1]
 
 
 @dataclass
@@ -156,7 +165,8 @@ class Support:
 @dataclass
 class Foundation:
     """Tensionless elastic bed of modulus k (force/length³) over ``region`` (whole plate if None):
-    the box [x0, x1, y0, y1] or, on a triangle mesh, ``{polygon = [[x, y], ...]}``.
+    the box [x0, x1, y0, y1], ``{polygon = [[x, y], ...]}`` or ``{circle = [xc, yc, r]}``, on
+    every mesh (:func:`plateqp.model.geometry.parse_region`).
 
     ``gap``: a number, a dict profile (``{profile = "linear", g0, gx, gy}``,
     ``{profile = "trough" | "bump", x, y, radius, depth}``) or, in Python, any callable
@@ -214,6 +224,9 @@ class Scene:
                 setattr(self, key, list(getattr(self, key)))
         if self.foundation is not None and isinstance(self.foundation.region, tuple):
             self.foundation.region = list(self.foundation.region)
+        for ld in self.loads:
+            if isinstance(ld, PatchLoad) and isinstance(ld.region, tuple):
+                ld.region = list(ld.region)
         self.edges = {k: (v if isinstance(v, Edge) else _edge_from(v, f"edges.{k}", self.source))
                       for k, v in self.edges.items()}
         self.validate()
@@ -449,7 +462,8 @@ class Scene:
             if getattr(self, key):
                 d[key] = [asdict(o) for o in getattr(self, key)]
         if self.loads:
-            d["loads"] = [{"type": ld.type, **{k: v for k, v in asdict(ld).items() if k != "type"}} for ld in self.loads]
+            d["loads"] = [{"type": ld.type, **{k: v for k, v in asdict(ld).items() if k != "type" and v is not None}}
+                          for ld in self.loads]
         if self.foundation is not None:
             f = self.foundation
             if callable(f.gap):

@@ -69,11 +69,13 @@ WORDS: dict[type, dict[str, tuple[str, str]]] = {
     },
     S.UniformLoad: {"q": ("F/L²", "pressure over the whole plate, positive downward")},
     S.PatchLoad: {
-        "q": ("F/L²", "pressure over the box, positive downward"),
-        "x0": ("L", "left of the loaded box"),
+        "q": ("F/L²", "pressure over the box (or the region), positive downward"),
+        "x0": ("L", "left of the loaded box (the box, or region: not both)"),
         "x1": ("L", "right of the box"),
         "y0": ("L", "bottom of the box"),
         "y1": ("L", "top of the box"),
+        "region": ("L", "the loaded region instead of the box: a box [x0, x1, y0, y1], "
+                        "{ polygon = [[x, y], ...] } or { circle = [xc, yc, r] }"),
     },
     S.PointLoad: {
         "P": ("F", "point force, positive downward"),
@@ -88,8 +90,8 @@ WORDS: dict[type, dict[str, tuple[str, str]]] = {
     },
     S.Foundation: {
         "k": ("F/L³", "modulus of the tensionless elastic bed (Winkler)"),
-        "region": ("L", "where the bed lies: the whole plate if absent, a box [x0, x1, y0, y1] or a "
-                        "polygon { polygon = [[x, y], ...] }"),
+        "region": ("L", "where the bed lies: the whole plate if absent, a box [x0, x1, y0, y1], "
+                        "{ polygon = [[x, y], ...] } or { circle = [xc, yc, r] }"),
         "gap": ("L", "initial gap g0 of the bed: a number, or a profile table (see nested keys)"),
     },
 }
@@ -102,6 +104,9 @@ NESTED: list[tuple[str, str, str, str]] = [
     ("holes.polygon", "[[x, y], ...]", "L", "[[holes]]: a polygonal hole (its edges free unless named holeK)"),
     ("holes.circle", "[xc, yc, r]", "L", "[[holes]]: a circular hole"),
     ("foundation.region.polygon", "[[x, y], ...]", "L", "a polygonal bed region"),
+    ("foundation.region.circle", "[xc, yc, r]", "L", "a circular bed region"),
+    ("loads.region.polygon", "[[x, y], ...]", "L", "a patch load over a polygon"),
+    ("loads.region.circle", "[xc, yc, r]", "L", "a patch load over a disc"),
     ("foundation.gap.profile", "str", "", "\"uniform\", \"linear\", \"trough\" (settlement) or \"bump\" (heave)"),
     ("foundation.gap.g0", "float", "L", "uniform and linear profiles: the gap at the origin"),
     ("foundation.gap.gx", "float", "1", "linear profile: the gap's slope along x"),

@@ -63,7 +63,8 @@ def _line(axis: int, c: float) -> str:
 def check_symmetry(sc, domain: Domain) -> None:
     """The scene ``sc`` (its fields checked) symmetric about the lines of ``sc.mesh.symmetry``
     (see the module docstring); ``domain``: its plate (:func:`plateqp.model.geometry.scene_domain`)."""
-    from .geometry import inner_segments, region_outline
+    from .geometry import inner_segments, mesh_size
+    from .regions import region_outline
 
     tol = TOL * domain.size
     names = ["plate.shape"] + [f"holes.{i}" for i in range(len(sc.holes))] + \
@@ -73,7 +74,7 @@ def check_symmetry(sc, domain: Domain) -> None:
         [(f"loads.{i}", ld.x, ld.y) for i, ld in enumerate(sc.loads) if ld.type == "point"] + \
         [(f"pins.{i}", p.x, p.y) for i, p in enumerate(sc.pins)]
     f = sc.foundation
-    lines = [] if f is None or f.region is None else inner_segments(domain, region_outline(f.region))
+    lines = [] if f is None or f.region is None else inner_segments(domain, region_outline(f.region, mesh_size(sc)))
     xy = np.array([(x, y) for _, x, y in points], dtype=float).reshape(-1, 2)
     for axis, c in mirror_lines(domain, sc.mesh.symmetry):
         where = _line(axis, c)

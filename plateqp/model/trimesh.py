@@ -29,7 +29,8 @@ import scipy.sparse as sp
 
 from ..errors import SceneError
 from .blocks import assemble_blocks
-from .geometry import Domain, Polygon, _point_segment, inner_segments, lumped_region, region_outline
+from .geometry import Domain, Polygon, _point_segment, inner_segments
+from .regions import lumped_region, region_outline
 from .symmetry import TOL as SYMMETRY_TOL
 from .symmetry import boundary_of, build_part, mirror_lines, read_triangles, unfold
 
@@ -123,7 +124,7 @@ class TriMesh:
         points = [(s.x, s.y) for s in scene.supports] + [(ld.x, ld.y) for ld in scene.loads
                                                          if isinstance(ld, PointLoad)] + [(p.x, p.y) for p in scene.pins]
         lines = [] if scene.foundation is None or scene.foundation.region is None else inner_segments(
-            domain, region_outline(scene.foundation.region))
+            domain, region_outline(scene.foundation.region, mesh_size(scene)))
         mirrors = mirror_lines(domain, scene.mesh.symmetry) if scene.mesh.symmetry else ()
         return mesh_domain(domain, mesh_size(scene), points, lines, mirrors)
 
@@ -199,11 +200,12 @@ class TriMesh:
         return assemble_blocks(Ke, self.triangles, len(self.nodes), pos, ncol)
 
     def tributary_areas(self, region) -> np.ndarray:
-        """(n_nodes,) each node's tributary area of a bed on ``region`` (a box [x0, x1, y0, y1] or a
-        polygon region; None: the whole plate): a third of every triangle, or of each triangle's
-        part in the region, weighted as a patch load is (:func:`plateqp.model.geometry.lumped_region`).
-        The region's outline is a line of the mesh (:meth:`from_scene`), so the region is a union
-        of whole triangles and the areas sum to its area on the plate exactly."""
+        """(n_nodes,) each node's tributary area of a bed on ``region`` (a box [x0, x1, y0, y1], a
+        polygon or a circle; None: the whole plate): a third of every triangle, or of each triangle's
+        part in the region, weighted as a patch load is (:func:`plateqp.model.regions.lumped_region`).
+        The region's outline is a line of the mesh (:meth:`from_scene`; a circle's inscribed polygon),
+        so a box or a polygon is a union of whole triangles; the areas sum to the region's area on
+        the plate exactly (a circle's to rounding)."""
         if region is None:
             return np.bincount(self.triangles.ravel(), weights=np.repeat(self.areas() / 3, 3), minlength=self.n_nodes)
         hit, weights = lumped_region(self.nodes[self.triangles], region)

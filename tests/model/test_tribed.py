@@ -142,7 +142,7 @@ def test_polygon_region_areas_and_outline():
 
 @pytest.mark.parametrize("region, words", [
     ({"polygon": [[2, 2], [3, 2], [3, 3]]}, "does not overlap the plate"),
-    ({"circle": [0.5, 0.5, 0.2]}, "polygon"),
+    ({"circle": [2.5, 2.5, 0.2]}, "does not overlap the plate"),
     ({"polygon": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "self-intersecting"),
 ])
 def test_bad_polygon_regions(region, words):
@@ -150,7 +150,7 @@ def test_bad_polygon_regions(region, words):
         bedded(region)
 
 
-def test_polygon_region_needs_triangles():
-    with pytest.raises(pq.SceneError, match=r"foundation.region: must be \[x0, x1, y0, y1\] \(got"):
+def test_a_region_of_no_known_form_is_named():
+    with pytest.raises(pq.SceneError, match=r"foundation.region: must be \[x0, x1, y0, y1\], \{ polygon"):
         pq.Scene(mesh=pq.MeshSpec(8, 8), loads=[pq.UniformLoad(1.0)],
-                 foundation=pq.Foundation(k=1e3, region={"polygon": L_REGION}))
+                 foundation=pq.Foundation(k=1e3, region={"square": L_REGION}))

@@ -150,24 +150,54 @@ class RectElement:
         """(ncell, ndof): the consistent load of a unit pressure over each cell."""
         return self._per_size(xy, lambda sx, sy: self.load(sx, sy))
 
-    def region_load(self, xy, box) -> tuple[np.ndarray, np.ndarray]:
-        """(hit, loads): the cells (indices into ``xy``) a unit pressure on the box
-        [x0, x1] × [y0, y1] covers in part, and their consistent loads (len(hit), ndof), the box
-        integrated exactly over each cell (:meth:`load` on the sub-box)."""
-        x0, x1, y0, y1 = (float(v) for v in box)
+    def region_load(self, xy, region) -> tuple[np.ndarray, np.ndarray]:
+        """(hit, loads): the cells (indices into ``xy``) a unit pressure on ``region`` covers in
+        part, and their consistent loads (len(hit), ndof), integrated exactly over each cell's part
+        in it: a box [x0, x1, y0, y1] by :meth:`load` on the sub-box; a polygon or a circle
+        (:func:`plateqp.model.geometry.parse_region`) by the moments of each cut cell's part
+        (:func:`plateqp.model.regions.part_moments`: a circle's arcs to rounding), whole cells by
+        :meth:`load`."""
+        from ..regions import as_shape, box_of
+
         xy = np.asarray(xy, dtype=float)
+        box = box_of(region)
         hits, loads = [], []
         for (sx, sy), at in _sizes(xy):
-            ox, oy = xy[at, 0, 0], xy[at, 0, 1]
-            b = np.column_stack([np.clip((x0 - ox) / sx, 0, 1), np.clip((x1 - ox) / sx, 0, 1),
-                                 np.clip((y0 - oy) / sy, 0, 1), np.clip((y1 - oy) / sy, 0, 1)])
-            hit = (b[:, 1] > b[:, 0]) & (b[:, 3] > b[:, 2])
-            if hit.any():
-                hits.append(at[hit])
-                loads.append(self.load(sx, sy, b[hit]))
+            if box is not None:
+                hit, fe = self._box_load(xy[at], box, sx, sy)
+            else:
+                hit, fe = self._shape_load(xy[at], as_shape(region), sx, sy)
+            hits.append(at[hit])
+            loads.append(fe)
         if not hits:
             return np.zeros(0, dtype=int), np.zeros((0, self.ndof))
         return np.concatenate(hits), np.vstack(loads)
+
+    def _box_load(self, xy, box, sx: float, sy: float):
+        x0, x1, y0, y1 = box
+        ox, oy = xy[:, 0, 0], xy[:, 0, 1]
+        b = np.column_stack([np.clip((x0 - ox) / sx, 0, 1), np.clip((x1 - ox) / sx, 0, 1),
+                             np.clip((y0 - oy) / sy, 0, 1), np.clip((y1 - oy) / sy, 0, 1)])
+        hit = np.flatnonzero((b[:, 1] > b[:, 0]) & (b[:, 3] > b[:, 2]))
+        return hit, self.load(sx, sy, b[hit]) if hit.size else np.zeros((0, self.ndof))
+
+    def _shape_load(self, xy, shape, sx: float, sy: float):
+        """Cells of one size (sx, sy): the whole ones' :meth:`load`, each cut one's ∫ N dA over its
+        part, Σ_m (∫∫ ξ^i η^j dA) × the shape functions' monomial coefficients."""
+        from ..regions import part_moments, split_cells
+
+        whole, cut = split_cells(xy, shape)
+        I, J = np.array(self.monomials).T
+        scale = self._dof_scale(sx, sy)
+        parts = []
+        for c in cut:
+            M = part_moments(xy[c], shape, xy[c, 0], (sx, sy), int(max(I.max(), J.max())))
+            parts.append((c, M[0, 0], (M[I, J] @ self._coef) * scale))
+        cut_hit = [c for c, area, _ in parts if area > 1e-10 * sx * sy]
+        fe = [f for _, area, f in parts if area > 1e-10 * sx * sy]
+        hit = np.concatenate([whole, np.array(cut_hit, dtype=int)])
+        out = np.vstack([np.tile(self.load(sx, sy), (len(whole), 1))] + ([np.array(fe)] if fe else []))
+        return hit, out
 
     def _per_size(self, xy, make) -> np.ndarray:
         groups = _sizes(xy)

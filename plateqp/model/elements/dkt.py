@@ -247,12 +247,12 @@ class DKT:
 
     def region_load(self, xy, region) -> tuple[np.ndarray, np.ndarray]:
         """(hit, loads): the triangles (indices into ``xy``) a unit pressure on ``region`` (a box
-        [x0, x1, y0, y1] or a polygon region, :func:`plateqp.model.geometry.region_outline`) covers in
+        [x0, x1, y0, y1], a polygon or a circle: :func:`plateqp.model.geometry.parse_region`) covers in
         part, and their loads (len(hit), 9), lumped on the vertices' w: over each triangle's part
         A_t in the region, ∫ λ_i dA = |A_t| λ_i(centroid of A_t) (λ the barycentric coordinates).
         The uniform load's lumping where the region covers a triangle; statically exact: the
         total is the region's area on the mesh, the moment that of the pressure on it."""
-        from ..geometry import lumped_region
+        from ..regions import lumped_region
 
         hit, weights = lumped_region(_as_tris(xy), region)
         f = np.zeros((hit.size, 9))
