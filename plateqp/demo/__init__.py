@@ -170,6 +170,7 @@ class Comparison:
     # sections 2 and 4 (sections_nodewise_nodes of them)
     sections_rel_nodewise: float = float("nan")
     sections_nodewise_nodes: int = 0
+    sections_nodewise_floor: float = NODEWISE_FLOOR
     s1_ring_radius: float = float("nan")
     s1_ring_one: float = float("nan")
     s1_ring_two: float = float("nan")
@@ -194,7 +195,7 @@ class Comparison:
                        f"{self.sections_dw:.4g}{Lu} = {100 * self.sections_rel:.1f} % of the largest two-sided |w| "
                        f"on those sections (the paper: at most 6 %); {100 * self.sections_rel_plate:.1f} % of max |w| "
                        f"over the plate" + (f"; node by node up to {100 * self.sections_rel_nodewise:.1f} % of |w2| at the "
-                       f"{self.sections_nodewise_nodes} of them where |w2| is at least {100 * NODEWISE_FLOOR:.0f} % of "
+                       f"{self.sections_nodewise_nodes} of them where |w2| is at least {100 * self.sections_nodewise_floor:.0f} % of "
                        "that largest" if self.sections_nodewise_nodes else ""))
         if math.isfinite(self.s1_ring_one):
             out.append(f"sigma1 at {self.s1_ring_radius:g}{Lu} from the load (mean of the 4 points on the x, y lines"
