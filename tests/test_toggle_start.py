@@ -62,3 +62,23 @@ def test_an_lcp_of_unknown_meaning_is_told_in_lcp_terms():
 def test_an_lcp_says_what_its_unknowns_are():
     with pytest.raises(pq.ProblemError, match="unknown"):
         LCP(np.eye(2), np.zeros(2), unknown="forces")
+
+
+def seesaw():
+    """A free square on four posts: two on the line y = 0.5, two settled far (0.5) above and
+    below it. Two-sided, both settled posts pull; toggle lifts them off together and is left
+    on the two posts of one line, about which the plate can turn (statics: no rigid motion of
+    a free plate is held by two points)."""
+    return pq.Scene(name="seesaw", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(10, 10),
+                    loads=[pq.PointLoad(10.0, 0.5, 0.4)],
+                    supports=[pq.Support(0.1, 0.5), pq.Support(0.9, 0.5), pq.Support(0.5, 0.9, gap=0.5),
+                              pq.Support(0.5, 0.1, gap=0.5)])
+
+
+def test_a_plate_round_on_two_posts_is_named_not_solved():
+    scene = seesaw()
+    R2 = pq.solve_bilateral(scene).reactions
+    assert R2[2] < 0 and R2[3] < 0  # both settled posts in tension: the next round drops both
+    with pytest.raises(pq.SolverError, match=r"round 2: the supports in contact \(rows 1, 2\) do not hold the plate"):
+        _solve(scene, backend="toggle")
+    assert _solve(scene).kkt.ok  # the problem itself has its answer (the plate rests on post 4)
