@@ -125,14 +125,26 @@ class QP:
         return sp.issparse(self.P)
 
 
+#: What the z of an :class:`LCP` may stand for.
+LCP_UNKNOWNS = ("z", "reactions", "gaps")
+
+
 @dataclass
 class LCP:
-    """A linear complementarity problem LCP(M, q); M dense (n, n)."""
+    """A linear complementarity problem LCP(M, q); M dense (n, n).
+
+    ``unknown``: what z stands for, one of :data:`LCP_UNKNOWNS`: "reactions" (the dual form:
+    w the gaps), "gaps" (the condensed form: w the reactions), or "z" (a plain LCP). Solvers
+    that read it only to phrase their messages or choose a start (``toggle``) may.
+    """
 
     M: np.ndarray
     q: np.ndarray
+    unknown: str = "z"
 
     def __post_init__(self) -> None:
+        if self.unknown not in LCP_UNKNOWNS:
+            raise ProblemError(f"unknown: one of {', '.join(map(repr, LCP_UNKNOWNS))}, got {self.unknown!r}")
         self.M = np.asarray(self.M.toarray() if sp.issparse(self.M) else self.M, dtype=float)
         self.q = np.asarray(self.q, dtype=float).reshape(-1)
         n = self.q.shape[0]

@@ -171,7 +171,7 @@ class Condensed(Formulation):
             # symmetrise from the row that is accurate relative to the entry (the smaller σ)
             lo, hi = sigma[:, None] < sigma[None, :], sigma[:, None] > sigma[None, :]
             M = np.where(lo, M, np.where(hi, M.T, 0.5 * (M + M.T)))
-        self.lcp = LCP(M, q)
+        self.lcp = LCP(M, q, unknown="gaps")
         self.qp = self.lcp.as_qp()
         self._T, self._fac, self._Koc, self._fo, self._m = T, fac, Koc, fo, m
 
@@ -214,7 +214,7 @@ class Dual(Formulation):
         u0 = fac.solve(data.f, refine=3)
         F = G + np.diag(data.rho)
         dvec = data.g0 - B @ u0
-        self.lcp = LCP(F, dvec)
+        self.lcp = LCP(F, dvec, unknown="reactions")
         self.qp = self.lcp.as_qp()
         self._fac, self._d = fac, dvec
         self._shift = np.zeros(data.m)  # q = d + shift: the correction handed to the backend
@@ -257,7 +257,7 @@ class Dual(Formulation):
         """The same problem with q moved by ``e`` (a :meth:`defect`)."""
         nxt = copy.copy(self)
         nxt._shift = self._shift + e
-        nxt.lcp = LCP(self.lcp.M, self._d + nxt._shift)
+        nxt.lcp = LCP(self.lcp.M, self._d + nxt._shift, unknown="reactions")
         nxt.qp = nxt.lcp.as_qp()
         nxt._last = None
         return nxt

@@ -40,7 +40,7 @@ class Regulation:
     target: np.ndarray  # reactions asked of them
     gaps_before: np.ndarray  # every support's gap, scene order
     gaps: np.ndarray  # every support's regulated gap
-    check: Result  # pq.solve of the regulated scene
+    check: Result  # pq.solve of the regulated scene (accuracy "high"): the reactions its gaps give
     shim: np.ndarray | None = None  # dR_i/dg0_j among the regulated supports, at the regulated scene
 
     @property
@@ -77,12 +77,11 @@ def regulation(scene: Scene | None = None) -> RegulationStudy:
     runs = []
     foot = np.array(FOOT)
     target = np.full(foot.size, before.reactions[foot].mean())
-    r = regulate_gaps(scene, target, supports=foot.tolist())
-    check = _solve(r.scene)
-    runs.append(Regulation("equalise", foot, target, g0, r.gaps, check, shim_sensitivity(check, foot)[0]))
+    r = regulate_gaps(scene, target, supports=foot.tolist())  # r.check: pq.solve of the regulated scene
+    runs.append(Regulation("equalise", foot, target, g0, r.gaps, r.check, shim_sensitivity(r.check, foot)[0]))
     flat = np.flatnonzero(g0 == 0.0)
     r = regulate_gaps(scene, level.reactions[flat], supports=flat.tolist())
-    runs.append(Regulation("re-level", flat, level.reactions[flat], g0, r.gaps, _solve(r.scene)))
+    runs.append(Regulation("re-level", flat, level.reactions[flat], g0, r.gaps, r.check))
     return RegulationStudy(scene, before, level, runs)
 
 

@@ -50,6 +50,7 @@ from ..linalg import Factor, solve_saddle
 from ..model.paths import set_param
 from ..progress import Progress
 from ..model.scene import PointLoad, Scene
+from ..results import Result
 from ..solving import solve
 from .reuse import adapt_model
 
@@ -64,19 +65,37 @@ class GapRegulation:
     """Gaps that make the regulated supports carry prescribed reactions.
 
     ``gaps``: new initial gap of every support (scene order); ``scene``: a copy with them;
-    ``supports``: the regulated supports; ``target``: the reactions asked; ``reactions``: the
-    reactions the gaps produce (the target, projected onto equilibrium on a floating plate);
-    ``other_reactions``: those of the unregulated supports; ``projection``: relative distance
-    ‖reactions − target‖ / ‖target‖ (0 when the target is reachable).
+    ``supports``: the regulated supports; ``target``: the reactions asked; ``aimed``: the
+    reactions the gaps were computed for (the target, projected onto equilibrium on a floating
+    plate); ``check``: the contact solve of ``scene`` (:func:`plateqp.solve`, accuracy "high"),
+    with exactly these gaps; ``reactions`` and ``other_reactions``: the regulated and the
+    other supports' reactions in that solve, so what the gaps give, not what they aim at;
+    ``projection``: relative distance ‖aimed − target‖ / ‖target‖ (0 when the target is
+    reachable).
     """
 
     gaps: np.ndarray
     scene: Scene
     supports: np.ndarray
     target: np.ndarray
-    reactions: np.ndarray
-    other_reactions: np.ndarray
+    aimed: np.ndarray
+    check: Result
     projection: float
+
+    @property
+    def reactions(self) -> np.ndarray:
+        return self.check.reactions[self.supports]
+
+    @property
+    def other_reactions(self) -> np.ndarray:
+        return np.delete(self.check.reactions, self.supports)
+
+    @property
+    def miss(self) -> float:
+        """max |reactions − aimed|, relative to the largest of either."""
+        scale = max(float(np.abs(self.aimed).max(initial=0.0)), float(np.abs(self.check.reactions).max(initial=0.0)),
+                    1e-300)
+        return float(np.abs(self.reactions - self.aimed).max(initial=0.0) / scale)
 
     @property
     def reachable(self) -> bool:
@@ -149,7 +168,8 @@ def regulate_gaps(scene: Scene, target_reactions, supports: Sequence[int] | None
     g0 = w − R/c (c its stiffness; R/c = 0 for a rigid one), so that it touches with exactly R.
     A target of 0 leaves that support touching with zero force (add a margin to lift it off).
     On a floating plate the target is first projected onto equilibrium (see module docs).
-    Check the answer with ``pq.solve(result.scene)``.
+    The regulated scene is then solved (``backend``, ``formulation``, accuracy "high"): the
+    reactions returned are that solve's (``result.check``), those the returned gaps give.
     """
     ns = len(scene.supports)
     if ns == 0:
@@ -177,7 +197,6 @@ def regulate_gaps(scene: Scene, target_reactions, supports: Sequence[int] | None
     proj = float(np.linalg.norm(R_reg - target) / max(np.linalg.norm(target), 1e-300))
 
     # the plate under the load and the regulated reactions (as upward point forces)
-    R_other = np.zeros(others.size)
     if others.size:
         sc = copy.deepcopy(scene)
         sc.supports = [scene.supports[k] for k in others]
@@ -189,7 +208,6 @@ def regulate_gaps(scene: Scene, target_reactions, supports: Sequence[int] | None
             res = solve(sc, backend=backend, formulation=formulation, accuracy="high")
         w_reg = np.asarray(res.deflection(np.array([scene.supports[k].x for k in reg]),
                                           np.array([scene.supports[k].y for k in reg])), dtype=float)
-        R_other = res.reactions.copy()
     else:
         rhs = model.f - c.B[reg].T @ R_reg
         u = _held_or_floating(model, rhs, V)
@@ -204,8 +222,13 @@ def regulate_gaps(scene: Scene, target_reactions, supports: Sequence[int] | None
     gaps = np.array([s.gap for s in scene.supports], dtype=float)
     gaps[reg] = w_reg - c.rho[reg] * R_reg
     new = set_param(scene, "supports.*.gap", gaps)
-    logger.info("regulate_gaps: %d supports regulated, relative distance to the target %.2e", reg.size, proj)
-    return GapRegulation(gaps, new, reg, target, R_reg, R_other, proj)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlateQPWarning)  # the check's status says it
+        check = solve(new, backend=backend, formulation=formulation, accuracy="high")
+    out = GapRegulation(gaps, new, reg, target, R_reg, check, proj)
+    logger.info("regulate_gaps: %d supports regulated, relative distance to the target %.2e, the check solve "
+                "%.1e off the reactions aimed at", reg.size, proj, out.miss)
+    return out
 
 
 def shim_sensitivity(result, supports) -> tuple[np.ndarray | None, str | None]:

@@ -61,7 +61,7 @@ def test_twist_gaps_match_the_closed_form(capsys, corners, tmp_path):
     d = json.loads(stdout)
     p = np.array([1.0, -1.0, 1.0, -1.0])
     np.testing.assert_allclose(d["gaps"], -t * p / (4 * K_TWIST), rtol=1e-9)
-    np.testing.assert_allclose([r["reaction_check"] for r in d["supports"]], target, rtol=1e-9)
+    np.testing.assert_allclose([r["reaction"] for r in d["supports"]], target, rtol=1e-9)
     assert [r["support"] for r in d["supports"]] == [1, 2, 3, 4] and d["reachable"]
     # the regulated scene written is the one checked: solving it gives the target again
     code, stdout, err = run(capsys, "solve", out, "--json", "--accuracy", "high")
@@ -74,7 +74,7 @@ def test_a_target_out_of_equilibrium_is_projected_and_says_so(capsys, corners):
     assert code == 5 and err.count("\n") == 1 and "not in equilibrium" in err
     d = json.loads(stdout)
     assert not d["reachable"]
-    np.testing.assert_allclose([r["reaction_check"] for r in d["supports"]], Q / 4, rtol=1e-9)  # statics
+    np.testing.assert_allclose([r["reaction"] for r in d["supports"]], Q / 4, rtol=1e-9)  # statics
 
 
 @pytest.mark.parametrize("argv, words", [

@@ -36,8 +36,6 @@ KNOWN_FAILURES: dict[tuple[str, str], str] = {
                                   "our statics check turns the false claim into a SolverError",
     ("cvxpy:CVXOPT", "primal"): "CVXOPT through cvxpy ends in solver_error at the 'high' preset",
     ("cvxpy:CVXOPT", "dual"): "CVXOPT through cvxpy ends in solver_error at the 'high' preset",
-    ("toggle", "condensed"): "toggle starts with every support in contact: on a floating plate a singular M_AA "
-                             "(it says which round)",
 }
 
 PAIRS = [(b, f) for b in ALL for f in formulations_for(b)]
@@ -68,9 +66,8 @@ def run_checked(scene, backend, formulation, reference):
     check_claim(res, reference)
 
 
-#: Declared give-ups with status ERROR, by (backend, formulation): the teaching backend toggle
-#: starts with every support in contact, which on a floating plate is a singular M_AA (it says so).
-KNOWN_ERRORS = {("toggle", "condensed"): "floating plate: all supports at once give a singular M_AA"}
+#: Declared give-ups with status ERROR, by (backend, formulation).
+KNOWN_ERRORS: dict[tuple[str, str], str] = {}
 
 
 def check_claim(res, reference, rtol=1e-6):
