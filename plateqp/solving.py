@@ -110,9 +110,12 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
 
     Raises
     ------
-    SceneError if ``scene`` is not a valid Scene (checked again here: it may have been changed
-    since it was built), and an error naming the argument for any other bad argument
-    (:func:`check_arguments`), before any work.
+    SceneError
+        If ``scene`` is not a valid Scene (checked again here: it may have been changed since
+        it was built), before any work.
+    PlateQPError
+        One of its kinds, naming the argument, for any other bad argument
+        (:func:`check_arguments`), before any work.
     """
     accuracy = check_arguments(scene, backend, formulation, accuracy, options, model, check_statics)
     auto = isinstance(accuracy, str) and accuracy == "auto"

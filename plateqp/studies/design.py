@@ -162,6 +162,8 @@ def regulate_gaps(scene: Scene, target_reactions, supports: Sequence[int] | None
     target_reactions : one value per regulated support, or one value for all
     supports : indices of the regulated supports (default: every support)
 
+    Notes
+    -----
     The regulated supports act on the plate as the forces R; the plate (with the other
     one-sided supports in contact as the contact problem says, solved with
     :func:`plateqp.solve`) deflects by w; the gap of each regulated support is then
