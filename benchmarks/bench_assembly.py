@@ -539,7 +539,6 @@ def profile(n: int, element: str) -> int:
 
     sys.path.insert(0, str(ROOT))
     from plateqp.model.assembly import build_model
-
     sc = _scene(element, n)
     build_model(_scene(element, 4))  # imports only: the profiled call is a first (cold) call, as in use
     pr = cProfile.Profile()

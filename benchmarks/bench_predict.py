@@ -127,7 +127,6 @@ def predicted(kind: str, n: int, d: int) -> tuple:
 
 def raw(kind: str, n: int) -> float:
     from plateqp.model.assembly import build_model
-
     K, f = plate_matrix("bed", build_model(SCENES[kind](n)))  # every (soft) row bonded
     A = to_cvxopt(K)
     t0 = time.process_time()

@@ -1206,7 +1206,6 @@ import numpy as np
 import matplotlib.pyplot as plt
 import plateqp as pq
 from plateqp.model.assembly import build_model
-
 pts = [(x, y) for x in (0.25, 0.5, 0.75) for y in (0.25, 0.5, 0.75)]
 gaps = [0.0, 1e-3, -1e-3, 2e-3, 0.0, -2e-3, 1e-3, 0.0, 0.0]      # m: + settled, − heaved
 plate = pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3)

@@ -156,8 +156,7 @@ def _stdout_to_stderr():
 
 def _set_memory_limit(text: str | None) -> None:
     if text:
-        from ..model.assembly import MEMORY_ENV, parse_bytes
-
+        from ..model.memory import MEMORY_ENV, parse_bytes
         parse_bytes(text, "--max-memory")
         os.environ[MEMORY_ENV] = text  # worker processes inherit it
 

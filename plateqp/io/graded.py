@@ -130,7 +130,6 @@ def graded_scene(mesh: int, kind: str, gaps: str) -> Scene:
     if not ref.kkt.ok:
         raise ProblemError(f"{mixed.name}: the exact solve for the lift-off gaps missed its KKT check")
     from ..model.assembly import build_model
-
     xy = build_model(mixed).contacts.xy
     lifted = ~np.asarray(ref.active)
     # the exact lift-off gap: g0 − gap, at the points that lift off (their R = 0, s = 0)

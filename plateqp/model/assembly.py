@@ -1,5 +1,8 @@
 """From a Scene to a Model: dof map, vectorised sparse assembly, loads, two-sided supports.
 
+The memory check before it: :mod:`plateqp.model.memory`; the generator of a scene's mesh:
+:mod:`plateqp.model.meshes`.
+
 Dofs: node n carries ``ndof_node`` dofs numbered ``n·ndof_node + k`` on the full grid.
 Two-sided supports prescribe some of them (``fixed`` with ``values``); the rest of the plate's
 dofs are ``free``. The Model holds, on the free dofs,
@@ -12,9 +15,7 @@ element's interpolation) with the gaps g0 shifted by the prescribed dofs' contri
 
 from __future__ import annotations
 
-import copy
 import dataclasses
-import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -24,13 +25,15 @@ import scipy.sparse as sp
 
 from .constraints import prescribed, rigid_modes
 from .elements import ELEMENTS, RectElement
-from ..errors import ResourceError, SceneError
-from .grid import Grid
-from .trimesh import TriMesh
+from ..errors import SceneError
+from .memory import check_memory
+from .meshes import mesh_generator
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
 
 if TYPE_CHECKING:  # pragma: no cover
     from .elements import DKT
+    from .grid import Grid
+    from .trimesh import TriMesh
 
 
 @dataclass
@@ -184,94 +187,6 @@ def load_vector(scene: Scene, mesh, element, cell_dofs: np.ndarray, n_full: int)
         elif isinstance(ld, PointLoad):
             f += ld.P * interpolation(mesh, element, cell_dofs, n_full, ld.x, ld.y).toarray().ravel()
     return f
-
-
-#: Peak memory of building and solving a scene, per dof of its grid: measured (resident set
-#: size, grid_rigid family, auto backend) 11.7 KB at 128², 9.9 KB at 256², 9.2 KB at 512².
-BYTES_PER_DOF = 12_000
-#: The environment variable that overrides the memory limit (bytes, or with a K/M/G/T suffix).
-MEMORY_ENV = "PLATEQP_MAX_MEMORY"
-
-
-def estimate_memory(scene: Scene) -> int:
-    """Bytes a build and solve of ``scene`` is expected to need at its peak (see BYTES_PER_DOF):
-    the dofs of the mesh its generator expects (``estimate_nodes``)."""
-    nd = len(ELEMENTS[scene.mesh.element].node_dofs)
-    return int(BYTES_PER_DOF * nd * mesh_generator(scene).estimate_nodes(scene))
-
-
-def memory_limit() -> int:
-    """The memory a solve may plan to use: ``$PLATEQP_MAX_MEMORY`` if set, else 80 % of this
-    machine's physical memory (no limit where that cannot be read)."""
-    text = os.environ.get(MEMORY_ENV, "").strip()
-    if text:
-        return parse_bytes(text, MEMORY_ENV)
-    try:
-        return int(0.8 * os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
-        return 2**63 - 1
-
-
-def parse_bytes(text: str, where: str) -> int:
-    """'8G', '512M', '1.5e9' → bytes; a SceneError naming ``where`` otherwise."""
-    t = str(text).strip().upper().removesuffix("B")
-    mult = {"K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}.get(t[-1:], 1)
-    try:
-        value = float(t[:-1] if t[-1:] in "KMGT" else t) * mult
-    except ValueError:
-        value = float("nan")
-    if not (value > 0 and np.isfinite(value)):
-        raise SceneError(f"{where}: {text!r} is not an amount of memory (e.g. 8G, 512M, 2e9)")
-    return int(value)
-
-
-def human_bytes(n: float) -> str:
-    for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
-        if n >= size:
-            return f"{n / size:.1f} {unit}"
-    return f"{n:.0f} B"
-
-
-def check_memory(scene: Scene) -> None:
-    """ResourceError before any allocation if ``scene`` would need more memory than allowed."""
-    need, limit = estimate_memory(scene), memory_limit()
-    if need > limit:
-        where, mesh, fix = mesh_generator(scene).describe(scene)
-        raise ResourceError(f"{where}: a {mesh} needs about {human_bytes(need)} to build and solve, above the limit "
-                            f"of {human_bytes(limit)}; {fix}, or raise the limit (--max-memory or ${MEMORY_ENV})")
-
-
-#: The mesh generator of each ``cell_type`` (:data:`plateqp.model.elements.ELEMENTS`): its class
-#: answers ``from_scene``, ``estimate_nodes``, ``describe``, and its meshes the names every mesh
-#: answers (nodes, cells, locate, boundary_edges, assemble, tributary_areas, …).
-GENERATORS = {"quad": Grid, "triangle": TriMesh}
-
-
-def mesh_generator(scene: Scene):
-    """The generator that meshes ``scene`` (:data:`GENERATORS`, by its element's cell type)."""
-    return GENERATORS[ELEMENTS[scene.mesh.element].cell_type]
-
-
-
-def mesh_cells(scene: Scene) -> tuple[int, int]:
-    """The mesh of a scene as the studies by mesh halving count it, in cells a side: (nx, ny) of
-    a grid; on triangles (n, n), n = L / h rounded (halving h doubles n)."""
-    return mesh_generator(scene).cells_a_side(scene)
-
-
-def with_cells(scene: Scene, nx: int, ny: int) -> Scene:
-    """A validated copy of ``scene`` meshed nx × ny cells a side (:func:`mesh_cells`; on
-    triangles the element size L / nx)."""
-    sc = copy.deepcopy(scene)
-    mesh_generator(scene).set_cells(sc, nx, ny)
-    sc.validate()
-    return sc
-
-
-def start_cells(scene: Scene, cells: int = 4) -> tuple[int, int]:
-    """The first mesh of a refinement ladder: ``cells`` on the shorter side, the other in
-    proportion to the scene's own grid (on triangles (cells, cells))."""
-    return mesh_generator(scene).start_cells(scene, cells)
 
 
 def build_model(scene: Scene) -> Model:

@@ -11,7 +11,7 @@ from .parts import _short
 from .symmetry import MODES, check_symmetry
 
 #: No scene needs more cells than this; the memory a mesh needs is checked before assembly
-#: (:func:`plateqp.model.assembly.check_memory`), this only keeps validation itself small.
+#: (:func:`plateqp.model.memory.check_memory`), this only keeps validation itself small.
 MAX_CELLS = 10_000_000
 EDGE_KINDS = ("free", "simple", "clamped")
 GAP_PROFILES = ("uniform", "linear", "trough", "bump")

@@ -12,7 +12,9 @@ import dataclasses
 
 import numpy as np
 
-from ..model.assembly import Model, mesh_generator
+from ..model.assembly import Model
+
+from ..model.meshes import mesh_generator
 from ..model.scene import Scene
 
 

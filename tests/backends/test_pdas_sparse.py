@@ -284,7 +284,6 @@ def test_bed_24_statics_and_contact_physics():
 @pytest.fixture(scope="module")
 def bed_8_matrices():
     from plateqp.model.assembly import build_model
-
     m = build_model(F.bed(8))
     K = m.K.tocsc()
     return K, m.contacts.B.tocsr(), K.diagonal().copy()

@@ -291,7 +291,6 @@ def test_a_scene_changed_after_construction_gives_the_constructors_message():
 
 def test_a_model_built_before_is_taken(res):
     from plateqp.model.assembly import build_model
-
     sc = make_scene()
     own = build_model(sc)
     assert np.allclose(pq.solve(sc, model=own, backend="lemke").reactions, res.reactions, rtol=1e-9, atol=0)

@@ -12,9 +12,8 @@ import numpy as np
 import pytest
 
 import plateqp as pq
-from plateqp.model.assembly import MEMORY_ENV, build_model, check_memory, estimate_memory, memory_limit, parse_bytes
-
-
+from plateqp.model.assembly import build_model
+from plateqp.model.memory import MEMORY_ENV, check_memory, estimate_memory, memory_limit, parse_bytes
 def plate(nx=8, ny=8, **kw):
     return pq.Scene(name="t", mesh=pq.MeshSpec(nx, ny), loads=[pq.UniformLoad(1.0)],
                     edges={"left": pq.Edge("simple", w=0.002), "right": "clamped"}, **kw)

@@ -16,7 +16,6 @@ import pytest
 import plateqp as pq
 from plateqp.scenes import families as F
 from plateqp.model.assembly import build_model
-
 TOTAL = F.Q * F.A * F.A + F.P  # kN: 10 kN/m² on 8 m × 8 m plus the 300 kN column
 MOMENT_X = F.Q * F.A * F.A * F.A / 2 + F.P * F.PX  # Σ load · x about the y axis
 MOMENT_Y = F.Q * F.A * F.A * F.A / 2 + F.P * F.PY

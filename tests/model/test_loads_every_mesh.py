@@ -8,7 +8,6 @@ import pytest
 
 import plateqp as pq
 from plateqp.model.assembly import build_model
-
 pytest.importorskip("gmsh")
 
 BOX = (0.3, 0.9, 0.2, 0.7)  # a patch with no side on a grid line of 8 or 16 cells

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 import plateqp as pq
-from plateqp.model.assembly import GENERATORS, build_model
+from plateqp.model.assembly import build_model
+from plateqp.model.meshes import GENERATORS
 from plateqp.model.elements import ELEMENTS
 
 

@@ -381,7 +381,6 @@ def test_four_corner_pins_symmetric(make_scene, element):
 @pytest.mark.parametrize("element", ["acm", "bfs"])
 def test_patch_over_whole_plate_equals_uniform(make_scene, element):
     from plateqp.model.assembly import build_model
-
     u = build_model(make_scene(element, 6, 4, loads=[pq.UniformLoad(Q)], **PLATE))
     p = build_model(make_scene(element, 6, 4, loads=[pq.PatchLoad(Q, 0, A, 0, A)], **PLATE))
     big = build_model(make_scene(element, 6, 4, loads=[pq.PatchLoad(Q, -1, 2 * A, -3, 5 * A)], **PLATE))
@@ -398,7 +397,6 @@ def test_patch_over_whole_plate_equals_uniform(make_scene, element):
 def test_patch_load_integrates_exactly(make_scene, element, box):
     """Σ f·d(p) = ∫ q p dA for p = 1, x, y, x², xy, y² (all in both element spaces)."""
     from plateqp.model.assembly import build_model
-
     x0, x1, y0, y1 = (A * v for v in box)
     model = build_model(make_scene(element, 8, 4, loads=[pq.PatchLoad(Q, x0, x1, y0, y1)], **PLATE))
     x0, x1, y0, y1 = max(x0, 0), min(x1, A), max(y0, 0), min(y1, A)
@@ -429,7 +427,6 @@ def poly_dofs(model):
 @pytest.mark.parametrize("element", ["acm", "bfs"])
 def test_point_load_at_node(make_scene, element):
     from plateqp.model.assembly import build_model
-
     model = build_model(make_scene(element, 8, loads=[pq.PointLoad(P, 0.375 * A, 0.5 * A)], **PLATE))
     f = np.zeros(model.n_full)
     f[model.grid.node_at(0.375 * A, 0.5 * A) * model.element.ndof_node] = P
@@ -441,7 +438,6 @@ def test_point_load_at_node(make_scene, element):
 def test_point_load_off_node(make_scene, element, pt):
     """Consistent loads f_k = P N_k(x_P): Σ f·d(p) = P p(x_P) for every polynomial p of the space."""
     from plateqp.model.assembly import build_model
-
     xp, yp = pt[0] * A, pt[1] * A
     model = build_model(make_scene(element, 8, loads=[pq.PointLoad(P, xp, yp)], **PLATE))
     for (i, j), d in poly_dofs(model).items():

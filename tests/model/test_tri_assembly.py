@@ -10,7 +10,6 @@ import scipy.sparse as sp
 
 import plateqp as pq
 from plateqp.model.assembly import build_model
-
 pytest.importorskip("gmsh")
 
 

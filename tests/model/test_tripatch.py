@@ -15,7 +15,6 @@ import pytest
 
 import plateqp as pq
 from plateqp.model.assembly import build_model
-
 pytest.importorskip("gmsh")
 
 SQ = [[0, 0], [1, 0], [1, 1], [0, 1]]

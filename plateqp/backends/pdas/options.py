@@ -164,7 +164,7 @@ LH_BUDGET, LH_OVERHEAD, LH_PROBE = 0.5, 5e4, 24
 #: Newton phase starts from its reactions.
 #: The rows of M it keeps (m doubles each, in a buffer that doubles) may take at most LH_MEMORY
 #: bytes per dof of the plate, a quarter of what plateqp plans for a whole solve
-#: (:data:`plateqp.model.assembly.BYTES_PER_DOF`): a post on every node needs 33 MB at 128², 416 MB at
+#: (:data:`plateqp.model.memory.BYTES_PER_DOF`): a post on every node needs 33 MB at 128², 416 MB at
 #: 256² (389 rows in contact, 590 MB allowed); at 512² it would give up.
 LH_BLOCK, LH_TIME, LH_PRESSED, LH_MEMORY = 8, 30.0, 0.5, 3000
 #: (sparse, stiff rows, floating plate, cold start) Lawson–Hanson on the anchored plate's
