@@ -25,6 +25,7 @@ import scipy.sparse as sp
 from .constraints import prescribed, rigid_modes
 from .elements import ELEMENTS, RectElement
 from ..errors import ResourceError, SceneError
+from .generators import GENERATORS, mesh_generator  # noqa: F401  (GENERATORS: read by callers)
 from .grid import Grid
 from .trimesh import TriMesh
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
@@ -239,18 +240,6 @@ def check_memory(scene: Scene) -> None:
         where, mesh, fix = mesh_generator(scene).describe(scene)
         raise ResourceError(f"{where}: a {mesh} needs about {human_bytes(need)} to build and solve, above the limit "
                             f"of {human_bytes(limit)}; {fix}, or raise the limit (--max-memory or ${MEMORY_ENV})")
-
-
-#: The mesh generator of each ``cell_type`` (:data:`plateqp.model.elements.ELEMENTS`): its class
-#: answers ``from_scene``, ``estimate_nodes``, ``describe``, and its meshes the names every mesh
-#: answers (nodes, cells, locate, boundary_edges, assemble, tributary_areas, …).
-GENERATORS = {"quad": Grid, "triangle": TriMesh}
-
-
-def mesh_generator(scene: Scene):
-    """The generator that meshes ``scene`` (:data:`GENERATORS`, by its element's cell type)."""
-    return GENERATORS[ELEMENTS[scene.mesh.element].cell_type]
-
 
 
 def mesh_cells(scene: Scene) -> tuple[int, int]:

@@ -46,9 +46,9 @@ def check_plate_and_mesh(sc) -> None:
                  f"(at most {MAX_CELLS:.0e}); the memory a mesh needs is checked before assembly")
     if not isinstance(m.element, str) or m.element not in ELEMENTS:
         sc._fail("mesh.element", f"unknown element {_short(m.element)}; choose one of {tuple(ELEMENTS)}")
-    if not sc.triangles and (p.shape is not None or m.size is not None):
-        sc._fail("plate.shape" if p.shape is not None else "mesh.size",
-                 'needs a triangle mesh: set mesh.element = "dkt"')
+    from .generators import mesh_generator
+
+    mesh_generator(sc).check_scene_fields(sc)  # e.g. a shape or an element size needs triangles
 
 
 def check_edges(sc) -> None:
@@ -87,11 +87,11 @@ def check_cutouts(sc):
 def plate_cover(sc):
     """What the point checks ask of the plate (``covers``, ``locate``, ``node_at``,
     ``covers_area``, ``cells_centred_in``, ``domain``): the grid, or on triangles the plate's
-    region (its shape and cut-outs checked: :func:`plateqp.model.geometry.validate_shaped`)."""
-    from .geometry import validate_shaped
-    from .grid import Grid
+    region (its shape and cut-outs checked: :func:`plateqp.model.geometry.validate_shaped`), as
+    the scene's mesh generator gives it (``cover``)."""
+    from .generators import mesh_generator
 
-    return validate_shaped(sc) if sc.triangles else Grid.from_scene(sc)
+    return mesh_generator(sc).cover(sc)
 
 
 def check_pins(sc, grid) -> None:

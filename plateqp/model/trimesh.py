@@ -114,11 +114,10 @@ class TriMesh:
         """The scene's plate meshed by gmsh at its element size, with a node at every support,
         point load and pin, and the bed region's outline drawn into the mesh (:func:`mesh_domain`)."""
         from .geometry import mesh_size, scene_domain
-        from .scene import PointLoad
 
         domain = scene_domain(scene)
         points = [(s.x, s.y) for s in scene.supports] + [(ld.x, ld.y) for ld in scene.loads
-                                                         if isinstance(ld, PointLoad)] + [(p.x, p.y) for p in scene.pins]
+                                                         if ld.type == "point"] + [(p.x, p.y) for p in scene.pins]
         lines = [] if scene.foundation is None or scene.foundation.region is None else inner_segments(
             domain, region_outline(scene.foundation.region))
         return mesh_domain(domain, mesh_size(scene), points, lines)
@@ -280,6 +279,54 @@ class TriMesh:
         tri = np.where((best >= -1e-9) & finite, tri, -1)
         lam = np.where(tri[:, None] >= 0, np.clip(np.nan_to_num(lam), 0.0, 1.0), 1.0 / 3.0)
         return tri, lam / lam.sum(axis=1, keepdims=True)
+
+    # -- what the scene's checks, the figures and the tables ask of every mesh (Grid too) -------
+    @staticmethod
+    def check_scene_fields(scene) -> None:
+        """The scene-language rules of triangles: every shape and element size meshes."""
+
+    @staticmethod
+    def cover(scene):
+        """What the point checks ask of the plate: its region (:func:`.geometry.validate_shaped`)."""
+        from .geometry import validate_shaped
+        return validate_shaped(scene)
+
+    #: whether ``edges.all`` held the cut-outs' edges before: yes on triangles (a warning says so)
+    all_held_holes = True
+    #: the demo's studies not yet run on this mesh, (name, why) pairs
+    not_yet_studied = (("convergence", ("the convergence study halves the structured grid (nx × ny); it does not "
+                                        "yet refine a triangle mesh (mesh.size)")),
+                       ("comparison", ("the paper's statements (zones, sections 2 and 4, σ1 on a ring around the "
+                                       "load) are measured on the structured grid's nodes; not yet on a triangle mesh")))
+
+    def caption(self, element: str) -> str:
+        """The mesh in a figure's caption: "triangle mesh (size h, ELEMENT)"."""
+        return f"triangle mesh (size {self.size:g}, {element.upper()})"
+
+    def outline_paths(self) -> list[tuple[str, np.ndarray, bool]]:
+        """The outline to draw, [(gid, points, closed)]: the outer boundary ("outline") and each
+        hole ("hole") as a closed loop of boundary nodes (:func:`.views.boundary_loops`)."""
+        from .views import boundary_loops
+        return [("outline" if k == 0 else "hole", pts, True) for k, pts in boundary_loops(self)]
+
+    def contour_position(self, xy: np.ndarray) -> tuple[np.ndarray, bool]:
+        """(zeros, False): a shaped plate's points are not placed along a rectangle's contour."""
+        return np.zeros(len(xy)), False
+
+    def default_sections(self, scene) -> list:
+        """Section lines cut to the plate (:func:`plateqp.model.views.cut_sections`)."""
+        from .views import cut_sections
+        return cut_sections(self, scene)
+
+    def field_layout(self, fields: dict, nodes: bool = False) -> tuple:
+        """(dims, coords, fields) of nodal fields in a dataset: one value per node (no grid view)."""
+        from .views import node_layout
+        return node_layout(self, fields)
+
+    @staticmethod
+    def plan_view(structured, shaped):
+        """Of a figure's two plan views, the one that draws this mesh: ``shaped``."""
+        return shaped
 
 
 def _barycentric(p, x, y):
