@@ -19,7 +19,7 @@ and uses it two ways:
   estimated error of max |w| and of the reactions is below REL, solving each mesh at a solver
   tolerance of a tenth of REL: the coarsest mesh and the loosest setting that reach it.
 
-On triangles a mesh of n cells a side has element size L / n (:func:`plateqp.model.meshes.mesh_cells`);
+On triangles a mesh of n cells a side has element size L / n (:func:`plateqp.model.generators.mesh_cells`);
 the meshes are not nested, so the change of w is read from max |w| alone.
 
 The quantities are the ones engineers read: the largest deflection max |w|, and the
@@ -38,7 +38,7 @@ import numpy as np
 
 from collections.abc import Callable
 
-from .model.meshes import mesh_cells, with_cells
+from .model.generators import mesh_cells, with_cells
 from .errors import MechanismError, PlateQPWarning, ProblemError, SceneError, SolverError
 from .results import Result
 from .model.scene import Scene
@@ -172,7 +172,7 @@ def confirm(est: ErrorEstimate, final: Result, order: float = ORDER) -> ErrorEst
 
 def with_mesh(scene: Scene, nx: int, ny: int) -> Scene:
     """A validated copy of ``scene`` meshed nx × ny cells a side: on a grid nx × ny cells, on
-    triangles of element size h = L / nx (:func:`plateqp.model.meshes.with_cells`)."""
+    triangles of element size h = L / nx (:func:`plateqp.model.generators.with_cells`)."""
     return with_cells(scene, nx, ny)
 
 

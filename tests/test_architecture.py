@@ -249,17 +249,7 @@ SCENE_NAMES = {"scene", "sc", "a", "b", "s", "self"}
 #: Known remaining questions about the mesh kind, ``module:function`` → how many, declared as
 #: data: each must still be there, so that removing one removes it from here.
 KNOWN_MESH_KIND_BRANCHES: dict[str, int] = {
-    # the scene language's own rules by mesh: a shape or an element size needs triangles; a
-    # cut-out is cut exactly on triangles, by cells on the grid
-    "plateqp.model.checks:check_plate_and_mesh": 1,
-    "plateqp.model.checks:plate_cover": 1,
-    "plateqp.model.constraints:warn_changed_all": 1,
-    "plateqp.demo:run_scene": 1,
-    "plateqp.io.fields:to_xarray": 1,  # the grid view where the mesh has one
-    "plateqp.plotting.charts:plot_reactions": 1,
-    "plateqp.plotting.marks:_draw_outline": 1,
-    "plateqp.plotting.plan:default_sections": 1,
-    "plateqp.plotting.plan:plot_mesh": 1,
+    # none: every question about the mesh kind is asked in a generator or an element
 }
 
 

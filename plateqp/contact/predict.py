@@ -25,7 +25,7 @@ from ..accuracy import Status
 from ..model.assembly import Model, build_model
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError
 from ..estimate import COARSE_FAILURES, with_mesh
-from ..model.meshes import mesh_cells
+from ..model.generators import mesh_cells
 from ..linalg import row_stiffness
 from .scaling import Scaled
 

@@ -68,15 +68,7 @@ def to_xarray(result, quantities=QUANTITIES, *, nodes: bool = False):
     xr = _optional("xarray")
     fields = node_fields(result, quantities)
     mesh = result.model.grid
-    if nodes or mesh.grid_shape is None:
-        dims = ("node",)
-        coords = {"x": ("node", mesh.nodes[:, 0].copy(), {"units": "L"}),
-                  "y": ("node", mesh.nodes[:, 1].copy(), {"units": "L"})}
-    else:
-        dims = ("y", "x")
-        coords = {"x": ("x", np.arange(mesh.nx + 1) * mesh.hx, {"units": "L"}),
-                  "y": ("y", np.arange(mesh.ny + 1) * mesh.hy, {"units": "L"})}
-        fields = {q: mesh.to_grid(v) for q, v in fields.items()}
+    dims, coords, fields = mesh.field_layout(fields, nodes=nodes)  # the grid view where the mesh has one
     data = {q: (dims, v, {"long_name": FIELD_ATTRS[q][0], "units": FIELD_ATTRS[q][1]})
             for q, v in fields.items()}
     if dims == ("node",):

@@ -12,6 +12,8 @@ module                     job
 :mod:`.scales`             the magnitudes of a scene, checked before any work
 :mod:`.grid`               the structured rectangle mesh (:class:`~.grid.Grid`)
 :mod:`.trimesh`            the triangle mesh from gmsh (:class:`~.trimesh.TriMesh`)
+:mod:`.generators`         the mesh generator of each element's cell type
+:mod:`.views`              what the meshes show of themselves: outlines, sections, dataset layouts
 :mod:`.elements`           the plate elements (ACM, BFS on rectangles; DKT on triangles), one
                            registry
 :mod:`.constraints`        prescribed dofs from named edges and pins; the rigid motions left free

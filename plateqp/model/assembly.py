@@ -1,7 +1,7 @@
 """From a Scene to a Model: dof map, vectorised sparse assembly, loads, two-sided supports.
 
 The memory check before it: :mod:`plateqp.model.memory`; the generator of a scene's mesh:
-:mod:`plateqp.model.meshes`.
+:mod:`plateqp.model.generators`.
 
 Dofs: node n carries ``ndof_node`` dofs numbered ``n·ndof_node + k`` on the full grid.
 Two-sided supports prescribe some of them (``fixed`` with ``values``); the rest of the plate's
@@ -26,8 +26,8 @@ import scipy.sparse as sp
 from .constraints import prescribed, rigid_modes
 from .elements import ELEMENTS, RectElement
 from ..errors import SceneError
+from .generators import mesh_generator
 from .memory import check_memory
-from .meshes import mesh_generator
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
 
 if TYPE_CHECKING:  # pragma: no cover

@@ -54,9 +54,9 @@ def check_plate_and_mesh(sc) -> None:
     if m.symmetry is not None and m.symmetry not in MODES:
         sc._fail("mesh.symmetry", f'must be "x", "y" or "xy" (a mesh mirrored in the plate\'s centre line x = xc, '
                  f"y = yc or both) or absent (got {_short(m.symmetry)})")
-    if not sc.triangles and (p.shape is not None or m.size is not None):
-        sc._fail("plate.shape" if p.shape is not None else "mesh.size",
-                 'needs a triangle mesh: set mesh.element = "dkt"')
+    from .generators import mesh_generator
+
+    mesh_generator(sc).check_scene_fields(sc)  # e.g. a shape or an element size needs triangles
 
 
 def check_edges(sc) -> None:
@@ -95,12 +95,12 @@ def check_cutouts(sc):
 
 def plate_cover(sc):
     """What the point checks ask of the plate (``covers``, ``locate``, ``node_at``,
-    ``cells_in``, ``domain``): the grid, or on triangles the plate's
-    region (its shape and cut-outs checked: :func:`plateqp.model.geometry.validate_shaped`)."""
-    from .geometry import validate_shaped
-    from .grid import Grid
+    ``cells_in``, ``domain``): the grid, or on triangles the plate's region (its shape and
+    cut-outs checked: :func:`plateqp.model.geometry.validate_shaped`), as the scene's mesh
+    generator gives it (``cover``)."""
+    from .generators import mesh_generator
 
-    return validate_shaped(sc) if sc.triangles else Grid.from_scene(sc)
+    return mesh_generator(sc).cover(sc)
 
 
 def check_pins(sc, grid) -> None:

@@ -88,9 +88,12 @@ def edge_table(scene, domain) -> dict[tuple[int, int], tuple[str, object]]:
 
 def warn_changed_all(scene, domain) -> None:
     """Warn (once per scene text) where ``edges.all`` meant more before: on a triangle mesh it also
-    held the holes' edges, which are now free unless named (``holeK``)."""
+    held the holes' edges, which are now free unless named (``holeK``): the generator says
+    whether it did (``all_held_holes``)."""
+    from .generators import mesh_generator
+
     every = scene.edges.get("all")
-    if every is None or every.kind == "free" or not domain.holes or not scene.triangles:
+    if every is None or every.kind == "free" or not domain.holes or not mesh_generator(scene).all_held_holes:
         return
     named = {int(m.group(2)) for m in map(EDGE_KEY.match, scene.edges) if m is not None and m.group(2) is not None}
     free = [f"hole{k}" for k in range(len(domain.holes)) if k not in named]

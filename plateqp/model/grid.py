@@ -349,6 +349,63 @@ class Grid:
         hit = np.outer(oy, ox).ravel()  # index j*nx + i, like cell_mask
         return bool(np.any(hit & self.cell_mask))
 
+    # -- what the scene's checks, the figures and the tables ask of every mesh (TriMesh too) ----
+    @staticmethod
+    def check_scene_fields(scene) -> None:
+        """The scene-language rules of the grid: a plate shape or an element size needs triangles."""
+        p, m = scene.plate, scene.mesh
+        if p.shape is not None or m.size is not None:
+            scene._fail("plate.shape" if p.shape is not None else "mesh.size",
+                        'needs a triangle mesh: set mesh.element = "dkt"')
+
+    @classmethod
+    def cover(cls, scene) -> Grid:
+        """What the point checks ask of the plate (``covers``, ``locate``, ``node_at``,
+        ``covers_area``, ``cells_centred_in``, ``domain``): the scene's grid itself."""
+        return cls.from_scene(scene)
+
+    #: whether ``edges.all`` held the cut-outs' edges before: never on a grid (nothing changed)
+    all_held_holes = False
+    #: the demo's studies not yet run on this mesh, (name, why) pairs: none on a grid
+    not_yet_studied: tuple = ()
+
+    def caption(self, element: str) -> str:
+        """The mesh in a figure's caption: "nx × ny mesh"."""
+        return f"{self.nx} × {self.ny} mesh"
+
+    def outline_paths(self) -> list[tuple[str, np.ndarray, bool]]:
+        """The outline to draw, [(gid, points, closed)]: one entry "outline", the (m, 2, 2) sides
+        of the kept cells on the plate's boundary, openings included, as separate segments."""
+        from .views import cell_side_outline
+
+        return [("outline", cell_side_outline(self), False)]
+
+    def contour_position(self, xy: np.ndarray) -> tuple[np.ndarray, bool]:
+        """Each point's arc length along the rectangle's boundary, anticlockwise from (0, 0), and
+        whether all of three or more points stand on it (:func:`plateqp.model.views.contour_position`)."""
+        from .views import contour_position
+
+        return contour_position(xy, self.a, self.b)
+
+    def default_sections(self, scene) -> list:
+        """Section lines across the rectangle (:func:`plateqp.model.views.rectangle_sections`)."""
+        from .views import rectangle_sections
+
+        return rectangle_sections(scene, self.a, self.b)
+
+    def field_layout(self, fields: dict, nodes: bool = False) -> tuple:
+        """(dims, coords, fields) of nodal fields in a dataset: the grid view, or with ``nodes``
+        one value per node (:mod:`plateqp.model.views`)."""
+        from .views import grid_layout, node_layout
+
+        return node_layout(self, fields) if nodes else grid_layout(self, fields)
+
+    @staticmethod
+    def plan_view(structured, shaped):
+        """Of a figure's two plan views, the one that draws this mesh: ``structured`` (the grid's
+        lines, removed cells hatched, the rectangle's sides)."""
+        return structured
+
 
 CORNER_IJ = ((0, 0), (1, 0), (1, 1), (0, 1))  # element corner order (di, dj)
 

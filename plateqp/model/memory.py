@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import ResourceError, SceneError
 from .elements import ELEMENTS
-from .meshes import mesh_generator
+from .generators import mesh_generator
 from .scene import Scene
 
 

@@ -23,9 +23,9 @@ view: mesh, supports, contact state, section lines), :mod:`.fields` (deflection 
 contours, principal stresses, difference map), :mod:`.charts` (sections, reactions,
 convergence as line and bar charts), :mod:`.studies` (the source paper's figures 5 and 6:
 working schemes, w along sections per scheme, contact pressure along a contour, uniformity
-against κ), :mod:`.tri` (the plan view and section lines of a shaped plate on a triangle
-mesh: the true outline and holes; :func:`plot_mesh` and :func:`default_sections` hand such
-results to it). The field maps are one path for every mesh: the nodal values (one per node of
+against κ), :mod:`.tri` (the plan view of a triangle mesh: the true outline and holes;
+:func:`plot_mesh` draws with it where the mesh picks it, and :func:`default_sections` are the
+mesh's own). The field maps are one path for every mesh: the nodal values (one per node of
 the plate) on a matplotlib ``Triangulation`` of ``mesh.nodes`` and ``mesh.triangulation()``
 (a grid's quads split in two for drawing only).
 """

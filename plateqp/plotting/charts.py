@@ -97,11 +97,7 @@ def plot_reactions(result: Result, two_sided: Result | None = None, units=None) 
     sup = _supports(result)
     fig = _figure((10.0, 4.6))
     ax = fig.add_subplot()
-    from .tri import on_triangles
-
-    pos, along = _contour_position(sup.xy, sc.plate.a, sc.plate.b)
-    if on_triangles(result):  # a shaped plate: by support number
-        along = False
+    pos, along = result.model.grid.contour_position(sup.xy)  # a shaped plate: (…, False), by number
     if along:
         order = np.argsort(pos)
         x = pos[order]
@@ -145,20 +141,6 @@ def plot_reactions(result: Result, two_sided: Result | None = None, units=None) 
     ax.legend(handles=handles, fontsize=8, loc="best")
     ax.set_title(f"{sc.name}: support reactions ({int(sup.active.sum())} of {sup.n} in contact)", pad=14)
     return fig
-
-
-def _contour_position(xy: np.ndarray, a: float, b: float) -> tuple[np.ndarray, bool]:
-    """Arc length along the boundary, anticlockwise from (0, 0), and whether all points are on it."""
-    if xy.shape[0] < 3:
-        return np.zeros(xy.shape[0]), False
-    tol = 1e-9 * max(a, b)
-    x, y = xy[:, 0], xy[:, 1]
-    bottom, right, top, left = y <= tol, x >= a - tol, y >= b - tol, x <= tol
-    if not np.all(bottom | right | top | left):
-        return np.zeros(xy.shape[0]), False
-    pos = np.where(bottom, x, np.where(right, a + y, np.where(top, a + b + (a - x), 2 * a + b + (b - y))))
-    pos = np.where(bottom & left, 0.0, pos)
-    return pos, True
 
 
 # -- convergence ------------------------------------------------------------------------------

@@ -104,43 +104,16 @@ def _plan_axes(ax, result: Result, units, title: str | None = None, margin: floa
     _frame(ax, (x0 - m, x1 + m), (y0 - m, y1 + m), units, title)
 
 
-def _boundary_edges(mesh) -> np.ndarray:
-    """(m, 2) the sides of the cells that belong to one cell only: the plate's boundary, holes
-    and openings included, as pairs of indices into ``mesh.nodes``."""
-    c = mesh.cells
-    e = np.sort(np.vstack([c[:, [k, (k + 1) % c.shape[1]]] for k in range(c.shape[1])]), axis=1)
-    uniq, count = np.unique(e, axis=0, return_counts=True)
-    return uniq[count == 1]
-
-
 def _draw_outline(ax, result: Result, lw: float = 1.2):
-    """The plate's outline. A shaped plate: the outer boundary and the holes as polygons on its
-    own boundary points (gid "outline" and "hole", holes filled white); a grid: the boundary
-    sides of its kept cells (gid "outline"), openings included."""
+    """The plate's outline as its mesh gives it (``mesh.outline_paths()``): closed loops as
+    polygons (the outer boundary gid "outline", holes gid "hole" filled white), separate sides as
+    one line collection (gid "outline": a grid's kept cells' boundary sides, openings included)."""
     from matplotlib.collections import LineCollection
     from matplotlib.patches import Polygon
 
-    mesh = result.model.grid
-    if mesh.grid_shape is None:  # the boundary loops of the geometry
-        for k, pts in outline_loops(mesh):
-            ax.add_patch(Polygon(pts, closed=True, fill=(k > 0), facecolor="white", edgecolor="k", lw=lw,
-                                 zorder=2, gid="outline" if k == 0 else "hole"))
-        return
-    ax.add_collection(LineCollection(mesh.nodes[_boundary_edges(mesh)], colors="k", linewidths=lw, zorder=2,
-                                     gid="outline"))
-
-
-def outline_loops(mesh) -> list[tuple[int, np.ndarray]]:
-    """The boundary as closed loops of node coordinates: [(boundary, (n, 2) points)], 0 the outer
-    boundary, k ≥ 1 hole k − 1 (the mesh's boundary nodes in order along each loop)."""
-    out = []
-    for k in np.unique(mesh.boundary):
-        e = mesh.edges[mesh.boundary == k]
-        nxt = {int(i): int(j) for i, j in e}
-        start = int(e[0, 0])
-        seq, n = [start], nxt[start]
-        while n != start and len(seq) <= len(e):
-            seq.append(n)
-            n = nxt.get(n, start)
-        out.append((int(k), mesh.nodes[seq]))
-    return out
+    for gid, pts, closed in result.model.grid.outline_paths():
+        if closed:
+            ax.add_patch(Polygon(pts, closed=True, fill=(gid == "hole"), facecolor="white", edgecolor="k", lw=lw,
+                                 zorder=2, gid=gid))
+        else:
+            ax.add_collection(LineCollection(pts, colors="k", linewidths=lw, zorder=2, gid=gid))

@@ -3,8 +3,8 @@ contact, hollow lifted off, shaped and coloured by the sign of their gap), the b
 nodes, point loads, reactions and the section lines drawn on the plate.
 
 The axes, outline and markers every plan-view map shares are in :mod:`.marks`; here also the
-choice of section lines (:func:`default_sections`). A result on a triangle mesh is
-drawn by :mod:`.tri`.
+choice of section lines (:func:`default_sections`, as the mesh chooses them). The mesh picks the
+plan view that draws it (``mesh.plan_view``): a grid's here, a triangle mesh's in :mod:`.tri`.
 """
 
 from __future__ import annotations
@@ -32,13 +32,20 @@ def plot_mesh(result: Result, units=None, *, sections=None, annotate: bool = Tru
     ``numbers``: write the support numbers (1-based, scene order); default when ≤ 64 supports.
     ``sections``: section lines to draw and number (as for :func:`plot_sections`).
     """
+    from .tri import plot_mesh_tri
+
+    # the mesh picks its plan view: a grid's lines on the rectangle, or the cells on the true outline
+    view = result.model.grid.plan_view(_plot_mesh_grid, plot_mesh_tri)
+    return view(result, units, sections=sections, annotate=annotate, numbers=numbers)
+
+
+def _plot_mesh_grid(result: Result, units=None, *, sections=None, annotate: bool = True,
+                    numbers: bool | None = None) -> Figure:
+    """The plan view of a grid (:func:`plot_mesh`): its lines, the removed cells hatched, the
+    rectangle's named sides, the supports and reactions placed outward from its edges."""
     from matplotlib.lines import Line2D
     from matplotlib.patches import Rectangle
 
-    from .tri import on_triangles, plot_mesh_tri
-
-    if on_triangles(result):  # the true outline, triangles, edges by kind
-        return plot_mesh_tri(result, units, sections=sections, annotate=annotate, numbers=numbers)
     L, F = _units(units)
     sc = result.scene
     g = result.model.grid
@@ -164,28 +171,13 @@ def _unit(d: np.ndarray) -> np.ndarray:
 
 # -- section lines ----------------------------------------------------------------------------
 def default_sections(result: Result) -> list[tuple[str, tuple[float, float], tuple[float, float]]]:
-    """Section lines for a scene: the rows of supports (up to six), else lines through the load.
+    """Section lines for a scene, as its mesh chooses them (``mesh.default_sections``): the rows
+    of supports (up to six), else lines through the load.
 
     Rows: the distinct y of the supports when there are 2 to 6 of them with at least two
     supports each (the source paper's sections 1–5 through a grid of supports). Otherwise the
-    horizontal and vertical lines through the largest point load (or the centre), the bottom
-    edge if supports stand on it, and the diagonal. On a triangle mesh: :func:`.tri.tri_sections`.
+    horizontal and vertical lines through the largest point load (or the centre); on a grid also
+    the bottom edge if supports stand on it, and the diagonal; on a triangle mesh each line is
+    cut to its longest stretch on the plate (:mod:`plateqp.model.views`).
     """
-    from .tri import on_triangles, tri_sections
-
-    if on_triangles(result):
-        return tri_sections(result)
-    sc = result.scene
-    a, b = sc.plate.a, sc.plate.b
-    sup = _supports(result)
-    if sup.n:
-        ys, counts = np.unique(np.round(sup.xy[:, 1], 9), return_counts=True)
-        if 2 <= ys.size <= 6 and np.all(counts >= 2):
-            return [(f"y = {y:g}", (0.0, float(y)), (a, float(y))) for y in ys]
-    pl = _point_loads(sc)
-    xl, yl = ((max(pl, key=lambda ld: abs(ld.P)).x, max(pl, key=lambda ld: abs(ld.P)).y) if pl else (a / 2, b / 2))
-    out = [(f"y = {yl:g}", (0.0, yl), (a, yl)), (f"x = {xl:g}", (xl, 0.0), (xl, b))]
-    if sup.n and np.any(np.abs(sup.xy[:, 1]) <= 1e-9 * max(a, b)):
-        out.append(("y = 0 (edge)", (0.0, 0.0), (a, 0.0)))
-    out.append(("diagonal", (0.0, 0.0), (a, b)))
-    return out
+    return result.model.grid.default_sections(result.scene)

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .charts import _contour_position
+from ..model.views import contour_position as _contour_position
 from .data import _supports, _w_at
 from .plan import _draw_supports, _legend_handles, _norm_sections
 from .style import _fig_legend, _figure, _lab, _units

@@ -1,23 +1,18 @@
 """The plan view of a shaped plate (a triangle mesh, ``mesh.element = "dkt"``): the true outline
 with its holes, the triangles, the edges by kind, and its section lines.
 
-The public functions of :mod:`.plan` hand such a result to the functions here, so callers use
-one name for both kinds of mesh. The conventions are theirs (supports filled in contact and
-hollow lifted off, coloured by the sign of their gap, numbered from 1). The field maps are one
-path for every mesh (:mod:`.fields`).
-
-Section lines on a shaped plate (:func:`tri_sections`) are the horizontal and vertical lines
-through the rows of supports (or the centre of the plate), cut to the longest stretch of each
-that lies on the plate, so that every point of a section is on the plate.
+:func:`plateqp.plotting.plan.plot_mesh` draws with the function here where the mesh picks it
+(``mesh.plan_view``), so callers use one name for both kinds of mesh. The conventions are
+theirs (supports filled in contact and hollow lifted off, coloured by the sign of their gap,
+numbered from 1). The field maps are one path for every mesh (:mod:`.fields`); the section lines
+are the mesh's own (``mesh.default_sections``: :func:`plateqp.model.views.cut_sections`).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import numpy as np
-
-from .data import _bbox, _supports, _triangulation
+from .data import _supports, _triangulation
 from .marks import _draw_outline, _plan_axes
 from .style import _figure, _fmt, _units
 
@@ -25,11 +20,6 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
     from ..results import Result
-
-
-def on_triangles(result) -> bool:
-    """Whether ``result`` lies on a triangle mesh (a shaped plate: its own plan view and sections)."""
-    return getattr(getattr(result.model, "grid", None), "cell_type", None) == "triangle"
 
 
 # -- plan view --------------------------------------------------------------------------------
@@ -97,51 +87,3 @@ def plot_mesh_tri(result: Result, units=None, *, sections=None, annotate: bool =
     ax.set_title(title)
     fig.legend(handles=handles, loc="outside right upper", fontsize=8)
     return fig
-
-
-# -- section lines ----------------------------------------------------------------------------
-def _on_plate_stretch(mesh, p0, p1, n: int = 801):
-    """The longest stretch of the segment p0 → p1 on the plate, as (q0, q1), or None."""
-    t = np.linspace(0.0, 1.0, n)
-    x = p0[0] + t * (p1[0] - p0[0])
-    y = p0[1] + t * (p1[1] - p0[1])
-    inside = mesh.locate(x, y)[0] >= 0
-    best, start, run = None, None, 0
-    for i, ok in enumerate(np.append(inside, False)):
-        if ok and start is None:
-            start = i
-        elif not ok and start is not None:
-            if i - start > run and i - 1 > start:
-                best, run = (start, i - 1), i - start
-            start = None
-    if best is None:
-        return None
-    return (float(x[best[0]]), float(y[best[0]])), (float(x[best[1]]), float(y[best[1]]))
-
-
-def tri_sections(result) -> list[tuple[str, tuple[float, float], tuple[float, float]]]:
-    """Section lines on a shaped plate: the rows of supports (2 to 6 distinct y with two or more
-    supports each), else the horizontal and vertical lines through the largest point load (or
-    the centre of the plate's bounding box), each cut to its longest stretch on the plate."""
-    mesh = result.model.grid
-    x0, x1, y0, y1 = _bbox(result)
-    sup = _supports(result)
-    lines = []
-    if sup.n:
-        ys, counts = np.unique(np.round(sup.xy[:, 1], 9), return_counts=True)
-        if 2 <= ys.size <= 6 and np.all(counts >= 2):
-            lines = [(f"y = {y:g}", (x0, float(y)), (x1, float(y))) for y in ys]
-    if not lines:
-        pl = [ld for ld in result.scene.loads if ld.type == "point"]
-        if pl:
-            ld = max(pl, key=lambda p: abs(p.P))
-            xc, yc = ld.x, ld.y
-        else:
-            xc, yc = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
-        lines = [(f"y = {yc:g}", (x0, yc), (x1, yc)), (f"x = {xc:g}", (xc, y0), (xc, y1))]
-    out = []
-    for lab, p0, p1 in lines:
-        cut = _on_plate_stretch(mesh, p0, p1)
-        if cut is not None:
-            out.append((lab, *cut))
-    return out

@@ -23,7 +23,7 @@ Triangle meshes
 ---------------
 On a triangle-meshed scene (``mesh.element = "dkt"``) a mesh of n "cells a side" is the gmsh
 mesh of element size h = L / n, L the plate's larger bounding-box side
-(:func:`plateqp.model.meshes.mesh_cells`): halving the mesh halves h. The meshes are not nested,
+(:func:`plateqp.model.generators.mesh_cells`): halving the mesh halves h. The meshes are not nested,
 so the change on halving is read from max |w| (and the reactions), not from the field at the
 coarse mesh's nodes.
 """
@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from ..accuracy import TOL_RANGE
-from ..model.meshes import mesh_cells, start_cells
+from ..model.generators import mesh_cells, start_cells
 from ..errors import PlateQPError, PlateQPWarning, ProblemError, SceneError
 from ..progress import track
 from ..estimate import (COARSE_FAILURES, FRACTION, LOOSEST, ORDER, ErrorEstimate, Quantities, changes, quiet_solve,
@@ -268,7 +268,7 @@ class TargetResult:
 
 def start_mesh(scene: Scene, cells: int = 4) -> tuple[int, int]:
     """``cells`` on the shorter side, the other in proportion to the scene's own mesh (on
-    triangles: (cells, cells), element size L / cells): :func:`plateqp.model.meshes.start_cells`."""
+    triangles: (cells, cells), element size L / cells): :func:`plateqp.model.generators.start_cells`."""
     return start_cells(scene, cells)
 
 

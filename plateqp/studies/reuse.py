@@ -14,7 +14,7 @@ import numpy as np
 
 from ..model.assembly import Model
 
-from ..model.meshes import mesh_generator
+from ..model.generators import mesh_generator
 from ..model.scene import Scene
 
 

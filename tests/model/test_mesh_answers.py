@@ -8,7 +8,7 @@ import pytest
 
 import plateqp as pq
 from plateqp.model.assembly import build_model
-from plateqp.model.meshes import GENERATORS
+from plateqp.model.generators import GENERATORS
 from plateqp.model.elements import ELEMENTS
 
 

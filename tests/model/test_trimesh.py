@@ -89,7 +89,7 @@ def test_missing_gmsh_is_one_clear_line(monkeypatch):
 
 
 def test_a_gmsh_failure_is_one_clear_line(monkeypatch):
-    import plateqp.model.trimesh as tm
+    import plateqp.model.gmsh_mesh as tm
 
     def fail(*args):
         raise Exception("Invalid boundary mesh (overlapping facets) on surface 1\nmore detail")
