@@ -1,4 +1,4 @@
-"""Sweeps that change the loads on a triangle mesh re-use the model (issue 13): the load vector
+"""Sweeps that change the loads on a triangle mesh re-use the model: the load vector
 is re-assembled on the same mesh. Checked against fresh builds, the closed form of a simply
 supported disc on a central one-sided support, and a moved point load (a new mesh)."""
 
