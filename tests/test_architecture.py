@@ -31,7 +31,7 @@ BACKEND_MAY_IMPORT = ("plateqp.accuracy", "plateqp.errors", "plateqp.linalg")
 #: Third-party packages that bind CHOLMOD: only plateqp.linalg may import them.
 CHOLMOD_BINDINGS = ("cvxopt", "sksparse")
 
-#: Known failures, declared as data (issue 12 is not finished): each entry must still fail its
+#: Known failures, declared as data (the work they describe is not finished): each entry must still fail its
 #: check, so that a fix removes it from here and nothing new can hide behind it.
 KNOWN_TOO_LONG: set[str] = set()
 KNOWN_CHOLMOD_OUTSIDE_LINALG: set[str] = set()

@@ -375,7 +375,7 @@ FACTORISE_P = ("cvxpy:ECOS", "cvxpy:CVXOPT")
 
 @pytest.mark.parametrize("name", FACTORISE_P)
 def test_indefinite_p_is_a_one_line_solver_error(name):
-    """cvxpy's "quad_form … indefinite" ValueError (issue 10: cvxpy:ECOS and cvxpy:CVXOPT on the
+    """cvxpy's "quad_form … indefinite" ValueError (cvxpy:ECOS and cvxpy:CVXOPT on the
     condensed form) becomes a SolverError of one line that keeps the cause."""
     b = BACKENDS.get(name)
     if b is None or not b.available():

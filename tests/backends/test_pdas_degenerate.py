@@ -1,4 +1,4 @@
-"""pdas on degenerate contact problems (issue 10 items 4-5): it must finish, exactly.
+"""pdas on degenerate contact problems: it must finish, exactly.
 
 External references: statics (a floating plate on two supports carries the load by the lever
 rule, whatever its stiffness: the ACM element holds the rigid motions exactly, so the consistent

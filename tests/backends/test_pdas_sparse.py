@@ -1,4 +1,4 @@
-"""pdas's sparse method on many contacts (issue 11, "no cliff"): a post on every node, and a bed.
+"""pdas's sparse method on many contacts (no cliff): a post on every node, and a bed.
 
 References, none of them pdas's own earlier output:
 

@@ -1,4 +1,4 @@
-"""The teaching backends: "toggle the springs" and the penalty method (issue 14 item 5).
+"""The teaching backends: "toggle the springs" and the penalty method.
 
 References: the 2 × 2 LCP with the closed-form solution z = (4/3, 7/3); Lemke's exact answer on
 the same LCP or scene; the penalty method's first-order error (the answer of LCP(M + εI, q)

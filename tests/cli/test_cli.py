@@ -93,7 +93,7 @@ def test_lemke_trace_through_solve():
     assert len(trace) == res.iterations and trace[0]["entering"][0] == "z0"
 
 
-# -- hostile input (issue 10): one line on stderr, the right exit code, nothing written astray ------
+# -- hostile input: one line on stderr, the right exit code, nothing written astray ------
 
 SMALL = """\
 name = {name}

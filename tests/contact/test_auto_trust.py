@@ -1,4 +1,4 @@
-"""accuracy="auto" must not claim an error estimate when the meshes disagree (issue 10, 6b).
+"""accuracy="auto" must not claim an error estimate when the meshes disagree.
 
 A support 5 mm from a clamped edge of a 1 m plate under a uniform load: on 2² and 4² its
 point lies in an element held by the edge and it carries nothing; on 8² it carries 196; the

@@ -214,7 +214,7 @@ def test_soft_and_rigid_supports_in_one_scene(backend, formulation):
 
     PGS (iterative) gets the reactions but leaves the soft springs' gaps open by 2.5e-3 of the
     deflection scale where they touch; the KKT check's natural residual in deflection units
-    (issue 10) flags that INACCURATE, which is the truth about its reported gaps."""
+    flags that INACCURATE, which is the truth about its reported gaps."""
     sc = grid_scene()
     for i, s in enumerate(sc.supports):
         s.stiffness = "rigid" if i % 2 else 1e-8 * sc.plate.D

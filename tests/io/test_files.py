@@ -1,4 +1,4 @@
-"""Where an export writes (plateqp.io.files; issue 10, item 1): only where it was asked, never over
+"""Where an export writes (plateqp.io.files): only where it was asked, never over
 something that exists without --force, and a path that cannot be written is refused in one line
 (exit code 2) before the problem is built, with nothing written.
 

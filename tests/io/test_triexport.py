@@ -1,4 +1,4 @@
-"""QP export on triangle meshes (issue 13): the contact problem of a shaped (DKT) scene,
+"""QP export on triangle meshes: the contact problem of a shaped (DKT) scene,
 written as ``.npz`` and QPS, read back and solved by an independent solver (Clarabel, called
 directly on the loaded matrices), gives pq.solve's reactions, and the reactions of a floating
 disc balance the load (statics: their sum is the total load q × the mesh's area, their moment

@@ -108,7 +108,7 @@ BAD = [
                                                'radius = 0.3, depth = 0.01, width = 1.0 }\n'}, "foundation.gap.width"),
     ("foundation-profile-zero-radius", {"add": '[foundation]\nk = 1.0\ngap = { profile = "bump", x = 0.5, y = 0.5, '
                                                'radius = 0.0, depth = 0.01 }\n'}, "foundation.gap.radius"),
-    # hostile input (issue 10): each of these was a traceback, not a SceneError
+    # hostile input: each of these was a traceback, not a SceneError
     ("load-type-array", {"sub": ('type = "uniform"', "type = []")}, "loads.0.type"),
     ("load-type-table", {"sub": ('type = "uniform"', "type = { a = 1 }")}, "loads.0.type"),
     ("foundation-region-number", {"add": "[foundation]\nk = 1.0\nregion = 5\n"}, "foundation.region"),

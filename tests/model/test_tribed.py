@@ -1,4 +1,4 @@
-"""Tensionless beds over part of a triangle-meshed plate (issue 13), and scene paths with the
+"""Tensionless beds over part of a triangle-meshed plate, and scene paths with the
 triangle meshes' edge names.
 
 The bed region's outline inside the plate is a line of the gmsh mesh, so the region is a union

@@ -1,4 +1,4 @@
-"""Patch loads and openings on triangle meshes (issue 13).
+"""Patch loads and openings on triangle meshes.
 
 A patch load [x0, x1] × [y0, y1] is integrated exactly over the parts of the triangles it covers
 (each triangle clipped by the box): its total is q × the patch's area on the plate, exactly, and

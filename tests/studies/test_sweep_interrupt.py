@@ -1,6 +1,6 @@
 """Ctrl-C (SIGINT) and SIGTERM in ``plateqp sweep``, serial and with worker processes.
 
-The promise (issue 10, item 2): the rows done so far are kept (on standard output, where the
+The promise: the rows done so far are kept (on standard output, where the
 user asked for them, with the values not done named), the worker processes are stopped (none
 outlives the command), the exit code is 130 (143 for SIGTERM), and standard error ends with
 one line that says so, without a traceback. Before: a traceback, no rows, 124 s to stop with

@@ -1,4 +1,4 @@
-"""Refinement on triangle meshes (issue 13): convergence studies, ``solve_to_target``
+"""Refinement on triangle meshes: convergence studies, ``solve_to_target``
 (``plateqp solve --target``) and ``accuracy="auto"`` on a circular plate, where a mesh of n
 "cells a side" has element size h = L / n (L = 2R: the bounding box).
 
