@@ -41,8 +41,9 @@ MAX_DOCSTRING_LINES = 60
 #: answer): the modules whose functions :data:`MAX_FUNCTION_LINES` holds.
 FLOORS = ("plateqp.model.scene", "plateqp.model.checks", "plateqp.model.parts", "plateqp.model.geometry", "plateqp.model.crossings", "plateqp.model.paths", "plateqp.model.grid", "plateqp.model.trimesh",
           "plateqp.model.elements", "plateqp.model.constraints", "plateqp.model.assembly",
-          "plateqp.contact")
-KNOWN_LONG_FUNCTIONS: set[str] = set()
+          "plateqp.contact", "plateqp.backends.pdas")
+#: the backends' active-set solver joined the floors with two bodies still to split into steps
+KNOWN_LONG_FUNCTIONS: set[str] = {"plateqp.backends.pdas.dense:first_set", "plateqp.backends.pdas.driver:pdas"}
 KNOWN_LONG_DOCSTRINGS: set[str] = set()
 
 

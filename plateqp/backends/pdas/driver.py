@@ -23,7 +23,8 @@ from .options import (
     TRAILING_SHARE,
 )
 from .reduced import ReducedQP, force_scale, natural_residuals
-from .sparse import SpringFactor, run_sparse
+from .exact import run_sparse
+from .sparse import SpringFactor
 
 __all__ = ["pdas"]
 

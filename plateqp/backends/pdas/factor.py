@@ -339,7 +339,7 @@ class TrailingFactor:
     half. Where the active rows leave a rigid motion ``v`` free, ``H(w) v = σ diag(K) v``
     exactly, as with :class:`SpringFactor` (the first correction, the hold check and the
     free motion's sharpening rest on that). The same interface as :class:`SpringFactor`
-    (``set``, ``solve``, ``refactor``, ``clean``, ``stats``) for :func:`.sparse.run_sparse`;
+    (``set``, ``solve``, ``refactor``, ``clean``, ``stats``) for :func:`.exact.run_sparse`;
     exact, so ``clean``.
     """
 
