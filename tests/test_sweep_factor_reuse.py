@@ -13,6 +13,7 @@ import pytest
 
 import plateqp as pq
 from plateqp.linalg import cholmod
+from plateqp.paths import set_param
 from plateqp.studies.sweep import sweep
 
 pytestmark = pytest.mark.skipif(not pq.linalg.bindings(), reason="no CHOLMOD binding")
@@ -123,3 +124,20 @@ def test_a_new_K_is_factorised_again(make, path, values, factorisations):
     assert factorisations["n"] >= len(values)  # a reused factorisation of another K would be wrong
     cold = run(scene, path, values, reuse=False)
     same_as_cold(hot, cold)
+
+
+def test_stiffness_design_factorises_K_once(factorisations):
+    """The stiffness design (one c for every support, searched) solves one K for every c."""
+    from plateqp.studies.design import most_uniform_stiffness
+
+    scene = posts()
+    scene.supports = [pq.Support(s.x, s.y, stiffness=1e5, gap=s.gap) for s in scene.supports]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        got = most_uniform_stiffness(scene, (1e4, 1e7), scan=5, backend="pdas", accuracy=1e-10)
+    assert len(got.evaluations) >= 6
+    assert factorisations["n"] == 1 and factorisations["analyse"] == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        cold = pq.solve(set_param(scene, "supports.*.stiffness", got.c), backend="pdas", accuracy=1e-10)
+    assert np.allclose(got.reactions, cold.reactions, rtol=1e-8, atol=1e-9 * np.abs(cold.reactions).max())

@@ -19,12 +19,12 @@ from ..backends import get_backend
 from ..backends.base import RawSolution
 from ..errors import MechanismError, NoEquilibriumError, PlateQPWarning, ProblemError, SolverError
 from ..linalg import solve_saddle
-from ..linalg.keep import keeping
+from ..linalg.keep import keeping, shared
 from ..results import Result
 from .formulations import ContactSolution, Formulation, formulate
 from .kkt import defect_residual, heave_bound, heave_force, kkt_report, reaction_scale
 from .predict import check_predict, predicted_set, wanted
-from .routing import choose, fallback_routes, formulations_for, repeating
+from .routing import choose, fallback_routes, formulations_for
 from .scaling import Scaled
 from .statics import NO_EQUILIBRIUM, settle, supports_reach
 
@@ -272,11 +272,11 @@ def _corrections(model: Model, form: Formulation, raw: RawSolution, res: Result,
 def kept_factors(data: Scaled) -> list | None:
     """The list of factorisations the model keeps for its K and B (in ``Model.derived``, which
     the models adapted from it share: :func:`plateqp.studies.reuse.adapt_model`), lent to the
-    backend's solve (:mod:`plateqp.linalg.keep`) inside :func:`.routing.repeated_solves` (a sweep);
+    backend's solve inside :func:`plateqp.linalg.keep.sharing` (a sweep, the stiffness design);
     None elsewhere (a single solve keeps no factor alive beside its Result) or where the data came
     from no model."""
     keep = data.derived
-    if keep is None or data.K_src is None or not repeating():
+    if keep is None or data.K_src is None or not shared():
         return None
     for K, B, kind, value in keep:
         if K is data.K_src and B is data.B_src and kind == "factors":

@@ -73,11 +73,6 @@ def repeated_solves():
         _REPEATED[0] -= 1
 
 
-def repeating() -> bool:
-    """True inside a :func:`repeated_solves` block (a sweep's solves share K and B)."""
-    return _REPEATED[0] > 0
-
-
 def condensed_pays(data: Scaled, backend: str = "auto") -> bool:
     """True where formulation="auto" condenses (see the rules above).
 

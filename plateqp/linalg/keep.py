@@ -2,8 +2,8 @@
 
 A sweep over gaps, support stiffnesses, the bed's modulus or loads solves one plate's K many
 times (:func:`plateqp.studies.reuse.adapt_model` shares K and the contact operator between the
-values). The contact pipeline lends each solve the list its model keeps for that K and B
-(:func:`keeping`); a backend that factorises K looks there first (:func:`kept`) and keeps what it
+values). Inside :func:`sharing` (a sweep's solves, the stiffness design's) the contact pipeline
+lends each solve the list its model keeps for that K and B (:func:`keeping`); a backend that factorises K looks there first (:func:`kept`) and keeps what it
 built there. What is kept must depend on K and B alone: gaps, flexibilities and loads are each
 solve's own. The list lives as long as the model (and the models adapted from it), never
 longer: a new K (thickness, modulus, mesh) is a new model with a new list.
@@ -17,7 +17,24 @@ import contextvars
 #: how many factorisations one list keeps, most recent last
 KEEP = 2
 
+_SHARING: contextvars.ContextVar[bool] = contextvars.ContextVar("plateqp_sharing_factors", default=False)
 _LENT: contextvars.ContextVar[list | None] = contextvars.ContextVar("plateqp_kept_factors", default=None)
+
+
+@contextlib.contextmanager
+def sharing():
+    """Within this block, solves of a model keep their factorisations for the next solve of the
+    same K and B (outside it a solve keeps nothing alive beside its Result)."""
+    token = _SHARING.set(True)
+    try:
+        yield
+    finally:
+        _SHARING.reset(token)
+
+
+def shared() -> bool:
+    """True inside :func:`sharing`."""
+    return _SHARING.get()
 
 
 @contextlib.contextmanager
@@ -41,4 +58,4 @@ def remember(store: list, entry) -> None:
     del store[:-KEEP]
 
 
-__all__ = ["KEEP", "keeping", "kept", "remember"]
+__all__ = ["KEEP", "keeping", "kept", "remember", "shared", "sharing"]
