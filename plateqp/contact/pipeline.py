@@ -19,6 +19,7 @@ from ..backends import get_backend
 from ..backends.base import RawSolution
 from ..errors import MechanismError, NoEquilibriumError, PlateQPWarning, ProblemError, SolverError
 from ..linalg import solve_saddle
+from ..linalg.keep import keeping, shared
 from ..results import Result
 from .formulations import ContactSolution, Formulation, formulate
 from .kkt import defect_residual, heave_bound, heave_force, kkt_report, reaction_scale
@@ -213,7 +214,8 @@ class _Step:
                 first = dict(options, active=A0)
         t_predict = time.perf_counter() - t1
         t1 = time.perf_counter()
-        raw = b.solve(problem, accuracy=self.acc, options=first)
+        with keeping(kept_factors(self.data)):
+            raw = b.solve(problem, accuracy=self.acc, options=first)
         t2 = time.perf_counter()
         if raw.status in (Status.INFEASIBLE, Status.UNBOUNDED):  # the backend's certificate, in QP/LCP terms
             verdict = f"{backend} on the {formulation} problem ended {raw.status.value} ({raw.solver_status})"
@@ -247,7 +249,8 @@ def _corrections(model: Model, form: Formulation, raw: RawSolution, res: Result,
             opts["active"] = raw.extras["active"]
         t3 = time.perf_counter()
         try:
-            again = b.solve(nxt.problem(b.accepts), accuracy=acc, options=opts)
+            with keeping(kept_factors(form.data)):
+                again = b.solve(nxt.problem(b.accepts), accuracy=acc, options=opts)
         except (SolverError, ProblemError) as exn:
             failed = f"{type(exn).__name__}: {exn}"
             break
@@ -264,6 +267,23 @@ def _corrections(model: Model, form: Formulation, raw: RawSolution, res: Result,
         if raw.iterations is not None:
             iterations = (iterations or 0) + raw.iterations
     return form, raw, res, corrections, iterations, failed, solve_s
+
+
+def kept_factors(data: Scaled) -> list | None:
+    """The list of factorisations the model keeps for its K and B (in ``Model.derived``, which
+    the models adapted from it share: :func:`plateqp.studies.reuse.adapt_model`), lent to the
+    backend's solve inside :func:`plateqp.linalg.keep.sharing` (a sweep, the stiffness design);
+    None elsewhere (a single solve keeps no factor alive beside its Result) or where the data came
+    from no model."""
+    keep = data.derived
+    if keep is None or data.K_src is None or not shared():
+        return None
+    for K, B, kind, value in keep:
+        if K is data.K_src and B is data.B_src and kind == "factors":
+            return value
+    value: list = []
+    keep.append((data.K_src, data.B_src, "factors", value))
+    return value
 
 
 def finish(model: Model, form: Formulation, raw: RawSolution, accuracy: str | float | Accuracy,

@@ -47,6 +47,7 @@ from ..model.assembly import Model, build_model
 from ..backends import LCP, get_backend
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError, SceneError
 from ..linalg import Factor, solve_saddle
+from ..linalg.keep import sharing
 from ..model.paths import set_param
 from ..progress import Progress
 from ..model.scene import PointLoad, Scene
@@ -342,7 +343,7 @@ def most_uniform_stiffness(scene: Scene, c_range: tuple[float, float], supports:
     def cv_at(logc: float) -> float:
         c = float(np.exp(logc))
         sc = set_param(scene, "supports.*.stiffness", c)
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), sharing():  # K factorised once for every c
             warnings.simplefilter("ignore", PlateQPWarning)
             res = solve(sc, backend=backend, formulation=formulation, accuracy=accuracy,
                         model=adapt_model(base, sc))
@@ -361,7 +362,7 @@ def most_uniform_stiffness(scene: Scene, c_range: tuple[float, float], supports:
     best = min(evals, key=lambda e: e[1])
     logger.info("most uniform stiffness: c = %.6g after %d solves (%s = %.6g)", best[0], len(evals), measure, best[1])
     sc = set_param(scene, "supports.*.stiffness", best[0])
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), sharing():
         warnings.simplefilter("ignore", PlateQPWarning)
         res = solve(sc, backend=backend, formulation=formulation, accuracy=accuracy, model=adapt_model(base, sc))
     step = grid[1] - grid[0]

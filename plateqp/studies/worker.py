@@ -2,7 +2,8 @@
 
 A worker (this process or another) keeps, per sweep, the base model built once and the
 nodal operator of its mesh (:func:`plateqp.model.recovery.nodal_operator`); with re-use each value's
-model is the base adapted to it (:func:`plateqp.studies.reuse.adapt_model`). Warm starts
+model is the base adapted to it (:func:`plateqp.studies.reuse.adapt_model`), and the solves
+share the factorisations of its K (:func:`plateqp.linalg.keep.sharing`). Warm starts
 (``options={"active": ...}``: the previous solve's own final state, ``Result.extras["active"]``,
 else its contact set) go only to backends that take them (:data:`WARM_START_BACKENDS`).
 """
@@ -21,6 +22,7 @@ import numpy as np
 from ..model.assembly import Model, build_model
 from ..contact.routing import repeated_solves
 from ..errors import NoEquilibriumError, PlateQPWarning
+from ..linalg.keep import sharing
 from ..model.paths import set_param
 from ..model.recovery import NodalOperator, nodal_operator
 from ..model.scene import Scene
@@ -96,7 +98,8 @@ def solve_value(ctx: Context, value, warm=None):
         opts = dict(ctx.options or {})
         if warm is not None:
             opts["active"] = np.asarray(warm, dtype=bool)
-        with warnings.catch_warnings(), (repeated_solves() if ctx.reuse else contextlib.nullcontext()):
+        again = (repeated_solves, sharing) if ctx.reuse else (contextlib.nullcontext, contextlib.nullcontext)
+        with warnings.catch_warnings(), again[0](), again[1]():
             warnings.simplefilter("ignore", PlateQPWarning)  # the row's status says it
             res = solve(scene, backend=ctx.backend, formulation=ctx.formulation, accuracy=ctx.accuracy,
                         options=opts or None, model=model)

@@ -5,10 +5,12 @@ output", "Accuracy")."""
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from ...errors import ProblemError, SolverError
+from ...linalg.keep import kept, remember
 from ..base import QP, RawSolution, Status, preset
 from .dense import DenseDual, NotApplicable, anchored_set, run_dense
 from .factor import TrailingFactor
@@ -47,6 +49,100 @@ def auto_max_dense(n: int, soft: bool = False) -> int:
     if soft:
         return min(hi, int(MAX_DENSE_SOFT * np.sqrt(n)))
     return max(lo, min(hi, int(per_root * np.sqrt(n))))
+
+
+#: the linear-algebra counts of :attr:`.dense.DenseDual.stats` that add up over the solves of a factor
+_COUNTS = ("analyse_s", "factor_s", "extract_s", "factorisations", "solves", "solve_s")
+
+
+@dataclass
+class _Kept:
+    """A condensed method's factorisation kept for the next solve of the same K and B
+    (:mod:`plateqp.linalg.keep`): its DenseDual, the K diagonal and B it was built from, and
+    the flexibilities ρ its M holds on the diagonal now."""
+
+    cond: DenseDual
+    Kd: np.ndarray
+    B: object
+    rho: np.ndarray
+
+    def fits(self, pb: ReducedQP, max_dense: int) -> bool:
+        """The same K (its diagonal, to rounding: the scaling of K differs by an ulp between
+        the solves of a sweep) and the same rows B; their dofs within ``max_dense``."""
+        B, c = pb.B, self.cond.fac.last
+        return (pb.K.shape == self.cond.pb.K.shape and pb.m == self.rho.size and c.size <= max_dense
+                and np.allclose(pb.Kd, self.Kd, rtol=1e-12, atol=0.0)
+                and B.shape == self.B.shape and np.array_equal(B.indptr, self.B.indptr)
+                and np.array_equal(B.indices, self.B.indices) and np.allclose(B.data, self.B.data, rtol=1e-12, atol=0.0))
+
+    def again(self, pb: ReducedQP) -> DenseDual:
+        """The kept DenseDual for this solve's flexibilities, gaps and loads: its M's diagonal
+        moved to the new ρ, ``d = g − B K⁻¹ f`` from the kept factor (half a solve)."""
+        cond = self.cond
+        diag = np.diag_indices(pb.m)
+        cond.M[diag] += pb.rho - self.rho
+        self.rho = pb.rho.copy()
+        cond.pb, cond._chol, cond.first, cond._dense_s = pb, None, {}, 0.0
+        cond.Bc = pb.B[:, cond.fac.last].tocsr()
+        cond.yf = cond._forward(pb.f)
+        cond.d = pb.g - cond.Bc @ cond._tail(cond.yf)
+        return cond
+
+
+def _dense_dual(pb: ReducedQP, max_dense: int) -> tuple[DenseDual, _Kept | None, dict | None]:
+    """``DenseDual(pb, max_dense)``, or the one a solve before built on the same K and B where
+    the caller lent a list of kept factorisations (:func:`plateqp.linalg.keep.kept`: a sweep
+    over gaps, flexibilities or loads). Returns (it, its entry to keep again after the solve or
+    None, its factor's counts before this solve where it was kept)."""
+    store = kept()
+    if store is None:
+        return DenseDual(pb, max_dense), None, None
+    for entry in list(store):
+        if isinstance(entry, _Kept) and entry.fits(pb, max_dense):
+            store.remove(entry)  # in use: not lent to another solve at the same time
+            before = {k: entry.cond.fac.stats[k] for k in _COUNTS}
+            return entry.again(pb), entry, before
+    cond = DenseDual(pb, max_dense)
+    return cond, _Kept(cond, pb.Kd.copy(), pb.B.copy(), pb.rho.copy()), None
+
+
+@dataclass
+class _KeptSprings:
+    """The sparse method's factor kept for the next solve of the same K and B: its
+    :class:`.factor.SpringFactor` (of ``K + σ diag(K) + Bᵀ diag(w) B`` at the last solve's
+    ``w``: the next solve's first set, warm-started from it, needs no new factorisation, and a
+    few rows changed are a low-rank correction) and what it was built from."""
+
+    fac: SpringFactor
+    Kd: np.ndarray
+    B: object
+    c: np.ndarray  # the rows' stiffnesses in series with their springs: each solve's own
+    sigma: float
+    method: str
+
+    def fits(self, pb: ReducedQP, sigma: float, method: str) -> bool:
+        B = pb.B
+        return (sigma == self.sigma and method == self.method and pb.Kd.shape == self.Kd.shape
+                and np.allclose(pb.Kd, self.Kd, rtol=1e-12, atol=0.0) and pb.c.shape == self.c.shape
+                and B.shape == self.B.shape and np.array_equal(B.indptr, self.B.indptr)
+                and np.array_equal(B.indices, self.B.indices) and np.allclose(B.data, self.B.data, rtol=1e-12, atol=0.0))
+
+
+def _spring_factor(pb: ReducedQP, sigma: float, method: str) -> tuple[SpringFactor, _KeptSprings | None]:
+    """``SpringFactor(pb.K, pb.B, pb.Kd, pb.c, σ, method)``, or the one a solve before kept for
+    the same K and B (:func:`plateqp.linalg.keep.kept`), its counts started afresh; with the
+    entry to keep again after the solve (None where nothing is kept)."""
+    store = kept()
+    if store is not None:
+        for entry in list(store):
+            if isinstance(entry, _KeptSprings) and entry.fits(pb, sigma, method):
+                store.remove(entry)  # in use: not lent to another solve at the same time
+                entry.fac.again(pb.c)
+                return entry.fac, entry
+    fac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, method)
+    if store is None:
+        return fac, None
+    return fac, _KeptSprings(fac, pb.Kd.copy(), pb.B.copy(), np.array(pb.c, copy=True), sigma, method)
 
 
 def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: int, steps, sigma: float):
@@ -154,7 +250,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
         try:
             if method == "auto" and qp.singular is True:  # a floating plate: its factorisation would fail
                 raise NotApplicable("K is singular (the QP says so: a floating plate)", singular=True)
-            cond = DenseDual(pb, max_dense)
+            cond, keep, before = _dense_dual(pb, max_dense)
         except NotApplicable as why:
             if method == "condensed":
                 raise SolverError(f"pdas: the condensed method does not apply here: {why}") from None
@@ -168,15 +264,21 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
                     A = anchored[0]
         else:
             out = run_dense(pb, cond, A, tol["feas_tol"], max_iter, p, steps)
-            extras.update(method="condensed", **cond.stats)
+            stats = cond.stats
+            if before is not None:  # a kept factorisation: this solve's own counts
+                stats.update({k: stats[k] - before[k] for k in _COUNTS}, kept=True)
+            extras.update(method="condensed", **stats)
+            if keep is not None:
+                remember(kept(), keep)
     if out is None:
         W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k))
+        spring = None
         if schur is not None and settings["factor"] == "auto" and _trailing_pays(schur):
             # the exact steps on the anchored factorisation, its trailing block replaced
             fac = TrailingFactor(schur, pb.B)
         else:
             schur = None  # released: the anchored factorisation is not kept beside a sparse one
-            fac = SpringFactor(pb.K, pb.B, pb.Kd, pb.c, sigma, settings["factor"])
+            fac, spring = _spring_factor(pb, sigma, settings["factor"])
         kfac = None
         lh, dual = bool(settings["lh_start"]), bool(settings["dual_start"])
         if (lh or dual) and A is None and not np.all(pb.rho * pb.k >= 1.0):
@@ -199,6 +301,8 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             info = {}
             out = run_sparse(pb, fac, W, sigma, None, tol["feas_tol"], max_iter, p, steps, kfac, info, lh, dual,
                              singular, False)
+        if spring is not None and anchored is None:
+            remember(kept(), spring)
         stats = dict(fac.stats, **info)
         if kfac is not None:  # the factor of K alone (phase 1's line search) counts too
             for key, val in kfac.stats.items():

@@ -89,6 +89,14 @@ class SpringFactor:
                       "update_s": 0.0, "lowrank": 0, "lowrank_rows": 0, "lowrank_s": 0.0, "solves": 0,
                       "solve_s": 0.0}
 
+    def again(self, c: np.ndarray) -> None:
+        """Start a new solve on this factor (kept from a solve before on the same K and B:
+        :mod:`plateqp.linalg.keep`), whose rows' springs may differ (``c``, their stiffnesses in
+        series: only the downdates' loss reads them): the factor, its ``w`` and its measured
+        costs stay; the counts start again."""
+        self.c = c
+        self.stats = {k: 0 if isinstance(v, int) else 0.0 for k, v in self.stats.items()}
+
     def twin(self) -> SpringFactor:
         """A second factor of the same ``H(w)`` family (the sparse method's factor of ``K``
         alone beside its active-set one): the pattern, its equilibration and the rows'
