@@ -19,37 +19,37 @@ ACCURACY: dict[str, dict[str, float]] = {
 
 #: Method settings (not accuracy: the answer is exact at every value); options override them.
 #:
-#: ``method``     "auto" (condensed where it applies, else sparse), "condensed", "sparse".
-#: ``max_dense``  the condensed method only if the rows touch at most this many dofs; "auto":
+#: :method: "auto" (condensed where it applies, else sparse), "condensed", "sparse".
+#: :max_dense: the condensed method only if the rows touch at most this many dofs; "auto":
 #:                :data:`MAX_DENSE_AUTO`.
-#: ``penalty``    κ (sparse): a rigid row's spring in ``H_A`` is κ times its local stiffness.
-#: ``prox``       σ (sparse): ``H_A`` includes σ diag(K) (definite for a floating plate).
-#: ``factor``     (sparse) "cholmod" (scikit-sparse: analysis re-used, rank-k updates),
+#: :penalty: κ (sparse): a rigid row's spring in ``H_A`` is κ times its local stiffness.
+#: :prox: σ (sparse): ``H_A`` includes σ diag(K) (definite for a floating plate).
+#: :factor: (sparse) "cholmod" (scikit-sparse: analysis re-used, rank-k updates),
 #:                "cvxopt" (CHOLMOD in cvxopt's wheels: analysis re-used, a numeric
 #:                refactorisation at every change), "linalg" (:class:`plateqp.linalg.Factor`'s
 #:                own choice, a new factorisation at every change), "superlu" (Factor's SuperLU,
 #:                likewise); "auto": the first of these that is installed.
-#: ``p``          block exchanges allowed without progress before Murty's single exchange
+#: :p: block exchanges allowed without progress before Murty's single exchange
 #:                (cycles always go to Murty's). 6, not Júdice–Pires' 3: on 30 × 30 post grids
 #:                the block steps stall near the end (infeasible rows 7 → 24 → 12 → 41), and
 #:                with 3 tries Murty's one-row steps then took 25–35 more sets; with 6, the
 #:                block steps find a better set: 61 → 35, 46 → 34, 62 → 30 and 58 → 31 sets at
 #:                32², 64², 128², 256² (a quarter of the dense method's time at 64²). Nothing
 #:                else measured changed (other post grids, beds, 45² and 63² posts at 128²).
-#: ``max_rows``   refuse a ``G`` with more rows than ``min(n, max_rows)``; None (the default):
+#: :max_rows: refuse a ``G`` with more rows than ``min(n, max_rows)``; None (the default):
 #:                than ``n``. (It was 100 000, and ``backend="auto"``, which takes pdas for the
 #:                primal problem, then refused every bed finer than 316 × 316 cells: the sparse
 #:                method's memory grows as m, the dense method's is bounded by ``max_dense``,
 #:                Lawson–Hanson's by LH_MEMORY; a 400² bed, 160 801 springs, solved in 9.5 s,
 #:                2.6× one raw CHOLMOD factorise-and-solve.)
-#: ``max_iter``   active sets solved before ``Status.MAX_ITER``; default 50 + 2 m.
-#: ``lh_start``   (sparse, stiff rows, held plate, cold start) find the active set first by
+#: :max_iter: active sets solved before ``Status.MAX_ITER``; default 50 + 2 m.
+#: :lh_start: (sparse, stiff rows, held plate, cold start) find the active set first by
 #:                Lawson–Hanson's method with the flexibility's rows computed as it frees them
 #:                (:func:`.sparse.lawson_hanson`, within LH_TIME factorisations' time).
-#: ``dual_start`` (sparse, stiff rows, cold start) where that is off or gave up, find it by
+#: :dual_start: (sparse, stiff rows, cold start) where that is off or gave up, find it by
 #:                projected Newton on the dual energy (:func:`.sparse.dual_newton`); with both
 #:                False: plain PDAS from the two-sided problem (every row active).
-#: ``anchor_start`` (stiff rows, K singular: a floating plate, cold start) find the active set
+#: :anchor_start: (stiff rows, K singular: a floating plate, cold start) find the active set
 #:                first on the plate with its rows anchored by soft springs (ANCHOR): method
 #:                "auto", up to ``max_dense`` rows, by the condensed method's dense steps
 #:                (:func:`.dense.anchored_set`); else by Lawson–Hanson on the anchored plate's
