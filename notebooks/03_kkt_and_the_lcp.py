@@ -13,7 +13,7 @@
 # ---
 
 # %% [markdown]
-# # 1. Contact as a convex QP: three formulations side by side
+# # 3. KKT conditions and the LCP: three formulations of one contact problem
 #
 # A plate on one-sided supports minimises its potential energy subject to *gap ≥ 0*. We write the
 # three standard forms of plateqp (primal, condensed, dual) **by hand in cvxpy** from the same
@@ -23,6 +23,18 @@
 # * primal feasibility  gap = g0 + s − B u ≥ 0
 # * dual feasibility  R ≥ 0
 # * complementarity  R_i · gap_i = 0 for every support
+
+
+# %% [markdown]
+# ## Learning goals
+#
+# * write the contact problem of a plate three ways (primal: every displacement; condensed: the
+#   gaps at the supports; dual: the reactions) and solve each as a QP;
+# * state the four KKT conditions (stationarity, primal feasibility, dual feasibility,
+#   complementarity) and check them by hand on a solution;
+# * see that the KKT system of the condensed QP *is* the linear complementarity problem
+#   R = M z + q, z ≥ 0, R ≥ 0, zᵀR = 0 that Lemke's method (lessons 4 and 5) solves;
+# * know why the dual needs a plate that is held: it needs K⁻¹.
 
 # %%
 import numpy as np
@@ -113,3 +125,77 @@ res = pq.solve(scene, backend="lemke", formulation="condensed", accuracy="high")
 print(res.status, res.kkt.as_dict())
 print("reactions:", np.round(res.reactions, 3), " sum:", res.reactions.sum(), "= load", 50 + 5)
 np.testing.assert_allclose(res.reactions / d.F0, R_c, atol=1e-5 * np.abs(R_c).max())
+
+# %% [markdown]
+# ## One answer, three routes
+#
+# The reactions of the nine supports from the primal QP (cvxpy's multipliers), the condensed QP
+# (R = M z + q) and plateqp's Lemke on the condensed LCP (in the user's units, scaled back). The
+# bars coincide: three formulations of one convex problem have one solution.
+
+# %%
+import matplotlib.pyplot as plt
+k = np.arange(d.m)
+fig, ax = plt.subplots(figsize=(6, 2.8))
+ax.bar(k - 0.25, R_p, 0.25, label="primal (multipliers)")
+ax.bar(k, R_c, 0.25, label="condensed (M z + q)")
+ax.bar(k + 0.25, res.reactions / d.F0, 0.25, label="plateqp lemke")
+ax.set_xlabel("support"); ax.set_ylabel("reaction (scaled)"); ax.legend(fontsize=7)
+fig.tight_layout(); plt.show()
+
+# %% [markdown]
+# ### Exercise 1: statics
+#
+# The plate floats: the nine supports carry the whole load. Check, in the user's units, that the
+# reactions balance the point load (50 at (0.6, 0.4)) and the uniform load (5 per unit area on the
+# unit square, its resultant 5 at the centre): the force and the moments about both axes.
+
+# %%
+xs = np.array([s.x for s in supports]); ys = np.array([s.y for s in supports])
+R = res.reactions
+print(f"force {R.sum():.6f}, moment about y-axis {R @ xs:.6f}, about x-axis {R @ ys:.6f}")
+assert abs(R.sum() - (50 + 5)) < 1e-8 * 55
+assert abs(R @ xs - (50 * 0.6 + 5 * 0.5)) < 1e-8 * 55
+assert abs(R @ ys - (50 * 0.4 + 5 * 0.5)) < 1e-8 * 55
+
+# %% [markdown]
+# ### Exercise 2: break it, make every support two-sided
+#
+# Replace the one-sided constraints B u ≤ g0 by equalities B u = g0 (every support holds the plate
+# both ways, as a linear FE model would). Solve, and check which KKT condition fails: stationarity
+# and statics still hold, but dual feasibility R ≥ 0 does not (some supports pull the plate down).
+
+# %%
+u2 = cp.Variable(d.n)
+eq = [d.B @ u2 == d.g0]
+cp.Problem(cp.Minimize(0.5 * cp.quad_form(u2, cp.psd_wrap(d.K)) - d.f @ u2), eq).solve(solver="CLARABEL")
+R2 = eq[0].dual_value
+stat2 = np.linalg.norm(d.K @ u2.value - d.f + d.B.T @ R2) / np.linalg.norm(d.f)
+print(f"stationarity {stat2:.1e}, reactions (scaled): {np.round(R2, 3)}")
+assert stat2 < 1e-6                                  # still in equilibrium
+assert abs(R2.sum() - R_p.sum()) < 1e-6 * R_p.sum()  # statics holds too
+assert R2.min() < 0                                  # but dual feasibility fails: tension
+
+# %% [markdown]
+# ### Exercise 3: complementarity, support by support
+#
+# From the Lemke answer, list each support's gap (from `res.gaps`) and reaction, and check that at
+# every support one of the two is zero, and that the supports in contact (`res.active`) are those
+# with a reaction.
+
+# %%
+scale = np.abs(res.reactions).max()
+for i, (g, r) in enumerate(zip(res.gaps, res.reactions)):
+    print(f"support {i}: gap {g:.2e}, reaction {r:8.4f}")
+assert np.all(np.minimum(np.abs(res.gaps) / abs(d.W), np.abs(res.reactions) / scale) < 1e-9)
+assert np.array_equal(res.active, res.reactions > 1e-9 * scale)
+
+# %% [markdown]
+# ## Summary
+#
+# * Primal (displacements), condensed (gaps) and dual (reactions) are three convex QPs with one
+#   solution; the dual needs a held plate because it needs K⁻¹.
+# * KKT: stationarity, gap ≥ 0, R ≥ 0, R · gap = 0. A two-sided model keeps the first two and loses
+#   R ≥ 0.
+# * The condensed KKT system is the LCP R = M z + q, z ≥ 0, R ≥ 0, zᵀR = 0: lesson 4 solves it by
+#   Lemke's method.
