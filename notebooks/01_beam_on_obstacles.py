@@ -13,7 +13,7 @@
 # ---
 
 # %% [markdown]
-# # 6. A 1-D warm-up: a beam on rigid obstacles
+# # 1. A 1-D warm-up: a beam on rigid obstacles
 #
 # Before plates, the smallest contact problem with all the ingredients: a simply supported
 # Euler–Bernoulli beam (span L, bending stiffness EI) under a uniform load q, above rigid
@@ -29,6 +29,18 @@
 #
 # Hermite cubics reproduce the exact Euler–Bernoulli deflection at the nodes for these loads, so
 # the closed forms below must come out to rounding.
+
+
+# %% [markdown]
+# ## Learning goals
+#
+# * pose a one-sided contact problem as a QP (minimise the potential energy subject to
+#   gap ≥ 0) and as an LCP in the reactions (R ≥ 0, gap ≥ 0, R · gap = 0);
+# * build the beam's stiffness from Hermite cubics by hand and see that its flexibility at the
+#   nodes is exact;
+# * check every answer against closed forms: the midspan reaction, the lift-off load,
+#   superposition for three obstacles, statics;
+# * see that the contact set is part of the answer, not of the data.
 
 # %%
 import numpy as np
@@ -234,3 +246,47 @@ plt.show()
 # a stiffness K from elements, an operator B that reads the deflection at the contact points,
 # and a QP whose multipliers are the reactions (or, after condensation, an LCP). What changes is
 # size, and that the plate's flexibility G has no closed form: notebook 09 builds it by hand.
+
+# %% [markdown]
+# ### Exercise 1: a point load instead
+#
+# Remove the uniform load and put a point load P = 20 kN at midspan, above the obstacle with gap
+# g = 10 mm. The beam touches when its free deflection P L³ / (48 EI) exceeds g, and then the
+# obstacle carries R = P − 48 EI g / L³ (the rest goes to the ends). Solve it as an LCP with the
+# Hermite model (G and d as above) and check the closed form.
+
+# %%
+P = 20e3
+f_P = np.zeros(free.size); f_P[list(free).index(2 * (nel // 2))] = P
+d_P = g - B @ np.linalg.solve(K, f_P)
+R_P = lemke(G, d_P).x[0]
+R_P_closed = max(0.0, P - 48 * EI * g / L**3)
+print(f"free deflection {P * L**3 / (48 * EI) * 1e3:.2f} mm; R Lemke {R_P:.6f} N, closed form {R_P_closed:.6f} N")
+assert R_P_closed > 0 and abs(R_P - R_P_closed) <= 1e-9 * R_P_closed
+
+# %% [markdown]
+# ### Exercise 2: break it, glue the beam to all three obstacles
+#
+# A two-sided model keeps every obstacle in contact: gap = 0 at all three, the linear system
+# G R = d instead of the LCP. Solve it, and check what goes wrong: statics still holds (the ends
+# and obstacles carry q L), but obstacles now pull the beam down, R < 0, which a rigid obstacle
+# cannot do: held at the top of the middle obstacle (which the one-sided beam leaves), the beam
+# is lifted there, and the outer obstacles must hold it down.
+
+# %%
+R_glued = np.linalg.solve(G3, d3)
+u_glued = np.zeros(2 * (nel + 1)); u_glued[free] = np.linalg.solve(K, f - B3.T @ R_glued)
+ends_glued = -(K_full @ u_glued - f_full)[[0, 2 * nel]]
+print("glued reactions [N]:", np.round(R_glued, 3), "| one-sided:", np.round(R3, 3))
+assert abs(ends_glued.sum() + R_glued.sum() - q * L) <= 1e-9 * q * L   # statics holds
+assert R_glued.min() < 0                                              # but one obstacle pulls
+
+# %% [markdown]
+# ## Summary
+#
+# * One-sided contact is a QP in the displacements and an LCP in the reactions; both give the
+#   closed-form answers here (to the QP solver's tolerance, and to rounding for Lemke).
+# * The flexibility G = B K⁻¹ Bᵀ of a Hermite beam is exact at the nodes, so the 1-D problem has
+#   no discretisation error at the obstacles.
+# * The contact set is unknown in advance; guessing it (gluing) keeps statics but breaks R ≥ 0.
+# * Lesson 2 draws the same problem for two supports: the geometry of the QP.

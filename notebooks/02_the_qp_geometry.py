@@ -13,7 +13,7 @@
 # ---
 
 # %% [markdown]
-# # 7. Two supports: the geometry of a contact QP
+# # 2. The QP's geometry: two supports as a picture
 #
 # With two one-sided supports the condensed problem lives in the plane, and everything a
 # lecture says about convex contact can be drawn:
@@ -28,6 +28,18 @@
 #
 # The scene: a 10 mm steel plate, 1 m × 1 m, simply supported on its edges, with two one-sided
 # posts under it, a uniform load and a point load off the centre line.
+
+
+# %% [markdown]
+# ## Learning goals
+#
+# * draw the condensed contact problem of two supports: the feasible quadrant of the gaps, the
+#   elliptic level sets of the energy Π, the unconstrained minimum;
+# * find the optimum on a corner (both touch), a face (one touches) or inside (none), and read the
+#   reactions as −∇Π in the normal cone there;
+# * enumerate the four contact sets and see that exactly one is consistent when M is positive
+#   definite;
+# * check each case against the primal formulation and statics.
 
 # %%
 import numpy as np
@@ -215,3 +227,55 @@ plt.show()
 # force follows. With m supports the quadrant becomes an orthant with 2ᵐ faces, and finding the
 # right face is the whole difficulty: that is what Lemke, active-set and interior-point methods
 # do in different ways.
+
+# %% [markdown]
+# ### Exercise 1: the minimum principle, by sampling
+#
+# The optimum of a convex QP has the least energy of every feasible point. For each of the four
+# cases, evaluate Π(z) = ½ zᵀ M z + qᵀ z at 2000 random points of the quadrant z ≥ 0 (in a box a
+# few times the size of the free deflection) and check that none is lower than Π at the optimum.
+
+# %%
+rng = np.random.default_rng(1)
+for name, (g0, z, R) in results.items():
+    qq = q_of(g0)
+    Zs = rng.uniform(0.0, 3.0, (2000, 2)) * np.abs(w_free).max()
+    Pi_s = 0.5 * np.einsum("ki,ij,kj->k", Zs, M, Zs) + Zs @ qq
+    Pi_opt = 0.5 * z @ M @ z + qq @ z
+    print(f"{name:20s} Π* = {Pi_opt:10.4f} N·m, lowest sample {Pi_s.min():10.4f} N·m")
+    assert Pi_s.min() >= Pi_opt - 1e-12 * abs(Pi_opt)
+
+# %% [markdown]
+# ### Exercise 2: break it, a concave energy
+#
+# Uniqueness rests on M being positive definite. Flip its sign (an energy that falls as the gaps
+# open: no material does this, but a wrong sign in an assembly does) and enumerate the contact
+# sets again. Check that with level posts (g0 = 0) all four sets are now consistent (four
+# "answers"), and that in the case "no post touches" none is (no answer at all).
+
+# %%
+def consistent_sets(Mx, qq):
+    found = []
+    for A in ([0, 1], [0], [1], []):
+        F = [i for i in (0, 1) if i not in A]
+        z = np.zeros(2)
+        if F:
+            z[F] = np.linalg.solve(Mx[np.ix_(F, F)], -qq[F])
+        if np.all(z >= -1e-15) and np.all(Mx @ z + qq >= -1e-9 * np.abs(r).max()):
+            found.append(A)
+    return found
+
+level, none = consistent_sets(-M, q_of(cases["both posts touch"])), consistent_sets(-M, q_of(cases["no post touches"]))
+print("concave energy, level posts:", level, "| no post touches:", none)
+assert len(consistent_sets(M, q_of(cases["both posts touch"]))) == 1
+assert len(level) == 4 and len(none) == 0
+
+# %% [markdown]
+# ## Summary
+#
+# * The condensed problem of two supports lives in the quadrant of the gaps; its energy's level
+#   sets are ellipses, and the optimum is where the lowest one touches the quadrant.
+# * At the optimum the reactions are ∇Π, and −∇Π lies in the normal cone: zero on an open gap,
+#   pointing out of the quadrant on a closed one. This is the KKT system (lesson 3) drawn.
+# * Positive definite M: one consistent contact set, found by enumeration here, by pivoting
+#   (lessons 4 and 5) when there are too many sets to try.
