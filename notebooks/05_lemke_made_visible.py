@@ -13,7 +13,7 @@
 # ---
 
 # %% [markdown]
-# # 12. Lemke made visible: the tableau, the path of z0, and a ray that proves no equilibrium
+# # 5. Lemke made visible: the tableau, the path of z0, and a ray that proves no equilibrium
 #
 # Notebook 2 printed Lemke's pivots. Here we open the method up. We write it ourselves in about
 # thirty lines on the dense tableau, print the tableau before every pivot, and check each pivot
@@ -28,6 +28,16 @@
 #
 # keeping n basic variables. The first n columns of the current tableau are B⁻¹ and the last is
 # the value of the basic variables.
+
+
+# %% [markdown]
+# ## Learning goals
+#
+# * write Lemke's method in thirty lines and print its tableau before every pivot;
+# * check it pivot by pivot against plateqp's `lemke`, and every corner of its path as almost
+#   complementary;
+# * follow the artificial variable z0 along the path (it need not fall monotonically);
+# * read a secondary ray as a proof that no equilibrium exists: a plate that tips off its posts.
 
 # %%
 import numpy as np
@@ -249,3 +259,50 @@ ax.set_xticks(range(1, max(len(z0_four), len(z0_nine), len(z0_tip)) + 1))
 ax.set_xlabel("pivot"); ax.set_ylabel("z0 (uniform pre-compression, scaled)"); ax.legend(fontsize=8)
 fig.tight_layout()
 plt.show()
+
+# %% [markdown]
+# ### Exercise 1: a 2 × 2 LCP in closed form
+#
+# For M = [[2, 1], [1, 2]] and q = (−1, −1) both gaps are positive only if both reactions vanish:
+# M z = −q gives z = (1/3, 1/3). For q = (−1, 2) the second support presses and the first opens:
+# z = (1/2, 0), R = (0, 2.5). Check `our_lemke` on both against these closed forms.
+
+# %%
+M2 = np.array([[2.0, 1.0], [1.0, 2.0]])
+for q2, z_exact in ((np.array([-1.0, -1.0]), np.array([1 / 3, 1 / 3])), (np.array([-1.0, 2.0]), np.array([0.5, 0.0]))):
+    kind2, z2, _ = our_lemke(M2, q2)
+    print(kind2, z2, "R =", M2 @ z2 + q2)
+    assert kind2 == "solution" and np.allclose(z2, z_exact, atol=1e-14)
+    assert np.allclose(M2 @ z2 + q2, np.maximum(M2 @ z_exact + q2, 0.0), atol=1e-14)
+
+# %% [markdown]
+# ### Exercise 2: break it, move the load off the posts' footprint
+#
+# The six posts of the tipping plate stand on the strip 0 ≤ x ≤ 0.25. With the point load inside
+# that strip (x = 0.2) the plate stands: Lemke ends with a solution and the reactions balance the
+# load and its moment. Move the load out (x = 0.8, as above) and the same method ends on a ray.
+# Check both, with statics for the first.
+
+# %%
+def tip_scene(x_load):
+    return pq.Scene(name="tip", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(8, 8),
+                    loads=[pq.PointLoad(40.0, x_load, 0.5)], supports=[pq.Support(x, y) for x, y in tip_posts])
+
+inside = pq.solve(tip_scene(0.2), backend="lemke", accuracy="high")
+print("load at x = 0.2:", inside.status.value, "R =", np.round(inside.reactions, 3))
+assert abs(inside.reactions.sum() - 40.0) < 1e-9 * 40 and abs(inside.reactions @ x_post - 40 * 0.2) < 1e-9 * 40
+for x_load, expected in ((0.2, "solution"), (0.8, "ray")):
+    _, lcp_x = lcp_of(tip_scene(x_load))
+    kind_x, _, _ = our_lemke(np.asarray(lcp_x.M), np.asarray(lcp_x.q))
+    print(f"load at x = {x_load}: our Lemke ends with a {kind_x}")
+    assert kind_x == expected
+
+# %% [markdown]
+# ## Summary
+#
+# * Lemke's method is a walk along almost complementary corners, one pivot at a time, driven by
+#   the artificial pre-compression z0; it ends when z0 leaves the basis.
+# * A thirty-line tableau version agrees with plateqp's `lemke` pivot by pivot and with closed
+#   forms on small LCPs.
+# * When no equilibrium exists, the walk ends on a secondary ray y ≥ 0 with Mᵀy ≤ 0 and qᵀy < 0:
+#   a rigid motion that lowers the energy for ever, a proof, not a failure to converge.
