@@ -13,7 +13,7 @@
 # ---
 
 # %% [markdown]
-# # 11. Duality: potential energy, complementary energy, and reactions as prices
+# # 7. Duality and multipliers: the reactions as prices
 #
 # One scene, two minimum principles. With K the plate's stiffness (held by its simply
 # supported edges, so K is positive definite), f the loads, B u the deflections at the supports
@@ -28,6 +28,17 @@
 # Lagrangian duality: the dual function of the primal is −Π_c(R), so for every feasible pair
 # Π(u) + Π_c(R) ≥ 0 (weak duality), with equality exactly at the solution (strong duality: a
 # convex QP with feasible points has no duality gap).
+
+
+# %% [markdown]
+# ## Learning goals
+#
+# * write the potential energy Π(u) and the complementary energy Π_c(R) of one contact problem,
+#   and see that their sum vanishes at the solution (no duality gap) and is positive elsewhere;
+# * split the gap of any feasible pair into a mismatch of displacements plus complementarity;
+# * read the reactions as prices: ∂Π*/∂g0_j = −R_j, checked by finite differences;
+# * check plateqp's `sensitivity(result, "gaps")` (symmetric by Maxwell–Betti) against finite
+#   differences.
 
 # %%
 import numpy as np
@@ -164,3 +175,48 @@ a2.bar(idx + 0.2, -dPi, 0.4, label="−∂Π*/∂g0  (finite differences)")
 a2.set_xticks(idx, [str(i + 1) for i in idx]); a2.set_xlabel("support"); a2.legend(fontsize=8)
 fig.tight_layout()
 plt.show()
+
+# %% [markdown]
+# ### Exercise 1: weak duality, by sampling
+#
+# For every displacement u that respects the supports (B u ≤ g0) and every R ≥ 0,
+# Π(u) + Π_c(R) ≥ 0: the split above is a sum of a square and a product of two non-negative
+# vectors. Check it on the feasible displacements of the raised scenes (one per δ) paired with
+# 50 random non-negative reaction vectors each.
+
+# %%
+worst = np.inf
+for d in deltas:
+    u_d = solve(gap0 - d).u[model.free]
+    assert np.all(B @ u_d <= g + 1e-15)
+    for R_any in rng.uniform(0, 50, (50, len(posts))):
+        worst = min(worst, Pi(u_d) + Pi_c(R_any))
+print(f"smallest Π(u) + Π_c(R) over {50 * len(deltas)} feasible pairs: {worst:.3e}")
+assert worst >= 0
+
+# %% [markdown]
+# ### Exercise 2: break it, let the plate penetrate
+#
+# Weak duality needs u feasible. Lower every support by δ = 1e-5 instead (gap0 + δ): the plate
+# then sinks below the original supports, B u > g0 somewhere. Check that the bound fails: the sum
+# is now negative, and by the same argument as above it equals −δ · ΣR exactly.
+
+# %%
+d = 1e-5
+low = solve(gap0 + d)
+u_low, R_low = low.u[model.free], low.reactions
+sum_low = Pi(u_low) + Pi_c(R_low)
+print(f"max penetration {(B @ u_low - g).max():.1e};  Π + Π_c = {sum_low:.6e},  −δ·ΣR = {-d * R_low.sum():.6e}")
+assert (B @ u_low - g).max() > 0                         # infeasible: it penetrates
+assert sum_low < 0 and abs(sum_low + d * R_low.sum()) < 1e-8 * abs(sum_low) + 64 * np.finfo(float).eps * abs(Pi(u_low))
+
+# %% [markdown]
+# ## Summary
+#
+# * The potential energy (minimised over displacements that respect the supports) and the
+#   complementary energy (minimised over reactions R ≥ 0) are dual: at the solution their sum is
+#   zero, elsewhere it is positive and measures how far from the solution a pair is.
+# * The reactions are the multipliers of the gap constraints and the prices of the gaps:
+#   −∂Π*/∂g0_j = R_j.
+# * The sensitivity of the reactions to the gaps is symmetric and negative semidefinite; lesson 11
+#   uses it to design the gaps.
