@@ -13,7 +13,7 @@
 # ---
 
 # %% [markdown]
-# # 10. "Toggle the springs": the iteration commercial codes use, and where it cycles
+# # 9. Toggle the springs: how it fails
 #
 # General finite-element codes (and PyNite's tension-only supports) handle one-sided supports
 # by iterating linear solves:
@@ -38,6 +38,18 @@
 # nearly equal, the flexibility matrix is close to singular, and one round's change overshoots.
 # Below is such a cluster: eight posts under a simply supported slab, mixed heave and settlement,
 # three loads (found by that search, written here deterministically).
+
+
+# %% [markdown]
+# ## Learning goals
+#
+# * write the iteration of many FE codes for one-sided supports: solve with every support held,
+#   release those in tension, restore those penetrated, repeat;
+# * watch it cycle on a tight cluster of posts, through contact sets that are all wrong, while
+#   Lemke, BPP and PDAS find the one answer;
+# * see Murty's least-index rule (flip one support at a time) finish on the same scene;
+# * check that the iteration does work where the posts are far apart, and why plates rarely
+#   cycle.
 
 # %%
 import warnings
@@ -193,3 +205,51 @@ plt.show()
 # tension, and so on round the cluster. The same happens on the 4 × 4 matrix of
 # tests/backends/test_toggle.py. The cures are the ones above: pivot one support at a time (Lemke, the
 # least-index rule), fall back to it when progress stalls (BPP), or safeguard the step (PDAS).
+
+# %% [markdown]
+# ### Exercise 1: where toggling works
+#
+# Nine posts at a quarter of the plate apart (lesson 4's scene: a plate held on its left edge,
+# two posts heaved, a point load) are far apart compared with the plate's stiffness scale, and
+# the toggle iteration settles. Run `toggle_by_hand` on it and check its reactions against Lemke.
+
+# %%
+far = pq.Scene(name="far", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(8, 8),
+               edges={"left": "simple"}, loads=[pq.PointLoad(40.0, 0.7, 0.7)],
+               supports=[pq.Support(x, y, gap=(-0.05 if (x, y) in ((0.5, 0.0), (1.0, 0.0)) else 0.0))
+                         for x in (0.5, 0.75, 1.0) for y in (0.0, 0.5, 1.0)])
+visited_far, R_far = toggle_by_hand(far)
+R_far_lemke = pq.solve(far, backend="lemke", accuracy="high").reactions
+print(f"{len(visited_far)} rounds; toggle R = {np.round(R_far, 4)}")
+assert R_far is not None
+np.testing.assert_allclose(R_far, R_far_lemke, atol=1e-8 * np.abs(R_far_lemke).max())
+
+# %% [markdown]
+# ### Exercise 2: every set on the cycle is wrong
+#
+# A cycle is not a near miss. For each contact set the toggle iteration visits on the cluster,
+# hold exactly those supports two-sided, solve, and check which KKT condition fails: a held
+# support in tension (R < 0) or a released one penetrated (gap < 0). Every visited set must fail
+# one of them (otherwise it would be the answer).
+
+# %%
+g_cluster = np.array([s.gap for s in scene.supports])
+for s in sets:
+    A = np.zeros(m, bool); A[list(s)] = True
+    held = pq.Scene(name="held", plate=scene.plate, mesh=scene.mesh, edges=scene.edges, loads=scene.loads,
+                    supports=[sp for sp, a in zip(scene.supports, A) if a])
+    r = pq.solve_bilateral(held)
+    gap = g_cluster - np.array([r.at(sp.x, sp.y) for sp in scene.supports])
+    tension, penetrated = np.flatnonzero(A)[r.reactions < 0], np.flatnonzero(~A & (gap < 0))
+    print(f"{one_based(s):28s} in tension {one_based(tension):12s} penetrated {one_based(penetrated)}")
+    assert tension.size + penetrated.size > 0
+
+# %% [markdown]
+# ## Summary
+#
+# * "Toggle the springs" solves a linear problem per guess of the contact set and flips every
+#   support that is wrong; nothing makes it converge, and on a tight cluster it cycles.
+# * Every set on the cycle violates a KKT condition; plateqp's `toggle` backend reports the cycle
+#   (status MAX_ITER) instead of an answer.
+# * Pivoting methods (Lemke, BPP with its safeguard, Murty's least-index rule) and PDAS finish, and
+#   agree. Where posts are far apart, toggling usually settles, which is why it survives in codes.
