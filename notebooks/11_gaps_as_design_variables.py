@@ -13,7 +13,7 @@
 # ---
 
 # %% [markdown]
-# # 5. Gaps as a design variable: sensitivities, exact paths, regulation
+# # 11. Gaps as design variables: sensitivities, paths and regulation
 #
 # The source paper ends with "control the interaction forces by changing the gaps". While the
 # contact set holds, the reactions are **linear** in the initial gaps: R(g0) = R(0) + S g0, with
@@ -23,6 +23,17 @@
 #
 # The scene: a free square plate (side a) on four rigid corner supports under a uniform load q.
 # By symmetry and statics each corner carries q a²/4.
+
+
+# %% [markdown]
+# ## Learning goals
+#
+# * compute the sensitivity of the reactions to the gaps, dR/dg0, and check it against the
+#   closed form of a plate on four corners (a twist mode) and against finite differences;
+# * follow an exact path of the reactions as one support settles, through a lift-off at the
+#   closed-form settlement δ* = q a⁴ / (8 D (1 − ν));
+# * regulate: find the gaps that give prescribed reactions, and check them by solving again;
+# * know when the linear prediction R + S Δg holds (a fixed contact set) and when it fails.
 
 # %%
 import numpy as np
@@ -119,3 +130,50 @@ assert np.allclose(check.reactions, [300, 200, 300, 200], rtol=1e-9)
 # the same from the sensitivities: the reactions are linear in the gaps while the contact set holds
 pred = res.reactions + np.asarray(S) @ reg.gaps
 assert np.allclose(pred, [300, 200, 300, 200], rtol=1e-9)
+
+# %% [markdown]
+# ### Exercise 1: a settlement predicted by the sensitivity
+#
+# Settle support 1 by δ = δ*/2 (below the lift-off value, so all four corners stay in contact).
+# The closed form is R_i = q a²/4 − k p_i p_1 δ with the twist mode p = (1, −1, 1, −1): predict
+# the reactions with it, solve the settled scene, and check both against each other and statics
+# (the four reactions carry q a²).
+
+# %%
+def settled(i, d):
+    gi = np.zeros(4); gi[i] = d
+    return pq.Scene(name="settled", plate=scene.plate, mesh=scene.mesh, loads=scene.loads,
+                    supports=[pq.Support(x, y, gap=g_) for (x, y), g_ in zip(corners, gi)])
+
+d = delta_star / 2
+R_half = pq.solve(settled(0, d), backend="lemke", accuracy="high").reactions
+R_pred = q * a**2 / 4 - k * p * p[0] * d
+print("solved:   ", R_half.round(6), "\npredicted:", R_pred.round(6))
+assert np.allclose(R_half, R_pred, rtol=1e-8, atol=1e-8 * q * a**2)
+assert abs(R_half.sum() - q * a**2) < 1e-9 * q * a**2
+
+# %% [markdown]
+# ### Exercise 2: break it, settle past the lift-off
+#
+# Settle support 1 by 1.5 δ*. The linear prediction now asks support 1 for a negative reaction,
+# a pull the corner cannot give; the solved scene has lifted off there instead (R = 0), and the
+# other three corners carry the whole load. Check both.
+
+# %%
+d = 1.5 * delta_star
+R_far = pq.solve(settled(0, d), backend="lemke", accuracy="high").reactions
+R_lin = q * a**2 / 4 - k * p * p[0] * d
+print("solved:", R_far.round(6), "| linear prediction:", R_lin.round(6))
+assert R_lin[0] < 0                                  # the prediction pulls
+assert abs(R_far[0]) < 1e-9 * q * a**2               # the plate lifts off instead
+assert abs(R_far.sum() - q * a**2) < 1e-9 * q * a**2 and R_far.min() >= -1e-9 * q * a**2
+
+# %% [markdown]
+# ## Summary
+#
+# * While the contact set holds, the reactions are linear in the gaps: R(g0 + Δg) = R + S Δg, with
+#   S = `pq.sensitivity(result, "gaps")`, symmetric and negative semidefinite.
+# * An exact path through the gaps is piecewise linear, with breakpoints where a support lifts off
+#   or touches; the first one here is at the closed-form δ*.
+# * Regulation inverts the relation for the gaps that give chosen reactions; a new solve checks it.
+#   Past a breakpoint the linear prediction fails and only a new solve tells the truth.
