@@ -245,7 +245,7 @@ plt.show()
 # **What to take to the plate.** The same three ingredients come back in two dimensions:
 # a stiffness K from elements, an operator B that reads the deflection at the contact points,
 # and a QP whose multipliers are the reactions (or, after condensation, an LCP). What changes is
-# size, and that the plate's flexibility G has no closed form: notebook 09 builds it by hand.
+# size, and that the plate's flexibility G has no closed form: lesson 6 builds it by hand.
 
 # %% [markdown]
 # ### Exercise 1: a point load instead

@@ -77,7 +77,7 @@ for d in (np.ones(lcp.n), np.linspace(1, 5, lcp.n), np.random.default_rng(0).uni
     np.testing.assert_allclose(r.x, z, atol=1e-12)
 
 # %% [markdown]
-# Notebook 12 opens the method up: the tableau before every pivot, the path of z0, and a plate
+# Lesson 5 opens the method up: the tableau before every pivot, the path of z0, and a plate
 # with no equilibrium, where Lemke ends on a ray that proves it.
 
 # %% [markdown]

@@ -15,7 +15,7 @@
 # %% [markdown]
 # # 5. Lemke made visible: the tableau, the path of z0, and a ray that proves no equilibrium
 #
-# Notebook 2 printed Lemke's pivots. Here we open the method up. We write it ourselves in about
+# Lesson 4 printed Lemke's pivots. Here we open the method up. We write it ourselves in about
 # thirty lines on the dense tableau, print the tableau before every pivot, and check each pivot
 # against plateqp's `lemke`. Then we follow the artificial variable z0 (the uniform
 # pre-compression) along its path, and end with a plate that has **no** equilibrium: there Lemke
@@ -158,8 +158,8 @@ assert abs(res.reactions @ x_post - 40.0 * 0.4) < 1e-9 * 40.0
 # Between pivots the method walks along a line on which (z, w) solves the LCP with q replaced by
 # q + d z0, a uniform pre-compression z0 of every support, and satisfies every complementarity
 # pair but one. Each pivot is a corner of that path, where one support changes state. We check
-# both facts at every corner, and draw z0 for this scene and for the nine-post scene of notebook
-# 2. In general z0 need not fall monotonically, but without degenerate ties the path never
+# both facts at every corner, and draw z0 for this scene and for the nine-post scene of lesson
+# 4. In general z0 need not fall monotonically, but without degenerate ties the path never
 # revisits a basis (plateqp's lexicographic rule makes that hold with ties too).
 
 # %%
@@ -249,7 +249,7 @@ print("z0 along the path:", np.round(z0_tip, 3), "(it never reaches 0: the pre-c
 
 # %%
 fig, ax = plt.subplots(figsize=(6.5, 3.4))
-for vals, lab in ((z0_four, "four posts (solution)"), (z0_nine, "nine posts, notebook 2 (solution)"),
+for vals, lab in ((z0_four, "four posts (solution)"), (z0_nine, "nine posts, lesson 4 (solution)"),
                   (z0_tip, "plate that tips off (ray)")):
     ax.plot(range(1, len(vals) + 1), vals, "o-", label=lab)
 ax.plot(len(z0_tip), z0_tip[-1], "x", color="k", ms=12, mew=2)

@@ -156,8 +156,9 @@ assert abs(R_half.sum() - q * a**2) < 1e-9 * q * a**2
 # ### Exercise 2: break it, settle past the lift-off
 #
 # Settle support 1 by 1.5 δ*. The linear prediction now asks support 1 for a negative reaction,
-# a pull the corner cannot give; the solved scene has lifted off there instead (R = 0), and the
-# other three corners carry the whole load. Check both.
+# a pull the corner cannot give; the solved scene has lifted off there instead (R = 0, and the
+# opposite corner 3 with it: a plate on two diagonal corners), and the corners still in contact
+# carry the whole load (here the diagonal pair 2 and 4). Check both.
 
 # %%
 d = 1.5 * delta_star
