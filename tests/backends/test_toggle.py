@@ -76,7 +76,7 @@ def test_toggle_says_when_the_contact_set_does_not_hold_the_plate():
 
 def cluster_scene():
     """Eight posts in a tight cluster under a simply supported slab, mixed heave and settlement:
-    toggling cycles through three contact sets (notebooks/10_toggle_the_springs)."""
+    toggling cycles through three contact sets (notebooks/09_toggle_how_it_fails)."""
     posts = [(0.48, 0.52), (0.48, 0.55), (0.50, 0.55), (0.51, 0.62),
              (0.54, 0.52), (0.56, 0.58), (0.57, 0.52), (0.57, 0.61)]
     gap0 = 1e-4 * np.array([1, 2, 1, -1, 1, 1, -2, 0])
