@@ -13,8 +13,9 @@ import plateqp  # noqa: E402
 project = "plateqp"
 author = "the plateqp developers"
 release = version = plateqp.__version__
-extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.autosummary", "sphinx.ext.napoleon", "sphinx.ext.mathjax", "sphinx.ext.viewcode"]
-source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
+extensions = ["myst_nb", "sphinx.ext.autodoc", "sphinx.ext.autosummary", "sphinx.ext.napoleon", "sphinx.ext.mathjax", "sphinx.ext.viewcode"]
+source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}  # .rst first: autosummary writes its stubs so
+nb_execution_mode = "off"  # the lessons are committed executed (tests/test_notebooks.py runs them)
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 exclude_patterns = ["_build", "README.md"]
@@ -62,3 +63,20 @@ def _scene_keys():
 
 
 _scene_keys()
+
+
+def _lessons():
+    """The course's lessons (notebooks/*.ipynb, committed with their outputs) copied beside the
+    course page, which lists them; the copies are not committed."""
+    import shutil
+
+    src = ROOT / "notebooks"
+    dst = Path(__file__).parent / "lessons"
+    dst.mkdir(exist_ok=True)
+    for nb in sorted(src.glob("[0-9][0-9]_*.ipynb")):
+        target = dst / nb.name
+        if not target.exists() or target.read_bytes() != nb.read_bytes():
+            shutil.copyfile(nb, target)
+
+
+_lessons()
