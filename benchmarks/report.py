@@ -100,6 +100,9 @@ class Part:
         dest = out / "results" / self.csv
         shutil.copyfile(src, dest)
         df = pd.read_csv(dest)
+        if df.empty:
+            raise RuntimeError(f"{self.script} measured nothing (no rows in {self.produced}):\n"
+                               f"{proc.stdout[-2000:]}")
         md = self.section(df, out / "figures")
         meta = (f"*Measured {dt.datetime.now(dt.timezone.utc):%Y-%m-%d %H:%M} UTC in {took:.0f} s on "
                 f"{machine()}; {versions()}. Command: `{shown}` (driven by "
