@@ -1,4 +1,4 @@
-"""Write the graded plate-contact test set for qpbenchmark (issue 15, item 4).
+"""Write the graded plate-contact test set for qpbenchmark.
 
     python benchmarks/qpbenchmark/make_testsets.py [--meshes 8,16,32,64] [--out DIR]
 
