@@ -53,7 +53,7 @@ def _quantities(res):
     from plateqp.estimate import Quantities
 
     q = Quantities.of(res)
-    return {"w": q.w_nodes, "w_max": q.w_max, "R": q.reactions, "p": q.p_max}
+    return {"w": q.w_grid, "w_max": q.w_max, "R": q.reactions, "p": q.p_max}  # the grid view
 
 
 def errors(q, ref):

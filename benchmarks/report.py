@@ -266,7 +266,7 @@ def parts() -> dict[str, Part]:
                               tri_section, "Triangles")
     if SWEEP_REUSE_SCRIPT.exists():
         p["sweep-reuse"] = Part("sweep-reuse", "bench_sweep_reuse", "sweep-reuse.csv", "sweep-reuse.csv",
-                                [], ["--meshes", "16", "--scenes", "grid", "--values", "3", "--repeats", "1"],
+                                [], ["--meshes", "32", "--scenes", "grid", "--values", "3", "--repeats", "1"],
                                 reuse_section, "Sweeps reusing the factorisation")
     for part in p.values():  # scripts taking --out: point it at the scratch results
         for lst in (part.full, part.quick):
