@@ -222,7 +222,10 @@ def tri_section(df, figdir):
 
 
 def reuse_section(df, figdir):
-    return table(df)
+    return ("A sweep that keeps the plate's factorisation between values (a gap or a bed's gap "
+            "field sweeping): the cost of a value after the first, divided by one raw CHOLMOD "
+            "factorise-and-solve of the same K (`per_value_ratio`; the goal is 0.3 at 128²), with the "
+            "worst KKT residual over the values.\n\n" + table(df))
 
 
 def parts() -> dict[str, Part]:

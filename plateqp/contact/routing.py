@@ -34,7 +34,7 @@ from .scaling import Scaled
 #   but at 128² BPP's answers were INACCURATE (KKT 1–2e-10: the condensation of a singular K,
 #   shifted and unshifted, costs digits) where PDAS's were at 1–2e-11. Now
 #   PDAS's exact steps run on the anchored factorisation itself (pdas.factor.TrailingFactor):
-#   0.67–0.96× BPP's time (benchmarks/bench_floating.py, interleaved, results/floating-s26.csv).
+#   0.67–0.96× BPP's time (benchmarks/bench_floating.py, interleaved).
 # * which backend, read from the declared capabilities (plateqp.backends.base.Backend): an
 #   exact one that takes the formulation (answers exact to rounding at any tolerance), the
 #   warm-startable ones first (sweeps re-use their final active set; of the exact LCP solvers
@@ -46,7 +46,7 @@ from .scaling import Scaled
 #   m ≤ AUTO_CONDENSED_FRACTION × free dofs, never beyond AUTO_CONDENSED_MAX (the dense work
 #   grows like m³, its memory like 8 m² bytes). Re-measured once condensation came from one
 #   factorisation's trailing block (bench_scaling.py --parts contacts --meshes 32,64,128
-#   --ks 5,9,15,31, accuracy 1e-6; results/scaling-auto-s21.csv): condensed was faster for
+#   --ks 5,9,15,31, accuracy 1e-6): condensed was faster for
 #   OSQP, Clarabel and ProxQP at every m up to 7.5 % of the dofs (225 posts at 32²: 1.8–2×),
 #   and at 2 % (961 at 128²: OSQP 7.4 s against 181 s, Clarabel 2.5 against 9.3, ProxQP 2.0
 #   against 15.9); at 7.9 % (961 at 64²) for OSQP and ProxQP but not Clarabel (2.1 s against
