@@ -321,6 +321,10 @@ def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, ba
     R = data.F0 * c.R
     s = data.W * c.s
     w = model.contacts.B @ u
+    if model.n_soil:  # the soil's settlement v under a bed node: its compression; w the plate's (B u = w − v)
+        v = np.zeros(R.shape)
+        v[model.contacts.source == "bed"] = u[model.n_free:]
+        s, w = s + v, w + v
     gaps = model.contacts.g0 + s - w
     stat = model.K @ u - model.f + model.contacts.B.T @ R
     res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))

@@ -66,13 +66,11 @@ class Scaled:
         p = model.scene.plate
         L = max(p.a, p.b)
         D = p.D
-        nd = model.element.ndof_node
-        kind = model.free % nd
-        orders = np.array([dx + dy for dx, dy in model.element.node_dofs])
+        order = model.dof_orders  # the soil's unknowns (if any) are deflections
         modes = model.rigid_modes()
         W, W_load = deflection_scale(model, floating=modes.shape[1] > 0)
         F0 = W * D / L**2
-        S = W / L ** orders[kind]
+        S = W / L ** order
         Sm = sp.diags(S)
         # CSC, the format every factorisation and the primal QP take: converted here, once, so
         # that no copy of it is alive beside this one when K is factorised (15 MB at 128²)
@@ -83,7 +81,7 @@ class Scaled:
         modes = modes / S[:, None]
         if modes.shape[1]:
             modes = modes / np.linalg.norm(modes, axis=0)
-        data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, kind == 0, model.K, c.B,
+        data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, order == 0, model.K, c.B,
                    w_load=W_load / W, spacing=contact_spacing(model) / L, derived=model.derived)
         check_distinct_contacts(data, model)
         return data

@@ -29,6 +29,7 @@ from ..errors import SceneError
 from .generators import mesh_generator
 from .memory import check_memory
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
+from .soil import attach, couples
 
 if TYPE_CHECKING:  # pragma: no cover
     from .elements import DKT
@@ -109,6 +110,11 @@ class Model:
     #: flexibility), kept for the next solve on this model or a copy of it that shares K and B
     #: (``dataclasses.replace`` shares this list: a sweep condenses once): [(K, B, kind, value)]
     derived: list = field(default_factory=list, repr=False, compare=False)
+    #: the soil's surface unknowns (:mod:`plateqp.model.soil`: Pasternak, half-space), appended
+    #: to K's dofs after the plate's free ones, one at each of ``soil_nodes`` (mesh nodes, the
+    #: bed's contact rows in order); 0 and None for Winkler's springs or no bed
+    n_soil: int = 0
+    soil_nodes: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def K_full(self) -> sp.csr_matrix:
@@ -124,7 +130,9 @@ class Model:
         return self.free.shape[0]
 
     def expand(self, u_free: np.ndarray) -> np.ndarray:
-        """Full dof vector (prescribed values in place, dofs off the plate zero)."""
+        """Full dof vector (prescribed values in place, dofs off the plate zero) of the plate's
+        free dofs ``u_free`` (the soil's unknowns after them, if any, left out)."""
+        u_free = u_free[:self.n_free]
         u = np.zeros(self.n_full if u_free.ndim == 1 else (self.n_full, u_free.shape[1]))
         u[self.free] = u_free
         u[self.fixed] = self.values if u_free.ndim == 1 else self.values[:, None]
@@ -146,9 +154,18 @@ class Model:
         return self.grid.tributary_areas(self.scene.foundation.region)
 
     def rigid_modes(self) -> np.ndarray:
-        """(n_free, k) basis of the rigid motions the two-sided supports leave free (k = 0..3 per
-        piece): :func:`plateqp.model.constraints.rigid_modes`."""
-        return rigid_modes(self)
+        """(n, k) basis of the rigid motions the two-sided supports leave free (k = 0..3 per
+        piece; n = K's size: the soil's unknowns, if any, do not move in them):
+        :func:`plateqp.model.constraints.rigid_modes`."""
+        modes = rigid_modes(self)
+        return np.vstack([modes, np.zeros((self.n_soil, modes.shape[1]))]) if self.n_soil else modes
+
+    @property
+    def dof_orders(self) -> np.ndarray:
+        """(n,) each unknown of K's derivative order: 0 a deflection (the soil's unknowns
+        too), 1 a slope, 2 a twist."""
+        orders = np.array([dx + dy for dx, dy in self.element.node_dofs])
+        return np.concatenate([orders[self.free % self.element.ndof_node], np.zeros(self.n_soil, dtype=orders.dtype)])
 
 
 def interpolation(mesh, element, cell_dofs: np.ndarray, n_full: int, x, y, dx: int = 0, dy: int = 0) -> sp.csr_matrix:
@@ -223,6 +240,10 @@ def build_model(scene: Scene) -> Model:
     model = Model(scene, mesh, el, K, f, free, fixed, values, n_full, cell_dofs, mesh.cell_ids, f_full, K_full,
                   symmetric=mesh.symmetric_assembly)
     model.contacts = _contacts(scene, model)
+    if couples(scene.foundation):
+        c = model.contacts
+        rows = np.flatnonzero(c.source == "bed")
+        attach(model, rows, c.index[rows], model.bed_areas()[c.index[rows]])
     return model
 
 
@@ -256,7 +277,7 @@ def _contacts(scene: Scene, model: Model) -> ContactOperator | None:
         blocks.append(sp.csr_matrix((np.ones(len(nodes)), (np.arange(len(nodes)), nodes * nd)),
                                     shape=(len(nodes), model.n_full)))
         g0.append(fnd.gap_at(pts[:, 0], pts[:, 1]))
-        rho.append(1.0 / (fnd.k * area[nodes]))
+        rho.append(np.zeros(len(nodes)) if couples(fnd) else 1.0 / (fnd.k * area[nodes]))  # coupled: soil dofs
         xy.append(pts)
         source += ["bed"] * len(nodes)
         index.append(nodes)

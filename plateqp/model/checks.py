@@ -202,7 +202,7 @@ def check_foundation(sc, grid) -> None:
     from .geometry import parse_region
 
     f = sc.foundation
-    sc._num("foundation.k", f.k, positive=True, physical=True)
+    check_soil_model(sc, f)
     if f.region is not None:
         shape = parse_region(f.region, "foundation.region", sc._fail)
         f.region = _scene_form(f.region, shape)
@@ -211,6 +211,34 @@ def check_foundation(sc, grid) -> None:
                      "no cell of it (it is off the plate, in an opening, or smaller than a cell): the bed would "
                      "have no node")
     check_gap(sc, f.gap)
+
+
+#: the soil models and the parameters each takes (all required)
+SOIL_MODELS = {"winkler": ("k",), "pasternak": ("k", "shear"), "halfspace": ("E", "nu")}
+
+
+def check_soil_model(sc, f) -> None:
+    """The soil model's name and its parameters: each one it takes present and physical
+    (``k`` > 0, ``shear`` ≥ 0, ``E`` > 0, −1 < ``nu`` ≤ 0.5), none it does not take."""
+    if f.model not in SOIL_MODELS:
+        sc._fail("foundation.model", f"unknown soil model {_short(f.model)}; choose one of {list(SOIL_MODELS)}")
+    takes = SOIL_MODELS[f.model]
+    for key in ("k", "shear", "E", "nu"):
+        v = getattr(f, key)
+        if key not in takes:
+            if v is not None:
+                users = [m for m, keys in SOIL_MODELS.items() if key in keys]
+                sc._fail(f"foundation.{key}", f"the {f.model} model does not take it (it is a parameter of "
+                         f"model = {' or '.join(repr(u) for u in users)})")
+            continue
+        if v is None:
+            sc._fail(f"foundation.{key}", f"missing: model = {f.model!r} needs {', '.join(takes)}")
+        if key == "nu":
+            nu = sc._num("foundation.nu", v)
+            if not -1.0 < nu <= 0.5:
+                sc._fail("foundation.nu", f"Poisson's ratio {nu:g} is outside (-1, 0.5]")
+        else:
+            sc._num(f"foundation.{key}", v, positive=key != "shear", nonneg=key == "shear", physical=True)
 
 
 def check_gap(sc, g) -> None:

@@ -164,18 +164,28 @@ class Support:
 
 @dataclass
 class Foundation:
-    """Tensionless elastic bed of modulus k (force/length³) over ``region`` (whole plate if None):
-    the box [x0, x1, y0, y1], ``{polygon = [[x, y], ...]}`` or ``{circle = [xc, yc, r]}``, on
-    every mesh (:func:`plateqp.model.geometry.parse_region`).
+    """Tensionless soil under the plate over ``region`` (whole plate if None): the box
+    [x0, x1, y0, y1], ``{polygon = [[x, y], ...]}`` or ``{circle = [xc, yc, r]}``, on every mesh
+    (:func:`plateqp.model.geometry.parse_region`). The soil never pulls the plate.
+
+    ``model``: ``"winkler"`` (the default): independent springs of modulus ``k``
+    (force/length³); ``"pasternak"``: springs ``k`` joined by a shear layer of ``shear`` (c2,
+    force/length), the soil's surface its own unknowns; ``"halfspace"``: an elastic half-space
+    of modulus ``E`` and Poisson's ratio ``nu`` (Boussinesq's surface flexibility), its surface
+    its own unknowns (:mod:`plateqp.model.soil`).
 
     ``gap``: a number, a dict profile (``{profile = "linear", g0, gx, gy}``,
     ``{profile = "trough" | "bump", x, y, radius, depth}``) or, in Python, any callable
     g0(x, y) taking and returning arrays.
     """
 
-    k: float
+    k: float | None = None
     region: list[float] | dict | None = None
     gap: float | dict | Callable = 0.0
+    model: str = "winkler"
+    shear: float | None = None
+    E: float | None = None
+    nu: float | None = None
 
     def gap_at(self, x, y):
         """The initial gap field g0 at points (arrays)."""
@@ -468,7 +478,10 @@ class Scene:
             f = self.foundation
             if callable(f.gap):
                 raise SceneError("foundation.gap: a Python callable cannot be saved to TOML; use a profile")
-            fd: dict[str, Any] = {"k": f.k, "gap": f.gap}
+            fd: dict[str, Any] = {"gap": f.gap}
+            if f.model != "winkler":
+                fd["model"] = f.model
+            fd.update({k: getattr(f, k) for k in ("k", "shear", "E", "nu") if getattr(f, k) is not None})
             if f.region is not None:
                 fd["region"] = dict(f.region) if isinstance(f.region, dict) else list(f.region)
             d["foundation"] = fd

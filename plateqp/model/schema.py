@@ -89,10 +89,15 @@ WORDS: dict[type, dict[str, tuple[str, str]]] = {
         "stiffness": ("F/L", "\"rigid\", or the spring stiffness c of an elastic support (R = c s)"),
     },
     S.Foundation: {
-        "k": ("F/L³", "modulus of the tensionless elastic bed (Winkler)"),
+        "k": ("F/L³", "winkler, pasternak: the modulus of the soil's springs (c1)"),
         "region": ("L", "where the bed lies: the whole plate if absent, a box [x0, x1, y0, y1], "
                         "{ polygon = [[x, y], ...] } or { circle = [xc, yc, r] }"),
         "gap": ("L", "initial gap g0 of the bed: a number, or a profile table (see nested keys)"),
+        "model": ("", "the soil: \"winkler\" (springs k; the default), \"pasternak\" (springs k and a shear "
+                      "layer shear) or \"halfspace\" (an elastic half-space E, nu); tensionless in every model"),
+        "shear": ("F/L", "pasternak: the shear layer's modulus c2 (0: Winkler's springs alone)"),
+        "E": ("F/L²", "halfspace: the soil's Young's modulus"),
+        "nu": ("1", "halfspace: the soil's Poisson's ratio, in (-1, 0.5]"),
     },
 }
 
