@@ -16,7 +16,8 @@ nondimensional variables of :class:`plateqp.contact.scaling.Scaled`). Parameters
   then foundation nodes), so ``sensitivity(result, "gaps")`` holds the (m, m) matrix
   dR_i/dg0_j. A gap g0 > 0 is settlement: settling a support unloads it (dR_j/dg0_j ≤ 0).
 - ``"stiffness"``: the stiffness c_j of every elastic discrete support (``supports.j.stiffness``),
-  then the bed modulus (``foundation.k``) if the scene has a foundation.
+  then the bed modulus (``foundation.k``) of a Winkler bed (a Pasternak or half-space soil holds
+  its parameters in K, not on its rows: not offered).
 - ``"loads"``: the factor λ of each entry of ``scene.loads`` (the load scaled by λ, at λ = 1),
   labelled ``loads.j``: the response to that load alone, d/dλ = q·d/dq.
 
@@ -347,7 +348,7 @@ def parameters(model, data: Scaled, R: np.ndarray, wrt: str):
                 cols.append(col)
                 labels.append(f"supports.{int(c.index[k]) + 1}.stiffness")
         bed = c.source == "bed"
-        if np.any(bed):
+        if np.any(bed) and not model.n_soil:  # a coupled soil's k is in K, not on its rows: not offered
             col = np.where(bed, -data.rho / scene.foundation.k, 0.0)  # ρ ∝ 1/k
             cols.append(col)
             labels.append("foundation.k")
@@ -359,7 +360,7 @@ def parameters(model, data: Scaled, R: np.ndarray, wrt: str):
             one = copy.copy(scene)  # the scene with this load alone (a shallow copy: nothing else changes)
             one.loads = [ld]
             f_full = model.load_vector(one)  # the load vector of one load alone (no stiffness assembly)
-            cols.append(data.dof_scale * f_full[model.free] / (data.F0 * data.W))
+            cols.append(data.dof_scale * model.on_unknowns(f_full) / (data.F0 * data.W))
         df = np.column_stack(cols) if cols else np.zeros((n, 0))
         p = df.shape[1]
         return [f"loads.{j}" for j in range(p)], df, np.zeros((m, p)), np.zeros((m, p))
@@ -380,7 +381,7 @@ def scaled_state(result) -> tuple[Scaled, np.ndarray, np.ndarray, np.ndarray]:
         warnings.warn("sensitivity: the result missed its asked accuracy; its contact set may be wrong",
                       PlateQPWarning, stacklevel=3)
     data = Scaled.from_model(model)
-    u = result.u[model.free] / data.dof_scale
+    u = model.unknowns(result.u, result.compressions) / data.dof_scale
     return data, u, np.asarray(result.reactions) / data.F0, np.asarray(result.gaps) / data.W
 
 
@@ -442,8 +443,10 @@ def _user(model, data: Scaled, d: Piece, unique: np.ndarray) -> Derivatives:
     the columns that are not ``unique``)."""
     du = data.dof_scale[:, None] * d.du
     u = np.zeros((model.n_full, du.shape[1]))
-    u[model.free] = du
+    u[model.free] = du[:model.n_free]
     w = data.W * np.asarray(data.B @ d.du)
+    if model.n_soil:  # B u = w − v on the bed's rows: the plate's deflection is w
+        w[model.contacts.source == "bed"] += data.W * d.du[model.n_free:]
     gaps = data.W * d.dgap
     for arr in (u, w, gaps):
         arr[:, ~unique] = np.nan

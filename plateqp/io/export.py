@@ -65,7 +65,7 @@ class ExportedQP:
         """
         d = self.data
         if self.formulation == "primal":
-            u = result.u[self.model.free] / d.dof_scale
+            u = self.model.unknowns(result.u, result.compressions) / d.dof_scale
             el = np.flatnonzero(d.rho > 0)
             return np.concatenate([u, np.sqrt(d.rho[el]) * result.reactions[el] / d.F0])
         if self.formulation == "condensed":

@@ -138,6 +138,18 @@ class Model:
         u[self.fixed] = self.values if u_free.ndim == 1 else self.values[:, None]
         return u
 
+    def unknowns(self, u_full: np.ndarray, compressions: np.ndarray | None = None) -> np.ndarray:
+        """K's unknowns at a result: the plate's free dofs of ``u_full``, then (a soil with its
+        own unknowns) the soil's settlements, a result's ``compressions`` on the bed's rows."""
+        u = u_full[self.free]
+        if not self.n_soil:
+            return u
+        return np.concatenate([u, np.asarray(compressions)[self.contacts.source == "bed"]])
+
+    def on_unknowns(self, v_full: np.ndarray) -> np.ndarray:
+        """A vector on every dof (a load) on K's unknowns: its free dofs, zeros for the soil's."""
+        return np.concatenate([v_full[self.free], np.zeros(self.n_soil)]) if self.n_soil else v_full[self.free]
+
     def load_vector(self, scene: Scene) -> np.ndarray:
         """The load vector (all dofs) of ``scene.loads`` on this model's mesh and element, without
         assembling the stiffness (a model re-used with new loads): :func:`load_vector`."""

@@ -210,3 +210,31 @@ def test_a_pasternak_bed_solves_alike_by_every_formulation_and_exact_backend():
             res = pq.solve(sc, backend=backend, formulation=form, accuracy=1e-10)
             assert res.status == pq.Status.OPTIMAL and res.kkt.ok, (backend, form)
             np.testing.assert_allclose(res.reactions, ref.reactions, rtol=0, atol=1e-7 * scale)
+
+
+def test_sensitivities_on_a_pasternak_bed_are_the_finite_differences_of_the_solves():
+    """dR/dg0 and the load factor's derivative (plateqp.sensitivity) against finite differences
+    of two exact solves (another computation of the same derivative); the plate's deflection
+    derivative is the plate's, not the gap to the soil. The soil's own parameters are in K, not
+    on its rows: ``foundation.k`` is not among the stiffness parameters."""
+
+    def scene(g0=0.0, q=2e4):
+        return pq.Scene(plate=pq.Plate(a=2.0, b=1.5, h=0.15, E=E, nu=NU), mesh=pq.MeshSpec(nx=10, ny=8),
+                        edges={"left": "simple", "right": "simple"}, loads=[pq.UniformLoad(q)],
+                        foundation=pq.Foundation(k=3e7, model="pasternak", shear=2e6,
+                                                 gap={"profile": "linear", "g0": -5e-4 + g0, "gx": 3e-4}))
+
+    res = pq.solve(scene(), backend="bpp", formulation="condensed", accuracy=1e-12)
+    assert 0 < (~res.active).sum()
+    d = 1e-8
+    moved = pq.solve(scene(g0=d), backend="bpp", formulation="condensed", accuracy=1e-12)
+    s = pq.sensitivity(res, "gaps")
+    fd = (moved.reactions - res.reactions) / d
+    np.testing.assert_allclose(np.asarray(s).sum(axis=1), fd, rtol=0, atol=1e-6 * np.abs(fd).max())
+    xy = res.model.contacts.xy
+    dw = (moved.at(xy[:, 0], xy[:, 1]) - res.at(xy[:, 0], xy[:, 1])) / d
+    np.testing.assert_allclose(s.deflections.sum(axis=1), dw, rtol=0, atol=1e-6 * np.abs(dw).max())
+    heavier = pq.solve(scene(q=2e4 + 1.0), backend="bpp", formulation="condensed", accuracy=1e-12)
+    sl = np.asarray(pq.sensitivity(res, "loads"))[:, 0]
+    np.testing.assert_allclose((heavier.reactions - res.reactions) * 2e4, sl, rtol=0, atol=1e-6 * np.abs(sl).max())
+    assert pq.sensitivity(res, "stiffness").labels == []
