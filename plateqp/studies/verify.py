@@ -16,7 +16,9 @@ Timoshenko & Woinowsky-Krieger, *Theory of plates and shells* (1959): Navier's d
 (§ 28, § 34), the circular plate (§§ 15-19) and the annulus (§ 62's general axisymmetric
 solution), the clamped square (Table 35, 0.00126 q a⁴/D; to more digits 0.0012653, Taylor and
 Govindjee, 2004), the plate on an elastic foundation under a point load (§ 57, Hertz:
-w₀ = P / (8 √(k D)), w(r) = −P ℓ² kei(r/ℓ) / (2π D), ℓ = (D/k)^¼).
+w₀ = P / (8 √(k D)), w(r) = −P ℓ² kei(r/ℓ) / (2π D), ℓ = (D/k)^¼); the plate on a two-parameter
+foundation (Kerr, "Elastic and viscoelastic foundation models", J. Appl. Mech. 31, 1964;
+Selvadurai, *Elastic analysis of soil-foundation interaction*, 1979, ch. 5).
 """
 
 from __future__ import annotations
@@ -84,6 +86,20 @@ def hertz_bed(r: float, P: float, k: float, D: float) -> float:
 
     ell = (D / k) ** 0.25
     return float(-P * ell**2 * kei(r / ell) / (2 * math.pi * D))
+
+
+def kerr_bed(r: float, P: float, k: float, c2: float, D: float) -> float:
+    """w of an infinite plate on a two-parameter (Pasternak) foundation, springs k and shear
+    layer c2, under a point load P, at distance r (Kerr 1964; Selvadurai 1979, ch. 5): with
+    ξ⁴ + (c2/D) ξ² + k/D = (ξ² + a1)(ξ² + a2), w = P [K0(√a2 r) − K0(√a1 r)] / (2π D (a1 − a2))
+    (modified Bessel functions of complex argument; c2 = 0: Hertz's :func:`hertz_bed`)."""
+    from scipy.special import kv
+
+    b, c = c2 / D, k / D
+    disc = complex(b * b - 4 * c) ** 0.5
+    a1, a2 = (b + disc) / 2, (b - disc) / 2
+    r = max(r, 1e-12)
+    return float((P * (kv(0, a2**0.5 * r) - kv(0, a1**0.5 * r)) / (2 * math.pi * D * (a1 - a2))).real)
 
 
 # -- the cases ----------------------------------------------------------------------------------
@@ -220,6 +236,12 @@ def cases() -> list[Case]:
              lambda n: 1.0 / n, lambda n: f"DKT R/{n}", lambda r: r.deflection(0.2, 0.0),
              lambda: hertz_bed(0.2, 1.0, k_bed, D), 0.01, solve="bilateral", **_LEVELS_TRI),  # the disc is
         # finite (R = 6.7 ℓ), the reference the infinite plate's: the error levels off near 2e-4
+        Case("bonded-pasternak-kerr", "free disc on a two-sided Pasternak bed (c2 = √(kD)), central P: w at r = 0.2",
+             "P [K0(√a2 r) − K0(√a1 r)] / (2π D (a1 − a2)) (Kerr 1964; Selvadurai 1979, ch. 5)",
+             lambda n: _disc(n, None, PointLoad(1.0, 0.0, 0.0),
+                             foundation=Foundation(k=k_bed, model="pasternak", shear=math.sqrt(k_bed * D))),
+             lambda n: 1.0 / n, lambda n: f"DKT R/{n}", lambda r: r.deflection(0.2, 0.0),
+             lambda: kerr_bed(0.2, 1.0, k_bed, math.sqrt(k_bed * D), D), 0.01, solve="bilateral", **_LEVELS_TRI),
         Case("bed-uniform-sinks", "free disc on a tensionless bed, uniform q: w at r = 0.5",
              "q / k: a rigid translation, no bending (exact for lumped loads and springs on one area)",
              lambda n: _disc(n, None, UniformLoad(2.0), foundation=Foundation(k=100.0)),
