@@ -22,8 +22,9 @@ point load P = 100 at (0.7, 0.6): four supports carry it, five lift off):
   w_free as a body (R of the zero-gap plate); net uplift (no equilibrium).
 - near: two supports either side of the centre, d apart, by symmetry carrying equal shares:
   rigid at 1e-1, 1e-3 and 1e-4 of a cell (solved; the condensed form refuses at 1e-4), rigid at
-  1e-8 of a cell (refused by design: the split is decided by rounding), elastic at 1e-8 of a
-  cell (springs decide the split: solved by the primal and the dual).
+  1e-7 of a cell (refused by design: the split is decided by rounding), elastic at 1e-7 of a
+  cell (springs decide the split: solved by the primal and the dual). (Closer than 1e-9 of the
+  plate's size two supports are one point, which the scene itself refuses.)
 - mesh: the grid scene at 64², 128², 256².
 
 References: two independent exact solvers that must agree (Lemke on the condensed LCP and PDAS
@@ -193,10 +194,10 @@ def _cases() -> list[Case]:
         Case("near-rigid-1e-1", "near", lambda: pair(1e-1), "exact", note="rigid pair 0.1 cell apart"),
         Case("near-rigid-1e-3", "near", lambda: pair(1e-3), "exact", note="rigid pair 1e-3 cell apart"),
         Case("near-rigid-1e-4", "near", lambda: pair(1e-4), "exact-held", note="rigid pair 1e-4 cell apart"),
-        Case("near-rigid-1e-8", "near", lambda: pair(1e-8), "none", "refused",
-             note="rigid pair 1e-8 cell apart: refused by design"),
-        Case("near-elastic-1e-8", "near", lambda: pair(1e-8, stiffness=1e3), "exact-dual",
-             note="elastic pair (c a²/D = 1e3) 1e-8 cell apart"),
+        Case("near-rigid-1e-7", "near", lambda: pair(1e-7), "none", "refused",
+             note="rigid pair 1e-7 cell apart: refused by design"),
+        Case("near-elastic-1e-7", "near", lambda: pair(1e-7, stiffness=1e3), "exact-dual",
+             note="elastic pair (c a²/D = 1e3) 1e-7 cell apart"),
     ]
     for n in (64, 128, 256):
         cs.append(Case(f"mesh-{n}", "mesh", (lambda n=n: grid(n)), "exact", note=f"{n}² mesh",
