@@ -213,8 +213,10 @@ def extremes_section(df, figdir):
     d = df[["case", "group", "backend", "formulation", "outcome", "error", "kkt_worst", "time_s"]]
     counts = df.pivot_table(index="backend", columns="outcome", values="case",
                             aggfunc="count", fill_value=0).reset_index()
-    return "Outcomes per backend:\n\n" + table(counts) + "\n\n<details><summary>Every row</summary>\n\n" \
-        + table(d) + "\n\n</details>"
+    bad = d[d["outcome"].isin(["wrong-claimed", "crash", "timeout"])]
+    rows = ("Runs whose outcome is wrong-claimed, a crash or a timeout (every run: the data file):\n\n"
+            + table(bad)) if len(bad) else "No run is wrong-claimed, crashed or timed out (every run: the data file)."
+    return "Outcomes per backend:\n\n" + table(counts) + "\n\n" + rows
 
 
 def tri_section(df, figdir):
