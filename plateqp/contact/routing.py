@@ -54,6 +54,10 @@ from .scaling import Scaled
 #   case measured is Clarabel at 7.9 %, 1.5× its primal. (The 1 % before was measured while
 #   condensation took m refined column solves.)
 # * a backend that takes only one of them (lemke, bpp, pgs: LCPs; pdas: the primal) gets it.
+# * an elastic half-space under the plate (plateqp.model.soil): its soil block of K is dense
+#   (m² numbers) already, so the condensed problem costs no more than the primal, at any m the
+#   dense route takes; its exact LCP solvers answer where PDAS's penalised rows meet a soil
+#   block 1e9 times softer than the plate's diagonal (a 16-triangle-a-side rigid punch).
 AUTO_LCP_MAX = 100
 AUTO_CONDENSED_FRACTION = 0.10
 AUTO_CONDENSED_MAX = 1000
@@ -80,6 +84,8 @@ def condensed_pays(data: Scaled, backend: str = "auto") -> bool:
     never; a named QP backend: m ≤ AUTO_CONDENSED_FRACTION × free dofs and m ≤
     AUTO_CONDENSED_MAX.
     """
+    if data.soil == "halfspace":  # its soil block is dense already: the condensed problem costs no more
+        return True
     if backend == "auto":
         return data.m <= AUTO_LCP_MAX and _REPEATED[0] > 0
     return data.m <= min(AUTO_CONDENSED_MAX, AUTO_CONDENSED_FRACTION * data.n)
@@ -126,7 +132,7 @@ def fallback_routes(data: Scaled, first: str) -> list[tuple[str, str]]:
     on the dual one. The condensed and dual problems are dense (m² numbers, m³ work), so they
     are offered while m ≤ AUTO_CONDENSED_MAX."""
     forms = ["primal"]
-    if data.m <= AUTO_CONDENSED_MAX:
+    if data.m <= AUTO_CONDENSED_MAX or data.soil == "halfspace":
         forms += ["condensed"] + ([] if data.floating else ["dual"])
     return [(b, f) for f in forms for b in exact_backends(f, data) if f"{b}/{f}" != first]
 

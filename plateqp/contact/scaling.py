@@ -57,6 +57,8 @@ class Scaled:
     # each contact point's distance to the nearest other held point (another contact point, or
     # a node whose w is prescribed), in units of L: bounds the plate's local stiffness there
     spacing: np.ndarray | None = field(default=None, repr=False, compare=False)
+    #: the soil whose surface has unknowns of its own among K's ("pasternak", "halfspace"), or None
+    soil: str | None = None
 
     @classmethod
     def from_model(cls, model: Model) -> Scaled:
@@ -83,6 +85,8 @@ class Scaled:
             modes = modes / np.linalg.norm(modes, axis=0)
         data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, order == 0, model.K, c.B,
                    w_load=W_load / W, spacing=contact_spacing(model) / L, derived=model.derived)
+        if model.n_soil:
+            data.soil = model.scene.foundation.model
         check_distinct_contacts(data, model)
         return data
 

@@ -29,7 +29,7 @@ from ..errors import SceneError
 from .generators import mesh_generator
 from .memory import check_memory
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
-from .soil import attach, couples
+from .soil import attach, couples, halfspace_areas
 
 if TYPE_CHECKING:  # pragma: no cover
     from .elements import DKT
@@ -162,8 +162,12 @@ class Model:
 
     def bed_areas(self) -> np.ndarray:
         """(n_nodes,) each node's tributary area of the scene's tensionless bed (its region, the
-        whole plate without one), by the mesh's rule (``mesh.tributary_areas``)."""
-        return self.grid.tributary_areas(self.scene.foundation.region)
+        whole plate without one), by the mesh's rule (``mesh.tributary_areas``); for a half-space
+        the areas its nodes press the soil over (:func:`plateqp.model.soil.halfspace_areas`)."""
+        fnd = self.scene.foundation
+        if fnd.model == "halfspace":
+            return halfspace_areas(self.grid, fnd.region)
+        return self.grid.tributary_areas(fnd.region)
 
     def rigid_modes(self) -> np.ndarray:
         """(n, k) basis of the rigid motions the two-sided supports leave free (k = 0..3 per

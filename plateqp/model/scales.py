@@ -33,11 +33,17 @@ def _load_force_log(scene, ld) -> float:
     return math.log10(abs(ld.q)) + math.log10(area)
 
 
-def bed_spring(scene) -> float:
-    """About the largest node spring of the scene's bed: k × h², h the element size."""
+def bed_springs(scene) -> list[tuple[str, float]]:
+    """About the largest node springs of the scene's soil, h the element size: Winkler's and
+    Pasternak's k × h² (and the shear layer's c2), a half-space's E h / (1 − ν²) (a cell's
+    stiffness on it)."""
     from .geometry import mesh_size
 
-    return scene.foundation.k * mesh_size(scene) ** 2
+    f = scene.foundation
+    h = mesh_size(scene)
+    if f.model == "halfspace":
+        return [("foundation.E", f.E * h / (1.0 - f.nu**2))]
+    return [("foundation.k", f.k * h**2)] + ([("foundation.shear", f.shear)] if f.shear else [])
 
 
 def check_scales(scene, derived: tuple[float, float]) -> None:
@@ -58,7 +64,7 @@ def check_scales(scene, derived: tuple[float, float]) -> None:
                         f"{derived[0]:.0e} … {derived[1]:.0e}; change units")
     springs = [(f"supports.{i + 1}.stiffness", s.stiffness) for i, s in enumerate(scene.supports) if not s.rigid]
     if scene.foundation is not None:
-        springs.append(("foundation.k", bed_spring(scene)))
+        springs += bed_springs(scene)
     for where, c in springs:
         logr = logD - math.log10(c) - 2 * logL
         if not lo <= logr <= hi:

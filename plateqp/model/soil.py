@@ -143,10 +143,71 @@ def soil_stiffness(model, nodes: np.ndarray, area: np.ndarray) -> sp.csr_matrix:
     return halfspace_stiffness(model, nodes)
 
 
+def pressure_cells(mesh, region) -> tuple[np.ndarray, np.ndarray]:
+    """(owner, polygons): the bed's cells cut into one polygon per corner, each the part of its
+    cell nearest that corner (the corner, the midpoints of its two edges and the cell's centre:
+    a quarter of a parallelogram, a median-dual third of a triangle), ``owner`` the corner's mesh
+    node (the numbering of the dofs), ``polygons`` (n, 4, 2) counter-clockwise."""
+    cells = region_cells(mesh, region)
+    xy = mesh.nodes[mesh.cells[cells]]  # (nc, k, 2)
+    k = xy.shape[1]
+    centre = xy.mean(axis=1)
+    nxt, prv = np.roll(xy, -1, axis=1), np.roll(xy, 1, axis=1)
+    polys = np.stack([xy, 0.5 * (xy + nxt), np.repeat(centre[:, None], k, axis=1), 0.5 * (xy + prv)], axis=2)
+    owner = mesh.plate_node_ids[mesh.cells[cells]]
+    return owner.ravel(), polys.reshape(-1, 4, 2)
+
+
+def polygon_areas(polys: np.ndarray) -> np.ndarray:
+    """(n,) the areas of polygons (n, k, 2) counter-clockwise (the shoelace formula)."""
+    x, y = polys[..., 0], polys[..., 1]
+    return 0.5 * (x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y).sum(axis=1)
+
+
+def halfspace_areas(mesh, region) -> np.ndarray:
+    """(n_nodes,) each node's share of the bed's cells (:func:`pressure_cells`): the areas over
+    which a half-space bed's nodes press the soil."""
+    owner, polys = pressure_cells(mesh, region)
+    return np.bincount(owner, weights=polygon_areas(polys), minlength=mesh.n_nodes)
+
+
+def halfspace_flexibility(model, nodes: np.ndarray) -> np.ndarray:
+    """(m, m) H_F: the soil's settlement at bed node i per unit force spread uniformly over node
+    j's pressure cells (Boussinesq's solution integrated exactly over each polygon,
+    :func:`plateqp.model.halfspace.potential`), symmetrised."""
+    from .halfspace import potential
+
+    fnd = model.scene.foundation
+    mesh = model.grid
+    m = nodes.size
+    if m > HALFSPACE_DENSE_MAX:
+        raise ProblemError(f"foundation: a half-space under {m} bed nodes needs a dense {m} x {m} flexibility "
+                           f"({3 * 8 * m * m / 1e9:.1f} GB with its inverse); this route takes at most "
+                           f"{HALFSPACE_DENSE_MAX} nodes: use a coarser mesh or a smaller region")
+    pos = np.full(mesh.n_nodes, -1)
+    pos[nodes] = np.arange(m)
+    owner, polys = pressure_cells(mesh, fnd.region)
+    col = pos[owner]
+    keep = col >= 0  # a node whose deflection is prescribed presses no soil here
+    col, polys = col[keep], polys[keep]
+    area = np.bincount(col, weights=polygon_areas(polys), minlength=m)
+    pts = mesh.node_xy()[nodes]
+    H = np.zeros((m, m))
+    for j, poly in zip(col.tolist(), polys):
+        H[:, j] += potential(pts[:, 0], pts[:, 1], poly)
+    H *= (1.0 - fnd.nu**2) / (np.pi * fnd.E) / area[None, :]
+    return 0.5 * (H + H.T)
+
+
 def halfspace_stiffness(model, nodes: np.ndarray) -> sp.csr_matrix:
-    """K_s = H_F⁻¹ (the module's text), dense, stored as a CSR matrix; a ProblemError above
-    :data:`HALFSPACE_DENSE_MAX` bed nodes."""
-    raise ProblemError("foundation.model = \"halfspace\" is not available yet")
+    """K_s = H_F⁻¹ (the module's text; :func:`halfspace_flexibility`), dense, stored as a CSR
+    matrix, exactly symmetric."""
+    import scipy.linalg as sla
+
+    H = halfspace_flexibility(model, nodes)
+    c, low = sla.cho_factor(H)
+    Ks = sla.cho_solve((c, low), np.eye(H.shape[0]))
+    return sp.csr_matrix(0.5 * (Ks + Ks.T))
 
 
 def attach(model, bed_rows: np.ndarray, nodes: np.ndarray, area: np.ndarray) -> None:
