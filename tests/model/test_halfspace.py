@@ -245,6 +245,38 @@ def test_the_fft_operator_is_symmetric_as_the_dense_matrix():
     assert u @ (op @ v) == pytest.approx(v @ (op @ u), rel=1e-12)
 
 
+def test_the_fft_operator_takes_a_flat_mask_and_column_vectors(dense):
+    mask = np.arange(NX * NY) % 4 != 1
+    op = GridFlexibility(NX, NY, HX, HY, E, NU, mask=mask)
+    p = np.linspace(1, 2, mask.sum())[:, None]
+    w = op @ p
+    assert w.shape == p.shape
+    assert np.abs(w - dense[np.ix_(mask, mask)] @ p).max() <= 1e-12 * np.abs(w).max()
+
+
+def test_a_rigid_disc_pressed_through_the_fft_operator_carries_boussinesqs_force():
+    """A rigid flat punch of radius a settled by δ carries P = 2 a δ E/(1 − ν²) (Boussinesq;
+    Johnson, Contact Mechanics, § 3.2): the operator solved by conjugate gradients for a uniform
+    settlement over the cells of a staircase disc (radius of equal area) converges to it as O(h)."""
+    from scipy.sparse.linalg import cg
+
+    err = []
+    ns = np.array([16, 32, 64])
+    for m in ns:
+        h = 2.0 / m
+        c = (np.arange(m) + 0.5) * h - 1.0
+        X, Y = np.meshgrid(c, c)
+        mask = X**2 + Y**2 < 1.0
+        op = GridFlexibility(m, m, h, h, E, NU, mask=mask)
+        p, info = cg(op, np.ones(op.shape[0]), rtol=1e-10, maxiter=1000)
+        assert info == 0
+        a = math.sqrt(mask.sum() * h * h / math.pi)
+        err.append(abs(p.sum() * h * h / (2 * a * E / (1 - NU**2)) - 1))
+    slope = np.polyfit(np.log(1.0 / ns), np.log(err), 1)[0]
+    assert 0.85 < slope < 1.15, (slope, err)
+    assert err[-1] < 0.005
+
+
 # -- bad input -------------------------------------------------------------------------------------------
 
 SQUARE = box(0, 1, 0, 1)
@@ -262,6 +294,7 @@ BAD = [
     ("touching", lambda: polygon_potential(0.0, 0.0, [[0, 0], [2, 0], [2, 2], [1, 0.0], [0, 2]]),
      "self-intersecting"),
     ("folded", lambda: polygon_potential(0.0, 0.0, [[0, 0], [2, 0], [1, 0], [1, 1]]), "self-intersecting"),
+    ("star-crossing", lambda: polygon_potential(0.0, 0.0, ngon(41, 1.0)[np.arange(41) * 2 % 41]), "self-intersecting"),
     ("nan-vertex", lambda: polygon_potential(0.0, 0.0, [[0, 0], [1, np.nan], [1, 1]]), "polygon"),
     ("bad-cell", lambda: flexibility([[0, 0], [3, 3]], [SQUARE, [[0, 0], [1, 1], [1, 0], [0, 1]]], E, NU),
      "cells[1]"),
