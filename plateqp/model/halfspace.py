@@ -140,7 +140,7 @@ def _segments_meet(p1, p2, p3, p4, tol):
 
 def _check_polygons(polys: np.ndarray, names: list[str]) -> np.ndarray:
     """ProblemError naming the first bad polygon of ``polys`` (c, k, 2) unless each is simple, with
-    k ≥ 3 finite vertices, no zero-length edge and an area; their orientations (+1 ccw, −1 cw)."""
+    k ≥ 3 finite vertices, no zero-length edge and an area; their signed areas (> 0 ccw, < 0 cw)."""
     c, k = polys.shape[:2]
     if k < 3:
         _fail(names[0], f"a polygon needs at least 3 vertices, got {k}")
@@ -178,7 +178,7 @@ def _check_polygons(polys: np.ndarray, names: list[str]) -> np.ndarray:
     if fold.any():
         j, e = np.unravel_index(int(np.argmax(fold)), fold.shape)
         _fail(names[j], f"self-intersecting: edges {e} and {(e + 1) % k} fold back onto each other")
-    return np.sign(area2)
+    return 0.5 * area2
 
 
 def _as_polygon(polygon, name: str) -> np.ndarray:
@@ -217,7 +217,7 @@ def polygon_potential(x, y, polygon) -> np.ndarray:
         coordinates that are not finite.
     """
     poly = _as_polygon(polygon, "polygon")
-    sign = _check_polygons(poly[None], ["polygon"])[0]
+    sign = np.sign(_check_polygons(poly[None], ["polygon"])[0])
     px, py = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     if not (np.isfinite(px).all() and np.isfinite(py).all()):
         raise ProblemError("x, y: the points' coordinates must be finite numbers")
@@ -275,7 +275,7 @@ def _points(points) -> np.ndarray:
 
 def _cell_groups(cells, m: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """The cells checked and grouped by their number of vertices: [(column indices, (c, k, 2)
-    vertices, orientations)]."""
+    vertices, signed areas)]."""
     if isinstance(cells, np.ndarray) and cells.ndim == 3:
         polys = [cells.astype(float)] if cells.shape[-1] == 2 else None
         ids = [np.arange(len(cells))]
@@ -318,10 +318,10 @@ def flexibility(points, cells, E: float, nu: float, *, per: str = "pressure",
     Returns
     -------
     ndarray, shape (m, m)
-        H, settlement positive downward under pressures positive downward. On equal cells with
-        their points at the same place in each (a grid's centres) H is symmetric and positive
-        definite; on unequal cells reciprocity holds in forces to the cells' second moments,
-        H[i, j] A_j − H[j, i] A_i = O(h² / r³).
+        H, settlement positive downward under pressures positive downward. On equal cells each
+        symmetric about its point (a grid's rectangles and their centres) H is symmetric (and, on
+        the grids of the tests, positive definite: observed, not proven); otherwise reciprocity
+        holds in forces to the cells' second moments, H[i, j] A_j − H[j, i] A_i = O(A h² / r³).
 
     Raises
     ------
@@ -336,11 +336,8 @@ def flexibility(points, cells, E: float, nu: float, *, per: str = "pressure",
         raise ProblemError(f"points: a dense flexibility of m = {m} cells needs {8 * m * m} bytes, above the limit "
                            f"of {max_bytes} bytes (max_bytes); on a grid use GridFlexibility")
     H = np.empty((m, m))
-    for idx, polys, sign in _cell_groups(cells, m):
-        scale = factor * sign
-        if per == "force":
-            v = polys - polys[:, :1]
-            scale = scale / np.abs(0.5 * np.einsum("cki,cki->c", v, np.roll(v, -1, axis=1)[..., ::-1] * [1.0, -1.0]))
+    for idx, polys, area in _cell_groups(cells, m):
+        scale = factor * np.sign(area) / (np.abs(area) if per == "force" else 1.0)
         rows = max(1, BLOCK // len(idx))
         for r0 in range(0, m, rows):
             px, py = pts[r0:r0 + rows, :1], pts[r0:r0 + rows, 1:]
@@ -368,6 +365,15 @@ def grid_kernel(nx: int, ny: int, hx: float, hy: float, E: float, nu: float, *,
                 per: str = "pressure") -> np.ndarray:
     """The flexibility of a grid of nx × ny equal cells hx × hy with their points at the centres,
     by index differences.
+
+    Parameters
+    ----------
+    nx, ny : int
+        The number of cells along x and along y (≥ 1).
+    hx, hy : float
+        The cells' sides (> 0).
+    E, nu, per
+        As :func:`flexibility`.
 
     Returns
     -------
