@@ -208,10 +208,13 @@ def close_pairs_error(data: Scaled, R, gap, rscale: float, delta: float, tol: fl
     0 where there is no such pair, or where that contact set does not hold the plate."""
     if data.m < 2:
         return 0.0
-    B = data.B.tocsr()
-    G = (B @ B.T).tocoo()
-    nrm = np.sqrt(np.maximum(G.diagonal(), 1e-300))
-    kb = np.maximum(row_stiffness(data.K, B, "diagonal"), 1e-300)
+    memo = data.memo if data.memo is not None else {}
+    if "rows_gram" not in memo:  # K and B alone: once per sweep
+        B = data.B.tocsr()
+        G = (B @ B.T).tocoo()
+        memo["rows_gram"] = (B, G, np.sqrt(np.maximum(G.diagonal(), 1e-300)),
+                             np.maximum(row_stiffness(data.K, B, "diagonal"), 1e-300))
+    B, G, nrm, kb = memo["rows_gram"]
     on = (R > tol * rscale) | (np.abs(gap) <= tol * delta)
     i, j = G.row, G.col
     cos = G.data / (nrm[i] * nrm[j])
@@ -253,8 +256,13 @@ def local_stiffness(data: Scaled) -> np.ndarray:
 
 
 def plate_stiffness(data: Scaled) -> np.ndarray:
-    """The plate's own part of :func:`local_stiffness` (without the supports' springs)."""
+    """The plate's own part of :func:`local_stiffness` (without the supports' springs); K, B and
+    the spacings alone, so in a sweep (``data.memo``) computed once."""
+    if data.memo is not None and "plate_stiffness" in data.memo:
+        return data.memo["plate_stiffness"]
     kb = row_stiffness(data.K, data.B, "rayleigh")
     if data.spacing is not None:
         kb = np.minimum(kb, CIRCLE / np.maximum(data.spacing, 1e-300) ** 2)
+    if data.memo is not None:
+        data.memo["plate_stiffness"] = kb
     return kb

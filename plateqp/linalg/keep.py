@@ -53,9 +53,11 @@ def kept() -> list | None:
 
 
 def remember(store: list, entry) -> None:
-    """Keep ``entry`` in ``store``, the oldest dropped past :data:`KEEP`."""
+    """Keep ``entry`` in ``store``, the oldest of its type dropped past :data:`KEEP` (a backend
+    keeps things of several types: a factorisation, the problem read from the QP)."""
     store.append(entry)
-    del store[:-KEEP]
+    drop = {id(e) for e in [e for e in store if type(e) is type(entry)][:-KEEP]}
+    store[:] = [e for e in store if id(e) not in drop]
 
 
 __all__ = ["KEEP", "keeping", "kept", "remember", "shared", "sharing"]

@@ -145,6 +145,25 @@ def _spring_factor(pb: ReducedQP, sigma: float, method: str) -> tuple[SpringFact
     return fac, _KeptSprings(fac, pb.Kd.copy(), pb.B.copy(), np.array(pb.c, copy=True), sigma, method)
 
 
+def _reduced(qp: QP, max_rows) -> ReducedQP:
+    """``ReducedQP(qp, max_rows)``, or where the caller lent a list of kept factorisations
+    (:func:`plateqp.linalg.keep.kept`: a sweep) and a solve before read the same Hessian, that
+    problem with this QP's loads, gaps and springs (:meth:`.reduced.ReducedQP.again`)."""
+    store = kept()
+    if store is not None:
+        for entry in list(store):
+            if isinstance(entry, ReducedQP):
+                pb = entry.again(qp, max_rows)
+                if pb is not None:
+                    store[:] = [e for e in store if e is not entry]
+                    remember(store, pb)
+                    return pb
+    pb = ReducedQP(qp, max_rows)
+    if store is not None:
+        remember(store, pb)
+    return pb
+
+
 def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: int, steps, sigma: float):
     """``((A, sets, seconds, how its first set was found), its SchurFactor)``: the anchored
     plate's contact set (:func:`.dense.anchored_set`), a first set for a floating plate, and
@@ -229,7 +248,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     if not isinstance(trace, (bool, np.bool_)):
         raise ProblemError(f"option trace must be True or False, got {trace!r}")
 
-    pb = ReducedQP(qp, max_rows)
+    pb = _reduced(qp, max_rows)
     m = pb.m
     if max_dense == "auto":
         max_dense = auto_max_dense(pb.K.shape[0], soft=bool(np.all(pb.rho * pb.k >= 1.0)))
