@@ -35,14 +35,16 @@ def is_value_leaf(path: str) -> bool:
     return isinstance(path, str) and VALUE_LEAF.match(path) is not None
 
 
-def with_value(scene: Scene, path: str, value) -> Scene:
+def with_value(scene: Scene, path: str, value, checked: bool = False) -> Scene:
     """:func:`plateqp.model.paths.set_param`'s answer (a validated scene with PATH = value, the
     scene given unchanged), the same scene field for field; for a value leaf made by copying only
     the containers on the PATH and checking only the changed field, the rest shared with
-    ``scene`` (checked here once: :meth:`Scene.revalidate`). Raises the same SceneError."""
+    ``scene`` (checked here: :meth:`Scene.revalidate`; ``checked``: the caller validated it since
+    its last change, as a sweep's :func:`check_values` did). Raises the same SceneError."""
     if not is_value_leaf(path):
         return set_param(scene, path, value)
-    scene.revalidate()
+    if not checked:
+        scene.revalidate()
     new = _made(scene, path, value)
     new._checked = new._fingerprint()
     return new

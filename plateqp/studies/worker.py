@@ -96,7 +96,8 @@ def solve_value(ctx: Context, value, warm=None):
 
     t0 = time.perf_counter()
     try:
-        scene = with_value(ctx.scene, ctx.path, value)  # only what the value changes copied and checked
+        # only what the value changes copied and checked (the sweep checked its scene: check_values)
+        scene = with_value(ctx.scene, ctx.path, value, checked=True)
         t_scene = time.perf_counter() - t0
         model = base = None
         if ctx.reuse:
@@ -127,7 +128,7 @@ def solve_value(ctx: Context, value, warm=None):
         times["total"] = t1 - t0
         times.update(scene=t_scene, formulate=res.times.get("formulate"), recover=res.times.get("recover"),
                      post=t1 - t_post)
-        active = tuple(bool(a) for a in res.active)
+        active = tuple(np.asarray(res.active, dtype=bool).tolist())
         state = np.asarray(res.extras.get("active", res.active), dtype=bool).copy()
         return row, active, (res.backend, state)
     except Exception as exn:  # never lose a sweep to one value: record it and go on

@@ -77,14 +77,17 @@ class _Kept:
 
     def again(self, pb: ReducedQP) -> DenseDual:
         """The kept DenseDual for this solve's flexibilities, gaps and loads: its M's diagonal
-        moved to the new ρ, ``d = g − B K⁻¹ f`` from the kept factor (half a solve)."""
+        moved to the new ρ, ``d = g − B K⁻¹ f`` from the kept factor (half a solve, none where the
+        load is the last solve's: its first half ``yf`` is kept)."""
         cond = self.cond
         diag = np.diag_indices(pb.m)
         cond.M[diag] += pb.rho - self.rho
         self.rho = pb.rho.copy()
+        same_load = cond.yf is not None and np.array_equal(pb.f, cond.pb.f)  # a gap or spring sweep
         cond.pb, cond._chol, cond.first, cond._dense_s = pb, None, {}, 0.0
         cond.Bc = pb.B[:, cond.fac.last].tocsr()
-        cond.yf = cond._forward(pb.f)
+        if not same_load:
+            cond.yf = cond._forward(pb.f)
         cond.d = pb.g - cond.Bc @ cond._tail(cond.yf)
         return cond
 

@@ -108,6 +108,15 @@ class ReducedQP:
         self.P, self.q = P, qp.q
         self._null, self._null_checked = qp.null, False
         self._src = (qp.P, qp.G, G, max_rows, qp.null)  # what :meth:`again` compares
+        self._abs_K = None  # |K|, kept where the problem is read again (:meth:`abs_K_times`)
+
+    def abs_K_times(self, x: np.ndarray) -> np.ndarray:
+        """``|K| x``: by blocks of K (:func:`plateqp.linalg.pattern.abs_matvec`, no copy of K),
+        or where this problem was read again for another solve (:meth:`again`: a sweep) with
+        ``|K|`` kept (its values only; K's index arrays shared)."""
+        if self._abs_K is None:
+            return abs_matvec(self.K, x)
+        return self._abs_K @ x
 
     def again(self, qp: QP, max_rows: int | None) -> ReducedQP | None:
         """This problem for ``qp`` where only its loads and gaps (``q``, ``h``) and the values of
@@ -121,6 +130,10 @@ class ReducedQP:
         if (qp.null is None) != (null0 is None) or (qp.null is not None and not np.array_equal(qp.null, null0)):
             return None
         new = copy.copy(self)
+        if new._abs_K is None:
+            K = self.K
+            new._abs_K = sp.csc_matrix((np.abs(K.data[:K.indptr[-1]]), K.indices[:K.indptr[-1]], K.indptr),
+                                       shape=K.shape, copy=False)
         if qp.G is not G0:
             G = sp.csc_matrix(qp.G, dtype=float)
             G.eliminate_zeros()
@@ -209,7 +222,7 @@ def at_rounding(pb: ReducedQP, u: np.ndarray, idx: np.ndarray, BA, lamA: np.ndar
     refinement step would not change the answer."""
     eps = ROUNDING_STOP * np.finfo(float).eps
     au, al = np.abs(u), np.abs(lamA)
-    su = (abs_matvec(pb.K, au) + abs(BA.T) @ al + np.abs(pb.f)).max(initial=0.0)
+    su = (pb.abs_K_times(au) + abs(BA.T) @ al + np.abs(pb.f)).max(initial=0.0)
     if np.abs(r_u).max(initial=0.0) > eps * su:
         return False
     sA = abs(BA) @ au + np.abs(pb.g[idx]) + pb.rho[idx] * al
