@@ -28,6 +28,14 @@ def bed_scene(n: int = 12, element: str = "acm") -> pq.Scene:
                     foundation=pq.Foundation(2.0e4, gap={"profile": "linear", "g0": 0.0, "gx": 0.004, "gy": 0.002}))
 
 
+def patched(element: str = "acm") -> pq.Scene:
+    """grid_elastic with a circular patch load beside its uniform and point loads."""
+    sc = grid_elastic(8, 2, element)
+    sc.loads.append(pq.PatchLoad(q=15.0, region={"circle": [2.5, 5.0, 1.2]}))
+    sc.validate()
+    return sc
+
+
 CASES = {
     "grid gap": (lambda: grid_rigid(12, 3), "supports.1.gap", [-1e-3, 0.0, 5e-4, 2e-3]),
     "grid load": (lambda: grid_rigid(12, 3), "loads.0.q", [5.0, 10.0, 20.0, 40.0]),
@@ -35,7 +43,9 @@ CASES = {
     "bed gap": (bed_scene, "foundation.gap.gx", [0.003, 0.004, 0.005, 0.006]),
     "bed load": (bed_scene, "loads.1.P", [100.0, 200.0, 300.0, 400.0]),
     "bed stiffness": (bed_scene, "foundation.k", [1e4, 2e4, 4e4, 8e4]),
+    "patch load": (patched, "loads.2.q", [0.0, 15.0, 60.0]),
     "triangles gap": (lambda: grid_elastic(8, 2, "dkt"), "supports.1.gap", [-1e-3, 0.0, 1e-3]),
+    "triangles load": (lambda: patched("dkt"), "loads.1.P", [100.0, 300.0, 600.0]),
     "triangles stiffness": (lambda: grid_elastic(8, 2, "dkt"), "supports.*.stiffness", [1e4, 1e5, 1e6]),
 }
 
@@ -101,3 +111,22 @@ def test_a_sweep_scales_its_data_reads_its_qp_and_validates_its_scene_once_not_o
     # the springs' rows change with a stiffness that goes rigid: the QP is read again there
     assert read.n <= (2 if "stiffness" in case else 1), f"the QP read {read.n} times for {len(values)} values"
     assert checked.n <= 1, f"the scene validated whole {checked.n} times for {len(values)} values"
+
+
+@pytest.mark.parametrize("case", ["grid load", "bed load", "patch load"])
+def test_a_load_sweep_assembles_each_load_once_not_once_per_value(case, monkeypatch):
+    from plateqp.model.assembly import Model
+
+    make, path, values = CASES[case]
+    scene = make()
+    assembled = _Counted()
+    real = Model.load_vector
+
+    def counting(self, sc):
+        assembled.n += len(sc.loads)
+        return real(self, sc)
+
+    monkeypatch.setattr(Model, "load_vector", counting)
+    r = run(scene, path, values)
+    assert all(row["status"] == "optimal" for row in r.rows)
+    assert assembled.n <= len(scene.loads), f"{assembled.n} loads assembled for {len(values)} values"
