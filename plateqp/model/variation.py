@@ -16,12 +16,15 @@ from __future__ import annotations
 
 import copy
 import re
+from dataclasses import is_dataclass
+
+import numpy as np
 
 from ..errors import SceneError
 from .checks import check_gap
 from . import paths
 from .parts import plain
-from .paths import _assign, _path_parts, set_param
+from .paths import _assign, _coerce, _path_parts, set_param
 from .scene import Scene
 
 #: The PATHs whose value changes no mesh, no K and no contact operator, and is checked by the
@@ -67,9 +70,31 @@ def _made(scene: Scene, path: str, value) -> Scene:
     """The scene with the value leaf PATH = ``value`` (its NumPy numbers made Python's, as the
     validation makes them), checked by :func:`check_leaf`; not marked validated."""
     new = _copy_path(scene, path)
-    _assign(new, path, plain(value))
+    value = plain(value)
+    if not _assign_items(new, path, value):
+        _assign(new, path, value)
     check_leaf(new, path)
     return new
+
+
+def _assign_items(new: Scene, path: str, value) -> bool:
+    """:func:`plateqp.model.paths._assign` for ``supports.*.F`` and ``loads.*.F`` without walking
+    the path once per item (the same coercion, item by item); False where the path or an item
+    needs the walk (then its SceneError says what is wrong)."""
+    parts = _path_parts(path)
+    if parts[0] not in ("supports", "loads") or parts[1] != "*":
+        return False
+    items, leaf = getattr(new, parts[0]), parts[2]
+    if not items or not all(hasattr(it, leaf) and is_dataclass(it) for it in items):
+        return False
+    per_item = not isinstance(value, (str, dict)) and np.ndim(value) == 1 and len(value) == len(items)
+    first = 1 if parts[0] == "supports" else 0
+    for j, it in enumerate(items):
+        old = getattr(it, leaf)
+        if isinstance(old, (list, dict)) or is_dataclass(old):
+            return False
+        setattr(it, leaf, _coerce(f"{parts[0]}.{j + first}.{leaf}", old, value[j] if per_item else value))
+    return True
 
 
 def check_leaf(sc: Scene, path: str) -> None:

@@ -44,7 +44,10 @@ def test_a_value_leaf_gives_the_scene_and_the_error_a_deep_copy_validated_whole_
     assert is_value_leaf(path)
     base = scene(stiff)
     before = set_param(base, "name", base.name)  # a deep copy of it, to see it unchanged
-    for v in GOOD + BAD + [{"profile": "uniform", "g0": 1e-3}, {"profile": "trough"}]:
+    n = len(base.supports)
+    per_item = [list(np.linspace(1e-3, 2e-3, n)), np.linspace(1e4, 2e4, n), [1e-3] * (n - 1), [1e4, "rigid"] * (n // 2),
+                [1e-3, math.nan] * (n // 2), [10.0, 20.0]]
+    for v in GOOD + BAD + per_item + [{"profile": "uniform", "g0": 1e-3}, {"profile": "trough"}]:
         want = outcome(lambda: set_param(base, path, v))
         got = outcome(lambda: with_value(base, path, v))
         assert got[0] == want[0], (path, v, got, want)
