@@ -126,9 +126,7 @@ class Primal(Formulation):
         # with no spring block, K itself (already CSC: no copy); else K's arrays and the identity's
         # joined column by column (block_diag went through COO and sorted every entry: 0.12 s at
         # 256²), K's stored zeros kept (the ordering reads them: plateqp.linalg.pattern)
-        P = _with_identity(data.K.tocsc(), ne) if ne else data.K.tocsc()
-        if ne:
-            data.share_K(P)
+        P = _primal_hessian(data, el)
         q = np.concatenate([-data.f, np.zeros(ne)])
         T = sp.csr_matrix((-np.sqrt(data.rho[el]), (el, np.arange(ne))), shape=(m, ne))
         G = sp.hstack([data.B, T], format="csc")
@@ -144,6 +142,26 @@ class Primal(Formulation):
         s = np.zeros(d.m)
         s[self._el] = np.sqrt(d.rho[self._el]) * raw.x[d.n:]
         return ContactSolution(u, R, s)
+
+
+def _primal_hessian(data: Scaled, el: np.ndarray) -> sp.csc_matrix:
+    """``block_diag(K, I)`` with one identity column per spring row ``el`` (K itself without
+    springs), ``data.K`` then its leading block (:meth:`Scaled.share_K`); in a sweep
+    (``data.memo``) the one a value before built for the same springs, whose leading block the
+    memo's K already is."""
+    ne = el.size
+    memo = data.memo
+    key = el.tobytes()
+    if memo is not None and memo.get("primal-P", (None,))[0] == key:
+        _, P, data.K = memo["primal-P"]
+        return P
+    P = _with_identity(data.K.tocsc(), ne) if ne else data.K.tocsc()
+    if ne:
+        data.share_K(P)
+    if memo is not None:
+        memo["primal-P"] = (key, P, data.K)
+        memo["K"] = data.K  # one copy of K's values alive, P's
+    return P
 
 
 class Condensed(Formulation):
@@ -268,6 +286,8 @@ class Dual(Formulation):
 # gaps, stiffnesses or loads that shares K and B (plateqp.studies.adapt_model) condenses once.
 #: how many derived matrices a model keeps (Model.derived), most recent last
 _CACHE_SIZE = 2
+#: the kinds of derived matrices :func:`_cached` keeps
+_MATRICES = ("condensed", "dual", "dual-exact")
 
 
 def _cached(data: Scaled, kind: str, build):
@@ -281,7 +301,11 @@ def _cached(data: Scaled, kind: str, build):
     value = build()
     if keep is not None and data.K_src is not None:
         keep.append((data.K_src, data.B_src, kind, value))
-        del keep[:-_CACHE_SIZE]
+        # the oldest derived matrices past _CACHE_SIZE dropped; the list's other entries (kept
+        # factorisations, the scaled data's memo: plateqp.contact.scaling.structure) stay
+        mine = [e for e in keep if e[2] in _MATRICES]
+        drop = {id(e) for e in mine[:-_CACHE_SIZE]}
+        keep[:] = [e for e in keep if id(e) not in drop]
     return value
 
 

@@ -53,6 +53,7 @@ support.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..accuracy import NO_WORK, PRESET_TOL, Accuracy
 from ..errors import MechanismError
@@ -91,7 +92,7 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     # Measured: HiGHS on the primal, stationarity 4e-11, deflections 1.4e-7 off (actual deflection
     # 3e-4 of the load's scale). The part of st above its rounding floor is scaled so.
     floor = np.finfo(float).eps * np.linalg.norm(
-        abs_matvec(data.K, np.abs(u)) + np.abs(data.f) + abs(data.B).T @ np.abs(R)) / force
+        abs_K_times(data, np.abs(u)) + np.abs(data.f) + abs(data.B).T @ np.abs(R)) / force
     # a gap error below what that floor moves the plate by (floor · w_load) is not resolvable:
     # where the plate does not bend (a load on a post: δ 1e-18 m and less) the gap residuals of
     # an exact answer were a large part of δ. δ is at least that motion ÷ tol (at most w_load)
@@ -117,6 +118,21 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
         tol=tol,
         scale=delta * data.W,
     )
+
+
+def abs_K_times(data: Scaled, x: np.ndarray) -> np.ndarray:
+    """``|K| x``: by blocks of K (no copy of it), or in a sweep (``data.memo``) with ``|K|`` kept
+    for the solves of the same K (its values only; K's index arrays shared)."""
+    memo = data.memo
+    if memo is None:
+        return abs_matvec(data.K, x)
+    kept = memo.get("abs_K")
+    if kept is None or kept[0] is not data.K:
+        K = data.K
+        end = K.indptr[-1]
+        kept = memo["abs_K"] = (K, sp.csc_matrix((np.abs(K.data[:end]), K.indices[:end], K.indptr), shape=K.shape,
+                                                 copy=False))
+    return kept[1] @ x
 
 
 def deflection_scale(data: Scaled, u: np.ndarray, w: np.ndarray | None = None) -> float:
@@ -208,10 +224,13 @@ def close_pairs_error(data: Scaled, R, gap, rscale: float, delta: float, tol: fl
     0 where there is no such pair, or where that contact set does not hold the plate."""
     if data.m < 2:
         return 0.0
-    B = data.B.tocsr()
-    G = (B @ B.T).tocoo()
-    nrm = np.sqrt(np.maximum(G.diagonal(), 1e-300))
-    kb = np.maximum(row_stiffness(data.K, B, "diagonal"), 1e-300)
+    memo = data.memo if data.memo is not None else {}
+    if "rows_gram" not in memo:  # K and B alone: once per sweep
+        B = data.B.tocsr()
+        G = (B @ B.T).tocoo()
+        memo["rows_gram"] = (B, G, np.sqrt(np.maximum(G.diagonal(), 1e-300)),
+                             np.maximum(row_stiffness(data.K, B, "diagonal"), 1e-300))
+    B, G, nrm, kb = memo["rows_gram"]
     on = (R > tol * rscale) | (np.abs(gap) <= tol * delta)
     i, j = G.row, G.col
     cos = G.data / (nrm[i] * nrm[j])
@@ -253,8 +272,13 @@ def local_stiffness(data: Scaled) -> np.ndarray:
 
 
 def plate_stiffness(data: Scaled) -> np.ndarray:
-    """The plate's own part of :func:`local_stiffness` (without the supports' springs)."""
+    """The plate's own part of :func:`local_stiffness` (without the supports' springs); K, B and
+    the spacings alone, so in a sweep (``data.memo``) computed once."""
+    if data.memo is not None and "plate_stiffness" in data.memo:
+        return data.memo["plate_stiffness"]
     kb = row_stiffness(data.K, data.B, "rayleigh")
     if data.spacing is not None:
         kb = np.minimum(kb, CIRCLE / np.maximum(data.spacing, 1e-300) ** 2)
+    if data.memo is not None:
+        data.memo["plate_stiffness"] = kb
     return kb

@@ -16,6 +16,7 @@ import scipy.sparse as sp
 from ..model.assembly import Model
 from ..errors import ProblemError
 from ..linalg import pattern, row_stiffness
+from ..linalg.keep import shared
 
 # A plate's deflection is about 0.004–0.012 × F L²/D (Timoshenko's coefficients for square
 # plates); scaling by F L²/D alone left deflections ~1e-3 and solvers' absolute tolerances
@@ -60,11 +61,19 @@ class Scaled:
     #: the soil whose surface has unknowns of its own among K's ("pasternak", "halfspace"), or None
     soil: str | None = None
 
+    # inside plateqp.linalg.keep.sharing (a sweep): what this data derive from K, B and the contact
+    # points' places alone (not from gaps, springs, loads nor W), kept in the model's list for the
+    # next solve of the same K and B (:func:`structure`); None in a single solve
+    memo: dict | None = field(default=None, repr=False, compare=False)
+
     @classmethod
     def from_model(cls, model: Model) -> Scaled:
         c = model.contacts
         if c is None:
             raise ProblemError("the scene has no one-sided supports: nothing to formulate")
+        memo = structure(model)
+        if memo is not None and "K" in memo:
+            return cls._again(model, memo)
         p = model.scene.plate
         L = max(p.a, p.b)
         D = p.D
@@ -84,7 +93,27 @@ class Scaled:
         if modes.shape[1]:
             modes = modes / np.linalg.norm(modes, axis=0)
         data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, order == 0, model.K, c.B,
-                   w_load=W_load / W, spacing=contact_spacing(model) / L, derived=model.derived)
+                   w_load=W_load / W, spacing=contact_spacing(model) / L, derived=model.derived, memo=memo)
+        if memo is not None:  # K̃ = S K S / (F0 W) and B̃ = B S / W do not depend on W (S ∝ W, F0 ∝ W)
+            memo.update(K=K, B=B, modes=modes, is_w=data.is_w, spacing=data.spacing, per_W=S / W)
+        if model.n_soil:
+            data.soil = model.scene.foundation.model
+        check_distinct_contacts(data, model)
+        return data
+
+    @classmethod
+    def _again(cls, model: Model, memo: dict) -> Scaled:
+        """:meth:`from_model` where a solve before on the same K and B left its :func:`structure`:
+        only W, F0 and the data that depend on them (S, f̃, g̃) and ρ̃ are made anew."""
+        c = model.contacts
+        p = model.scene.plate
+        L = max(p.a, p.b)
+        W, W_load = deflection_scale(model, floating=memo["modes"].shape[1] > 0)
+        F0 = W * p.D / L**2
+        S = W * memo["per_W"]
+        data = cls(memo["K"], S * model.f / (F0 * W), memo["B"], c.g0 / W, c.rho * p.D / L**2, S, L, W, F0,
+                   memo["modes"], memo["is_w"], model.K, c.B, w_load=W_load / W, spacing=memo["spacing"],
+                   derived=model.derived, memo=memo)
         if model.n_soil:
             data.soil = model.scene.foundation.model
         check_distinct_contacts(data, model)
@@ -111,6 +140,23 @@ class Scaled:
     def floating(self) -> bool:
         """True if the two-sided supports leave rigid motions free (K singular)."""
         return self.modes.shape[1] > 0
+
+
+def structure(model: Model) -> dict | None:
+    """Inside :func:`plateqp.linalg.keep.sharing` (a sweep, the stiffness design), the memo the
+    model keeps for its K and B (in ``Model.derived``, which the models adapted from it share:
+    :func:`plateqp.studies.reuse.adapt_model`): what the scaled data, their formulation and their
+    KKT check derive from K, B and the contact points' places alone, computed by the first solve
+    and read by the next ones. None elsewhere: a single solve keeps nothing beside its Result."""
+    if not shared() or model.contacts is None:
+        return None
+    K, B = model.K, model.contacts.B
+    for k, b, kind, value in model.derived:
+        if k is K and b is B and kind == "structure":
+            return value
+    value: dict = {}
+    model.derived.append((K, B, "structure", value))
+    return value
 
 
 def contact_spacing(model: Model) -> np.ndarray:
@@ -190,7 +236,10 @@ def check_distinct_contacts(data: Scaled, model: Model) -> None:
     from scipy.spatial import cKDTree
 
     h = min(model.grid.hx, model.grid.hy)
-    pairs = cKDTree(c.xy).query_pairs(1e-3 * h, output_type="ndarray")
+    memo = data.memo if data.memo is not None else {}
+    if "close_points" not in memo:  # the points' places alone
+        memo["close_points"] = cKDTree(c.xy).query_pairs(1e-3 * h, output_type="ndarray")
+    pairs = memo["close_points"]
     if not len(pairs):
         return
     B = data.B.tocsr()

@@ -131,8 +131,11 @@ def supports_reach(data: Scaled, band: float = 1e-9) -> Reach:
     V = data.modes
     if V.shape[1] == 0:
         return Reach(True, False, 0.0, band)
-    Q, _ = np.linalg.qr(V)
-    A = _generators(np.asarray((data.B @ Q).T))
+    memo = data.memo if data.memo is not None else {}
+    if "reach_generators" not in memo:  # the rigid motions and B alone: once per sweep
+        Q, _ = np.linalg.qr(V)
+        memo["reach_generators"] = (Q, _generators(np.asarray((data.B @ Q).T)))
+    Q, A = memo["reach_generators"]
     b = Q.T @ data.f
     size = float(np.linalg.norm(np.abs(Q).T @ np.abs(data.f)))
     if size == 0.0:  # no load on any rigid motion: nothing to carry

@@ -4,8 +4,8 @@ A sweep over gaps, support stiffnesses, the bed's modulus or loads solves one pl
 times (:func:`plateqp.studies.reuse.adapt_model` shares K and the contact operator between the
 values). Inside :func:`sharing` (a sweep's solves, the stiffness design's) the contact pipeline
 lends each solve the list its model keeps for that K and B (:func:`keeping`); a backend that factorises K looks there first (:func:`kept`) and keeps what it
-built there. What is kept must depend on K and B alone: gaps, flexibilities and loads are each
-solve's own. The list lives as long as the model (and the models adapted from it), never
+built there (its factorisation; pdas also its reading of the QP, checked against the next QP).
+What is kept must depend on K and B alone: gaps, flexibilities and loads are each solve's own. The list lives as long as the model (and the models adapted from it), never
 longer: a new K (thickness, modulus, mesh) is a new model with a new list.
 """
 
@@ -53,9 +53,11 @@ def kept() -> list | None:
 
 
 def remember(store: list, entry) -> None:
-    """Keep ``entry`` in ``store``, the oldest dropped past :data:`KEEP`."""
+    """Keep ``entry`` in ``store``, the oldest of its type dropped past :data:`KEEP` (a backend
+    keeps things of several types: a factorisation, the problem read from the QP)."""
     store.append(entry)
-    del store[:-KEEP]
+    drop = {id(e) for e in [e for e in store if type(e) is type(entry)][:-KEEP]}
+    store[:] = [e for e in store if id(e) not in drop]
 
 
 __all__ = ["KEEP", "keeping", "kept", "remember", "shared", "sharing"]

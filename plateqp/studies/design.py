@@ -227,7 +227,9 @@ def regulate_gaps(scene: Scene, target_reactions, supports: Sequence[int] | None
     new = set_param(scene, "supports.*.gap", gaps)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PlateQPWarning)  # the check's status says it
-        check = solve(new, backend=backend, formulation=formulation, accuracy="high")
+        # the model built for the gaps, adapted to them: no second assembly
+        check = solve(new, backend=backend, formulation=formulation, accuracy="high",
+                      model=adapt_model(model, new))
     out = GapRegulation(gaps, new, reg, target, R_reg, check, proj)
     logger.info("regulate_gaps: %d supports regulated, relative distance to the target %.2e, the check solve "
                 "%.1e off the reactions aimed at", reg.size, proj, out.miss)

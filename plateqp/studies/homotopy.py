@@ -35,8 +35,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.assembly import Model, build_model
+from ..contact.routing import repeated_solves
 from ..contact.scaling import Scaled
 from ..errors import MechanismError, ProblemError
+from ..linalg.keep import sharing
 from ..model.paths import as_number, get_param, set_param
 from ..progress import Progress
 from ..model.scene import Scene
@@ -337,9 +339,12 @@ def exact_sweep(scene: Scene, path: str, values, backend: str = "auto", formulat
     if not (np.all(diffs >= 0) or np.all(diffs <= 0)):
         raise ProblemError("--exact: the values must be in increasing or decreasing order (the path is followed "
                            "from the first to the last)")
-    ep = exact_path(scene, path, nums[0], nums[-1], backend=backend, formulation=formulation)
+    # the path's start solve on the route the sweep's solves take (repeated_solves), keeping its
+    # factorisation and scaled data in its model (sharing), which the sweep's values then adapt
+    with repeated_solves(), sharing():
+        ep = exact_path(scene, path, nums[0], nums[-1], backend=backend, formulation=formulation)
     kw["refine_breakpoints"] = False
-    res = sweep(scene, path, values, backend=backend, formulation=formulation, **kw)
+    res = sweep(scene, path, values, backend=backend, formulation=formulation, model=ep._model, **kw)
     out = []
     for b in ep.breakpoints:
         i = next((k for k in range(len(nums) - 1) if min(nums[k], nums[k + 1]) <= b["at"] <= max(nums[k], nums[k + 1])),

@@ -8,6 +8,7 @@ value; the condensation of a contact problem that shares K and B is then compute
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 
 import numpy as np
@@ -15,7 +16,7 @@ import numpy as np
 from ..model.assembly import Model
 
 from ..model.generators import mesh_generator
-from ..model.scene import Scene
+from ..model.scene import PointLoad, Scene
 
 
 def same_structure(a: Scene, b: Scene) -> bool:
@@ -34,9 +35,42 @@ def same_structure(a: Scene, b: Scene) -> bool:
 
 
 def _point_loads(scene: Scene) -> list:
-    from ..model.scene import PointLoad
-
     return [(ld.x, ld.y) for ld in scene.loads if isinstance(ld, PointLoad)]
+
+
+def _kept(base: Model, kind: str, build):
+    """What ``build()`` gave for ``base``'s K before (kept in ``base.derived``, which the models
+    adapted from it share), or that, built now and kept."""
+    for K, _, k, value in base.derived:
+        if K is base.K and k == kind:
+            return value
+    value = build()
+    base.derived.append((base.K, None, kind, value))
+    return value
+
+
+def _prescribed_load(base: Model) -> np.ndarray:
+    """K_fp u_p: the load the prescribed displacements put on the free dofs (the same whatever
+    the loads), computed once per K."""
+    return _kept(base, "prescribed-load", lambda: base.K_full[base.free][:, base.fixed] @ base.values)
+
+
+def _load_vector(base: Model, scene: Scene) -> np.ndarray:
+    """The load vector of ``scene.loads`` on ``base``'s mesh: each load's magnitude times its
+    vector at magnitude 1, kept per place and shape of a load (a sweep of a load's magnitude
+    assembles it once)."""
+    units = _kept(base, "unit-loads", dict)
+    f = np.zeros(base.n_full)
+    for ld in scene.loads:
+        key = "P" if isinstance(ld, PointLoad) else "q"
+        unit = dataclasses.replace(ld, **{key: 1.0})
+        tag = repr(unit)
+        if tag not in units:
+            one = copy.copy(scene)  # not validated: only its load vector is read
+            one.loads = [unit]
+            units[tag] = base.load_vector(one)
+        f += getattr(ld, key) * units[tag]
+    return f
 
 
 def adapt_model(base: Model, scene: Scene) -> Model | None:
@@ -52,9 +86,9 @@ def adapt_model(base: Model, scene: Scene) -> Model | None:
         return None
     model = dataclasses.replace(base, scene=scene)
     if old.loads != scene.loads:
-        f_full = base.load_vector(scene)  # the load vector alone, on the same mesh
+        f_full = _load_vector(base, scene)  # the load vector alone, on the same mesh
         model.f_full = f_full
-        model.f = f_full[base.free] - base.K_full[base.free][:, base.fixed] @ base.values
+        model.f = f_full[base.free] - _prescribed_load(base)
     c = base.contacts
     if c is not None:
         gaps, rho = c.scene_gaps.copy(), c.rho.copy()

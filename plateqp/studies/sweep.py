@@ -26,12 +26,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ProblemError
-from ..model.paths import as_number, check_values, get_param
+from ..model.paths import as_number, get_param
+from ..model.variation import check_values
 from ..model.scene import Scene
 from .breakpoints import Bisection, contact_set, refine_bracket
 from ..progress import Progress
 from .parallel import SERIAL_BELOW, make_runner
-from .worker import WARM_START_BACKENDS, Context, forget, next_start, run_chunk, solve_value
+from .worker import WARM_START_BACKENDS, Context, forget, next_start, run_chunk, seed, solve_value
 
 logger = logging.getLogger(__name__)
 
@@ -186,7 +187,7 @@ def _few(values, keep: int = 3) -> str:
 def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", formulation: str = "auto",
           accuracy: str = "default", executor=None, progress: bool = True, refine_breakpoints: bool = True,
           rtol: float = 1e-3, options: dict | None = None, reuse: bool = True, max_workers: int = 2,
-          bisection: str = "auto", warm_start: bool = True, store=None) -> SweepResult:
+          bisection: str = "auto", warm_start: bool = True, store=None, model=None) -> SweepResult:
     """Solve ``scene`` for each value of the field PATH; find where the contact set changes.
 
     Parameters
@@ -195,7 +196,7 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
         same path language as ``plateqp sweep --param``: ``supports.1.gap`` is the first
         support, supports being numbered from 1 as in every table)
     values : the values, in sweep order ("rigid" allowed for a stiffness); every one is
-        checked against the scene before any solve (:func:`plateqp.model.paths.check_values`)
+        checked against the scene before any solve (:func:`plateqp.model.variation.check_values`)
     backend, formulation, accuracy, options : as for :func:`plateqp.solve`
     executor : None (local processes, ``max_workers`` of them, or this process for fewer
         than :data:`SERIAL_BELOW` values), "serial", "process", any
@@ -222,6 +223,10 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
         written as soon as it is solved; if the file holds rows of this same sweep (same scene,
         path, values and solver settings) from a stopped run, those values are not solved
         again. A file of another sweep is a ProblemError.
+    model : None, or a model built before from ``scene`` with PATH at another value (what
+        :func:`plateqp.studies.exact_sweep` built for its path): the values solved in this
+        process adapt it (:func:`plateqp.studies.reuse.adapt_model`) and re-use what its solves
+        kept (the factorisation of K, the scaled data) instead of building their own
 
     Returns
     -------
@@ -263,6 +268,8 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
     t0 = time.perf_counter()
     ctx = Context(uuid.uuid4().hex, scene, path, backend, formulation, accuracy, options, reuse,
                    bool(warm_start))
+    if model is not None and reuse:
+        seed(ctx, model)
     runner = make_runner(executor, len(values), max_workers, ctx)
     n = len(values)
     rows: list[dict | None] = [None] * n

@@ -23,7 +23,7 @@ from ..model.assembly import Model, build_model
 from ..contact.routing import repeated_solves
 from ..errors import NoEquilibriumError, PlateQPWarning
 from ..linalg.keep import sharing
-from ..model.paths import set_param
+from ..model.variation import with_value
 from ..model.recovery import NodalOperator, nodal_operator
 from ..model.scene import Scene
 from ..solving import solve
@@ -72,6 +72,14 @@ def base_of(ctx: Context) -> Base:
     return b
 
 
+def seed(ctx: Context, model: Model) -> None:
+    """Make ``model`` (built from ``ctx.scene`` with PATH at some value) the base of the sweep
+    ``ctx`` in this process: its values adapt it and share what its solves kept."""
+    _MODELS[ctx.token] = Base(model)
+    while len(_MODELS) > _MODELS_KEEP:
+        _MODELS.popitem(last=False)
+
+
 def forget(token: str) -> None:
     """Drop the base of the sweep ``token`` from this process."""
     _MODELS.pop(token, None)
@@ -88,7 +96,8 @@ def solve_value(ctx: Context, value, warm=None):
 
     t0 = time.perf_counter()
     try:
-        scene = set_param(ctx.scene, ctx.path, value)
+        # only what the value changes copied and checked (the sweep checked its scene: check_values)
+        scene = with_value(ctx.scene, ctx.path, value, checked=True)
         t_scene = time.perf_counter() - t0
         model = base = None
         if ctx.reuse:
@@ -119,7 +128,7 @@ def solve_value(ctx: Context, value, warm=None):
         times["total"] = t1 - t0
         times.update(scene=t_scene, formulate=res.times.get("formulate"), recover=res.times.get("recover"),
                      post=t1 - t_post)
-        active = tuple(bool(a) for a in res.active)
+        active = tuple(np.asarray(res.active, dtype=bool).tolist())
         state = np.asarray(res.extras.get("active", res.active), dtype=bool).copy()
         return row, active, (res.backend, state)
     except Exception as exn:  # never lose a sweep to one value: record it and go on
@@ -156,4 +165,5 @@ def run_chunk(ctx: Context, items: list[tuple[int, Any]], state=None):
     return out
 
 
-__all__ = ["Base", "Context", "WARM_START_BACKENDS", "base_of", "forget", "run_chunk", "next_start", "solve_value"]
+__all__ = ["Base", "Context", "WARM_START_BACKENDS", "base_of", "forget", "run_chunk", "next_start", "seed",
+           "solve_value"]

@@ -77,14 +77,17 @@ class _Kept:
 
     def again(self, pb: ReducedQP) -> DenseDual:
         """The kept DenseDual for this solve's flexibilities, gaps and loads: its M's diagonal
-        moved to the new ρ, ``d = g − B K⁻¹ f`` from the kept factor (half a solve)."""
+        moved to the new ρ, ``d = g − B K⁻¹ f`` from the kept factor (half a solve, none where the
+        load is the last solve's: its first half ``yf`` is kept)."""
         cond = self.cond
         diag = np.diag_indices(pb.m)
         cond.M[diag] += pb.rho - self.rho
         self.rho = pb.rho.copy()
+        same_load = cond.yf is not None and np.array_equal(pb.f, cond.pb.f)  # a gap or spring sweep
         cond.pb, cond._chol, cond.first, cond._dense_s = pb, None, {}, 0.0
         cond.Bc = pb.B[:, cond.fac.last].tocsr()
-        cond.yf = cond._forward(pb.f)
+        if not same_load:
+            cond.yf = cond._forward(pb.f)
         cond.d = pb.g - cond.Bc @ cond._tail(cond.yf)
         return cond
 
@@ -143,6 +146,25 @@ def _spring_factor(pb: ReducedQP, sigma: float, method: str) -> tuple[SpringFact
     if store is None:
         return fac, None
     return fac, _KeptSprings(fac, pb.Kd.copy(), pb.B.copy(), np.array(pb.c, copy=True), sigma, method)
+
+
+def _reduced(qp: QP, max_rows) -> ReducedQP:
+    """``ReducedQP(qp, max_rows)``, or where the caller lent a list of kept factorisations
+    (:func:`plateqp.linalg.keep.kept`: a sweep) and a solve before read the same Hessian, that
+    problem with this QP's loads, gaps and springs (:meth:`.reduced.ReducedQP.again`)."""
+    store = kept()
+    if store is not None:
+        for entry in list(store):
+            if isinstance(entry, ReducedQP):
+                pb = entry.again(qp, max_rows)
+                if pb is not None:
+                    store[:] = [e for e in store if e is not entry]
+                    remember(store, pb)
+                    return pb
+    pb = ReducedQP(qp, max_rows)
+    if store is not None:
+        remember(store, pb)
+    return pb
 
 
 def _anchored(pb: ReducedQP, max_dense: int, feas_tol: float, max_iter: int, p: int, steps, sigma: float):
@@ -229,7 +251,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     if not isinstance(trace, (bool, np.bool_)):
         raise ProblemError(f"option trace must be True or False, got {trace!r}")
 
-    pb = ReducedQP(qp, max_rows)
+    pb = _reduced(qp, max_rows)
     m = pb.m
     if max_dense == "auto":
         max_dense = auto_max_dense(pb.K.shape[0], soft=bool(np.all(pb.rho * pb.k >= 1.0)))

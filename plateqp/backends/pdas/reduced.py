@@ -4,6 +4,8 @@ the infeasible rows, the residuals of an answer (see the package docstring: "The
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -105,6 +107,56 @@ class ReducedQP:
         self.c = self.k / (1.0 + self.rho * self.k)  # in series with the row's spring
         self.P, self.q = P, qp.q
         self._null, self._null_checked = qp.null, False
+        self._src = (qp.P, qp.G, G, max_rows, qp.null)  # what :meth:`again` compares
+        self._abs_K = None  # |K|, kept where the problem is read again (:meth:`abs_K_times`)
+
+    def abs_K_times(self, x: np.ndarray) -> np.ndarray:
+        """``|K| x``: by blocks of K (:func:`plateqp.linalg.pattern.abs_matvec`, no copy of K),
+        or where this problem was read again for another solve (:meth:`again`: a sweep) with
+        ``|K|`` kept (its values only; K's index arrays shared)."""
+        if self._abs_K is None:
+            return abs_matvec(self.K, x)
+        return self._abs_K @ x
+
+    def again(self, qp: QP, max_rows: int | None) -> ReducedQP | None:
+        """This problem for ``qp`` where only its loads and gaps (``q``, ``h``) and the values of
+        the separable columns of ``G`` (the springs) differ from the QP it was read from, P being
+        the same object (a sweep's next value, its Hessian kept: :mod:`plateqp.linalg.keep`): a
+        copy with those read anew, the rest (the split, K's block, B, the checks on P, the rigid
+        motions checked) shared. None where anything else differs."""
+        P0, G0, Gc0, rows0, null0 = self._src
+        if qp.P is not P0 or max_rows != rows0 or qp.A is not None or qp.lb is not None or qp.ub is not None:
+            return None
+        if (qp.null is None) != (null0 is None) or (qp.null is not None and not np.array_equal(qp.null, null0)):
+            return None
+        new = copy.copy(self)
+        if new._abs_K is None:
+            K = self.K
+            new._abs_K = sp.csc_matrix((np.abs(K.data[:K.indptr[-1]]), K.indices[:K.indptr[-1]], K.indptr),
+                                       shape=K.shape, copy=False)
+        if qp.G is not G0:
+            G = sp.csc_matrix(qp.G, dtype=float)
+            G.eliminate_zeros()
+            if (G.shape != Gc0.shape or not np.array_equal(G.indptr, Gc0.indptr)
+                    or not np.array_equal(G.indices, Gc0.indices)):
+                return None
+            at = Gc0.indptr[self.sep]  # each separable column's one entry
+            coupled = np.ones(Gc0.data.size, dtype=bool)
+            coupled[at] = False
+            if not np.array_equal(G.data[coupled], Gc0.data[coupled]):
+                return None
+            gamma = np.empty(self.sep.size)
+            gamma[:] = G.data[at]
+            if not np.array_equal(gamma, self.sep_gamma):
+                new.sep_gamma = gamma
+                new.rho = np.bincount(self.sep_row, weights=gamma**2 / self.sep_p, minlength=self.m)
+                new.c = self.k / (1.0 + new.rho * self.k)
+            new._src = (P0, qp.G, G, rows0, null0)
+        new.q = qp.q
+        new.sep_q = qp.q[self.sep]
+        new.f = -qp.q[self.keep]
+        new.g = qp.h + np.bincount(self.sep_row, weights=new.sep_gamma * new.sep_q / self.sep_p, minlength=self.m)
+        return new
 
     def rigid(self) -> np.ndarray | None:
         """The QP's hint ``null`` (:attr:`QP.null`) on the coupled variables, once checked (on
@@ -170,7 +222,7 @@ def at_rounding(pb: ReducedQP, u: np.ndarray, idx: np.ndarray, BA, lamA: np.ndar
     refinement step would not change the answer."""
     eps = ROUNDING_STOP * np.finfo(float).eps
     au, al = np.abs(u), np.abs(lamA)
-    su = (abs_matvec(pb.K, au) + abs(BA.T) @ al + np.abs(pb.f)).max(initial=0.0)
+    su = (pb.abs_K_times(au) + abs(BA.T) @ al + np.abs(pb.f)).max(initial=0.0)
     if np.abs(r_u).max(initial=0.0) > eps * su:
         return False
     sA = abs(BA) @ au + np.abs(pb.g[idx]) + pb.rho[idx] * al
