@@ -18,6 +18,9 @@ module                     job
                            registry
 :mod:`.constraints`        prescribed dofs from named edges and pins; the rigid motions left free
 :mod:`.assembly`           :func:`~.assembly.build_model`: mesh, stiffness, load, contact operator
+:mod:`.soil`               soils whose surface has unknowns of its own (Pasternak, half-space)
+:mod:`.halfspace`          Boussinesq's surface flexibility: polygons exactly, a grid's by FFT
+:mod:`.variation`          a scene with one value changed, checked where it changed (sweeps)
 :mod:`.recovery`           moments and stresses from the curvatures, nodal averages
 =========================  =======================================================================
 

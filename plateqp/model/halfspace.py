@@ -290,13 +290,13 @@ def _cell_groups(cells, m: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray
         ids = [np.flatnonzero(ks == k) for k in np.unique(ks)]
         polys = [np.stack([seq[j] for j in idx]) for idx in ids]
     n = sum(len(i) for i in ids)
-    if n != m:
+    if m >= 0 and n != m:
         raise ProblemError(f"cells: {n} cells for {m} points; give one cell (the tributary area) per point")
     return [(idx, p, _check_polygons(p, [f"cells[{j}]" for j in idx])) for idx, p in zip(ids, polys)]
 
 
 def flexibility(points, cells, E: float, nu: float, *, per: str = "pressure",
-                max_bytes: int = DENSE_LIMIT) -> np.ndarray:
+                max_bytes: int = DENSE_LIMIT, owner=None) -> np.ndarray:
     """The dense surface flexibility of the half-space at ``points`` under uniform loads over ``cells``.
 
     Parameters
@@ -314,6 +314,11 @@ def flexibility(points, cells, E: float, nu: float, *, per: str = "pressure",
         spread uniformly over cell j, H[:, j] / area[j], settlements = H @ forces (length/force).
     max_bytes : int
         The refusal's limit on the matrix's 8 m² bytes (default :data:`DENSE_LIMIT`).
+    owner : array_like of int, optional
+        A point's tributary area made of several polygons (a mesh node's parts of its cells):
+        ``owner[c]`` is the point (column) polygon c belongs to; the polygons of one point load
+        it together, uniformly over their union (``per="force"``: over their total area). Any
+        number of polygons then; every point must own at least one.
 
     Returns
     -------
@@ -335,13 +340,35 @@ def flexibility(points, cells, E: float, nu: float, *, per: str = "pressure",
     if 8 * m * m > max_bytes:
         raise ProblemError(f"points: a dense flexibility of m = {m} cells needs {8 * m * m} bytes, above the limit "
                            f"of {max_bytes} bytes (max_bytes); on a grid use GridFlexibility")
-    H = np.empty((m, m))
-    for idx, polys, area in _cell_groups(cells, m):
-        scale = factor * np.sign(area) / (np.abs(area) if per == "force" else 1.0)
+    if owner is None:
+        H = np.empty((m, m))
+        for idx, polys, area in _cell_groups(cells, m):
+            scale = factor * np.sign(area) / (np.abs(area) if per == "force" else 1.0)
+            rows = max(1, BLOCK // len(idx))
+            for r0 in range(0, m, rows):
+                px, py = pts[r0:r0 + rows, :1], pts[r0:r0 + rows, 1:]
+                H[r0:r0 + rows, idx] = _potential(px, py, polys[None], 1.0) * scale
+        return H
+    import scipy.sparse as sp
+
+    owner = np.asarray(owner)
+    groups = _cell_groups(cells, len(owner) if owner.ndim == 1 else -1)
+    if owner.ndim != 1 or not np.issubdtype(owner.dtype, np.integer) or (owner.size and not 0 <= owner.min() <= owner.max() < m):
+        raise ProblemError(f"owner: one point index in 0 … {m - 1} per polygon, got {owner!r}"[:200])
+    total = np.zeros(m)
+    for idx, _, area in groups:
+        np.add.at(total, owner[idx], np.abs(area))
+    if np.any(total == 0):
+        raise ProblemError(f"owner: point {int(np.flatnonzero(total == 0)[0])} owns no polygon")
+    H = np.zeros((m, m))
+    for idx, polys, area in groups:
+        own = owner[idx]
+        gather = sp.csr_matrix((factor * np.sign(area) / (total[own] if per == "force" else 1.0),
+                                (np.arange(len(idx)), own)), shape=(len(idx), m))
         rows = max(1, BLOCK // len(idx))
         for r0 in range(0, m, rows):
             px, py = pts[r0:r0 + rows, :1], pts[r0:r0 + rows, 1:]
-            H[r0:r0 + rows, idx] = _potential(px, py, polys[None], 1.0) * scale
+            H[r0:r0 + rows] += (gather.T @ _potential(px, py, polys[None], 1.0).T).T
     return H
 
 

@@ -174,8 +174,8 @@ def halfspace_areas(mesh, region) -> np.ndarray:
 def halfspace_flexibility(model, nodes: np.ndarray) -> np.ndarray:
     """(m, m) H_F: the soil's settlement at bed node i per unit force spread uniformly over node
     j's pressure cells (Boussinesq's solution integrated exactly over each polygon,
-    :func:`plateqp.model.halfspace.potential`), symmetrised."""
-    from .halfspace import potential
+    :func:`plateqp.model.halfspace.flexibility`), symmetrised."""
+    from .halfspace import flexibility
 
     fnd = model.scene.foundation
     mesh = model.grid
@@ -189,13 +189,8 @@ def halfspace_flexibility(model, nodes: np.ndarray) -> np.ndarray:
     owner, polys = pressure_cells(mesh, fnd.region)
     col = pos[owner]
     keep = col >= 0  # a node whose deflection is prescribed presses no soil here
-    col, polys = col[keep], polys[keep]
-    area = np.bincount(col, weights=polygon_areas(polys), minlength=m)
-    pts = mesh.node_xy()[nodes]
-    H = np.zeros((m, m))
-    for j, poly in zip(col.tolist(), polys):
-        H[:, j] += potential(pts[:, 0], pts[:, 1], poly)
-    H *= (1.0 - fnd.nu**2) / (np.pi * fnd.E) / area[None, :]
+    H = flexibility(mesh.node_xy()[nodes], polys[keep], fnd.E, fnd.nu, per="force", owner=col[keep],
+                    max_bytes=8 * HALFSPACE_DENSE_MAX**2)
     return 0.5 * (H + H.T)
 
 

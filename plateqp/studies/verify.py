@@ -44,6 +44,12 @@ def _D() -> float:
     return Plate(**PLATE).D
 
 
+#: half-spaces under the verification plate (D ≈ 0.0916, radius 1): E_s a³ / D = 1e-3 (the plate
+#: a rigid punch on it) and 1e5 (the plate's bending negligible: the bare half-space's load)
+_E_SOIL = 1e-3 * 0.0916
+_E_SOFT = 1e5 * 0.0916
+
+
 # -- closed forms -------------------------------------------------------------------------------
 def navier_uniform(a: float, b: float, x: float, y: float, terms: int = 199) -> float:
     """w·D/q of a simply supported a × b plate under uniform q at (x, y): Navier's double series
@@ -120,6 +126,8 @@ class Case:
     levels: tuple[int, ...] = (8, 16, 32)
     quick: tuple[int, ...] = (8, 16)
     solve: str = "solve"  # or "bilateral"
+    #: the accuracy asked ("high" unless the case's own rounding floor is above it)
+    accuracy: str | float = "high"
 
 
 def _square(n: int, element: str, edge: str, load, ny_ratio: int = 1, **kw) -> Scene:
@@ -242,6 +250,17 @@ def cases() -> list[Case]:
                              foundation=Foundation(k=k_bed, model="pasternak", shear=math.sqrt(k_bed * D))),
              lambda n: 1.0 / n, lambda n: f"DKT R/{n}", lambda r: r.deflection(0.2, 0.0),
              lambda: kerr_bed(0.2, 1.0, k_bed, math.sqrt(k_bed * D), D), 0.01, solve="bilateral", **_LEVELS_TRI),
+        Case("halfspace-rigid-punch", "a disc 1e3 × stiffer than the half-space under it, central P: w at the centre",
+             "a rigid circular punch settles P (1 − ν²) / (2 a E) (Boussinesq; Johnson, Contact Mechanics, § 5.2)",
+             lambda n: _disc(n, None, PointLoad(1.0, 0.0, 0.0), foundation=Foundation(model="halfspace", E=_E_SOIL, nu=NU)),
+             lambda n: 1.0 / n, lambda n: f"DKT R/{n}", lambda r: r.deflection(0.0, 0.0),
+             lambda: (1 - NU**2) / (2 * _E_SOIL), 0.02, levels=(4, 8, 16), quick=(4, 8),
+             accuracy=1e-6),  # a plate 1e3 × stiffer than its soil: the KKT's rounding floor is 2e-7
+        Case("halfspace-flexible-disc", "a disc 1e5 × softer than the half-space under it, uniform q: w at the centre",
+             "uniform q over a circle of radius a on a half-space: 2 q a (1 − ν²)/E at its centre (Timoshenko & Goodier § 138)",
+             lambda n: _disc(n, None, UniformLoad(1.0), foundation=Foundation(model="halfspace", E=_E_SOFT, nu=NU)),
+             lambda n: 1.0 / n, lambda n: f"DKT R/{n}", lambda r: r.deflection(0.0, 0.0),
+             lambda: 2 * (1 - NU**2) / _E_SOFT, 0.02, levels=(4, 8, 16), quick=(4, 8)),
         Case("bed-uniform-sinks", "free disc on a tensionless bed, uniform q: w at r = 0.5",
              "q / k: a rigid translation, no bending (exact for lumped loads and springs on one area)",
              lambda n: _disc(n, None, UniformLoad(2.0), foundation=Foundation(k=100.0)),
@@ -286,7 +305,7 @@ def _solve(case: Case, scene: Scene):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PlateQPWarning)
-        res = solve_bilateral(scene) if case.solve == "bilateral" else solve(scene, accuracy="high")
+        res = solve_bilateral(scene) if case.solve == "bilateral" else solve(scene, accuracy=case.accuracy)
     if hasattr(res, "kkt") and res.kkt is not None and not res.kkt.ok:
         raise PlateQPError(f"verify {case.name}: the KKT check failed on {case.mesh(0)}")
     return res
