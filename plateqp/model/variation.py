@@ -21,7 +21,7 @@ from dataclasses import is_dataclass
 import numpy as np
 
 from ..errors import SceneError
-from .checks import check_gap
+from .checks import check_gap, check_soil_model
 from . import paths
 from .parts import plain
 from .paths import _assign, _coerce, _path_parts, set_param
@@ -120,7 +120,7 @@ def check_leaf(sc: Scene, path: str) -> None:
         for i in items:
             sc._num(f"loads.{i}.{parts[2]}", getattr(sc.loads[i], parts[2]), physical=True)
     elif parts[1] == "k":
-        sc._num("foundation.k", sc.foundation.k, positive=True, physical=True)
+        check_soil_model(sc, sc.foundation)
     else:
         check_gap(sc, sc.foundation.gap)
     check_scales(sc, SAFE_DERIVED)

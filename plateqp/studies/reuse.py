@@ -17,6 +17,7 @@ from ..model.assembly import Model
 
 from ..model.generators import mesh_generator
 from ..model.scene import PointLoad, Scene
+from ..model.soil import couples
 
 
 def same_structure(a: Scene, b: Scene) -> bool:
@@ -31,7 +32,13 @@ def same_structure(a: Scene, b: Scene) -> bool:
         return False
     if (a.foundation is None) != (b.foundation is None):
         return False
-    return a.foundation is None or a.foundation.region == b.foundation.region
+    if a.foundation is None:
+        return True
+    fa, fb = a.foundation, b.foundation
+    if fa.region != fb.region or fa.model != fb.model:
+        return False
+    # a soil with unknowns of its own holds its parameters in K (plateqp.model.soil): only its gap may differ
+    return not couples(fa) or all(getattr(fa, k) == getattr(fb, k) for k in ("k", "shear", "E", "nu"))
 
 
 def _point_loads(scene: Scene) -> list:
@@ -88,7 +95,7 @@ def adapt_model(base: Model, scene: Scene) -> Model | None:
     if old.loads != scene.loads:
         f_full = _load_vector(base, scene)  # the load vector alone, on the same mesh
         model.f_full = f_full
-        model.f = f_full[base.free] - _prescribed_load(base)
+        model.f = base.on_unknowns(f_full) - np.concatenate([_prescribed_load(base), np.zeros(base.n_soil)])
     c = base.contacts
     if c is not None:
         gaps, rho = c.scene_gaps.copy(), c.rho.copy()
@@ -101,7 +108,8 @@ def adapt_model(base: Model, scene: Scene) -> Model | None:
         if np.any(bed):
             fo, fn = old.foundation, scene.foundation
             gaps[bed] = fn.gap_at(c.xy[bed, 0], c.xy[bed, 1])
-            rho[bed] = c.rho[bed] * (fo.k / fn.k)  # 1 / (k × the node's area)
+            if not couples(fn):  # Winkler's springs: 1 / (k × the node's area) on their rows
+                rho[bed] = c.rho[bed] * (fo.k / fn.k)
         model.contacts = c.with_gaps(gaps, rho)
     return model
 

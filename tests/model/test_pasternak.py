@@ -238,3 +238,23 @@ def test_sensitivities_on_a_pasternak_bed_are_the_finite_differences_of_the_solv
     sl = np.asarray(pq.sensitivity(res, "loads"))[:, 0]
     np.testing.assert_allclose((heavier.reactions - res.reactions) * 2e4, sl, rtol=0, atol=1e-6 * np.abs(sl).max())
     assert pq.sensitivity(res, "stiffness").labels == []
+
+
+@pytest.mark.parametrize("path, values", [("foundation.k", [2e7, 3e7, 5e7]), ("foundation.gap.g0", [-8e-4, -5e-4, 0.0]),
+                                          ("foundation.shear", [1e6, 4e6])])
+def test_a_sweep_of_a_pasternak_bed_gives_what_cold_solves_give(path, values):
+    """A sweep re-uses the model only where K stays: a Pasternak soil's k and shear are in K
+    (the model is rebuilt), its gap is not (adapted). Every value equals a cold solve of that
+    scene (another computation of the same answer)."""
+    from plateqp.model.paths import set_param
+    from plateqp.studies.sweep import sweep
+
+    base = pq.Scene(plate=pq.Plate(a=2.0, b=1.5, h=0.15, E=E, nu=NU), mesh=pq.MeshSpec(nx=10, ny=8),
+                    edges={"left": "simple", "right": "simple"}, loads=[pq.UniformLoad(2e4)],
+                    foundation=pq.Foundation(k=3e7, model="pasternak", shear=2e6,
+                                             gap={"profile": "linear", "g0": -5e-4, "gx": 3e-4}))
+    out = sweep(base, path, values, executor="serial", progress=False, refine_breakpoints=False, accuracy=1e-10)
+    assert [row["value"] for row in out.rows] == values
+    for v, row in zip(values, out.rows):
+        cold = pq.solve(set_param(base, path, v), accuracy=1e-10)
+        np.testing.assert_allclose(row["reactions"], cold.reactions, rtol=0, atol=1e-8 * np.abs(cold.reactions).max())
