@@ -1,0 +1,101 @@
+"""Soils: the cost of a tensionless Winkler, Pasternak and half-space bed against raw CHOLMOD.
+
+    python benchmarks/bench_soils.py                       # meshes 32, 64, 128 (half-space 16, 32, 48)
+    python benchmarks/bench_soils.py --meshes 16 --hs-meshes 8 --repeats 1    # quick
+
+The scene: a 1 × 1 plate (h = 0.02, E = 1e7, ν = 0.3) simply supported on its left and right
+edges, under q = 20 and P = 200 at (0.6, 0.55), on soil over its whole area whose gap falls away
+towards x = 1 (g0 = 0.004 x: part of the bed lifts off). Winkler k = 2e4; Pasternak the same k
+and a shear layer c2 = 2e2 (its length √(c2/k) = 0.1); a half-space E = 1e4, ν = 0.3.
+
+"raw" is benchmarks/bench_fast.py's floor: one CHOLMOD symbolic analysis + numeric
+factorisation + solve of the plate's K with every Winkler spring bonded (K + Bᵀ C B), through
+cvxopt. Per mesh and soil, interleaved, ``--repeats`` times: raw, then pq.solve (backend and
+formulation "auto", accuracy 1e-8) from the scene (the model's build included); CPU time
+(time.process_time, one BLAS thread), medians. Writes results/soils.csv.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+import warnings
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+import plateqp as pq  # noqa: E402
+from plateqp.model.assembly import build_model  # noqa: E402
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+from bench_fast import plate_matrix, raw_cholmod, to_cvxopt  # noqa: E402
+
+SOILS = {
+    "winkler": dict(k=2.0e4),
+    "pasternak": dict(model="pasternak", k=2.0e4, shear=2.0e2),
+    "halfspace": dict(model="halfspace", E=1.0e4, nu=0.3),
+}
+
+
+def scene(soil: str, n: int) -> pq.Scene:
+    return pq.Scene(name=f"{soil}{n}", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
+                    edges={"left": "simple", "right": "simple"},
+                    loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
+                    foundation=pq.Foundation(gap={"profile": "linear", "g0": 0.0, "gx": 0.004, "gy": 0.0},
+                                             **SOILS[soil]))
+
+
+def cpu(fn):
+    t0 = time.process_time()
+    out = fn()
+    return time.process_time() - t0, out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--meshes", default="32,64,128", help="cells a side for Winkler and Pasternak")
+    ap.add_argument("--hs-meshes", default="16,32,48", help="cells a side for the half-space (dense: m ≤ 4000)")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--out", default=str(HERE / "results" / "soils.csv"))
+    args = ap.parse_args(argv)
+    cases = [(s, int(n)) for n in args.meshes.split(",") for s in ("winkler", "pasternak")]
+    cases += [("halfspace", int(n)) for n in args.hs_meshes.split(",")]
+    rows = []
+    with warnings.catch_warnings():  # imports and first-call costs out of the first case's clock
+        warnings.simplefilter("ignore")
+        for soil in SOILS:
+            pq.solve(scene(soil, 8), accuracy=1e-8)
+    for soil, n in cases:
+        floor = build_model(scene("winkler", n))
+        A, f = plate_matrix("bed", floor)
+        Ac = to_cvxopt(A)
+        raw_t, solve_t, info = [], [], {}
+        for _ in range(args.repeats):
+            raw_t.append(cpu(lambda: raw_cholmod(Ac, f))[0])
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                t, res = cpu(lambda: pq.solve(scene(soil, n), accuracy=1e-8))
+            solve_t.append(t)
+            info = dict(route=f"{res.backend}/{res.formulation}", status=res.status.value, kkt_worst=res.kkt.worst,
+                        contacts=int(res.model.contacts.m), in_contact=int(res.active.sum()),
+                        soil_unknowns=int(res.model.n_soil), build_s=res.times.get("build", float("nan")))
+        raw, solve = statistics.median(raw_t), statistics.median(solve_t)
+        rows.append(dict(soil=soil, mesh=n, dofs=A.shape[0], raw_s=raw, solve_s=solve, solve_ratio=solve / raw, **info))
+        print(f"{soil:10s} {n:4d}  raw {raw:.3g} s  solve {solve:.3g} s  ratio {solve / raw:.1f}  "
+              f"{info['route']} {info['status']} kkt {info['kkt_worst']:.1e}", flush=True)
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame(rows).to_csv(out, index=False)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
