@@ -293,7 +293,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             if keep is not None:
                 remember(kept(), keep)
     if out is None:
-        W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k))
+        W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k_penalty))  # κ times the row's softest unknown at most
         spring = None
         if schur is not None and settings["factor"] == "auto" and _trailing_pays(schur):
             # the exact steps on the anchored factorisation, its trailing block replaced

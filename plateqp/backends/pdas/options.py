@@ -22,7 +22,9 @@ ACCURACY: dict[str, dict[str, float]] = {
 #: :method: "auto" (condensed where it applies, else sparse), "condensed", "sparse".
 #: :max_dense: the condensed method only if the rows touch at most this many dofs; "auto":
 #:                :data:`MAX_DENSE_AUTO`.
-#: :penalty: κ (sparse): a rigid row's spring in ``H_A`` is κ times its local stiffness.
+#: :penalty: κ (sparse): a rigid row's spring in ``H_A`` is κ times its local stiffness (on a
+#:                row that reads several unknowns, at most twice its softest unknown's:
+#:                :func:`.reduced.penalty_stiffness`).
 #: :prox: σ (sparse): ``H_A`` includes σ diag(K) (definite for a floating plate).
 #: :factor: (sparse) "cholmod" (scikit-sparse: analysis re-used, rank-k updates),
 #:                "cvxopt" (CHOLMOD in cvxopt's wheels: analysis re-used, a numeric

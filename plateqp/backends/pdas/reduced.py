@@ -19,7 +19,14 @@ from ..base import QP
 #: rigid motions from its coordinates: about 1e-15 at 128²).
 NULL_ROUNDING = 1e-10
 
-__all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "heave_force", "infeasible", "natural_residuals"]
+__all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "heave_force", "infeasible", "natural_residuals",
+           "penalty_stiffness"]
+
+#: A rigid row's penalty spring puts at most PENALTY_SOFT · κ K_jj on each unknown j it reads
+#: (:func:`penalty_stiffness`): ε κ PENALTY_SOFT lost on that unknown's pivot. Above 1 so that
+#: a row whose weight sits on one unknown (a DKT row at a node: k and K_jj/B_ij² an ulp apart)
+#: keeps its spring to the bit.
+PENALTY_SOFT = 2.0
 
 #: A step is exact when its residuals are within this many ε of the terms that make them
 #: (:func:`at_rounding`).
@@ -36,6 +43,27 @@ def _leading_block(P: sp.csc_matrix, keep: np.ndarray) -> sp.csc_matrix:
         if K is not None:
             return K
     return P[keep][:, keep].tocsc()
+
+
+def penalty_stiffness(B: sp.csr_matrix, Kd: np.ndarray, k: np.ndarray) -> np.ndarray:
+    """The stiffness a rigid row's penalty spring is κ times (:func:`.driver.pdas`): the row's
+    local stiffness ``k_i = Σ_j B_ij² K_jj``, but on a row that reads several unknowns at most
+    ``PENALTY_SOFT · min_j K_jj / B_ij²`` (its softest unknown's stiffness in the row's units).
+
+    The spring ``W B_iᵀB_i`` ties the row's unknowns together; where the factor eliminates one
+    of them before another, the other's pivot becomes ``K_bb + W B_b² − (W B_a B_b)²/(K_aa +
+    W B_a²)``, and the cancellation loses ``ε W B_b²`` on it: against ``K_bb``, ``ε κ`` (as on a
+    row of one unknown, which cancels nothing) only while ``W B_b²`` is about ``κ K_bb`` at most.
+    A bed row of a soil with unknowns of its own reads ``w − v``, the plate's stiff dof beside
+    the soil's soft one (``K_ww / K_vv`` = 3e4 on a Pasternak soil at 16², 3e5 at 48²); with
+    ``W = κ (K_ww + K_vv)`` the soil's pivots lost ``ε κ K_ww``: the refinement's steps then
+    contracted only by 1/60 at 16² (by 1/3 with κ = 1e10: rounding, not the method) and at 24²
+    (κ = 1e10) or 48² (κ = 1e8) the factor was not definite. Rows on one unknown, and the
+    interpolated posts' rows of the ACM, BFS and DKT elements (weights at most 1 on unknowns
+    of like stiffness), keep ``k_i``."""
+    nnz = np.diff(B.indptr)
+    soft = np.minimum.reduceat(Kd[B.indices] / B.data**2, B.indptr[:-1])  # every row has an entry
+    return np.where(nnz > 1, np.minimum(k, PENALTY_SOFT * soft), k)
 
 
 class ReducedQP:
@@ -105,6 +133,7 @@ class ReducedQP:
         # local stiffness of each row, Σ_j B_ij² K_jj: that kind reads the diagonal alone
         self.k = row_stiffness(sp.diags(Kd), self.B, "diagonal")
         self.c = self.k / (1.0 + self.rho * self.k)  # in series with the row's spring
+        self.k_penalty = penalty_stiffness(self.B, Kd, self.k)
         self.P, self.q = P, qp.q
         self._null, self._null_checked = qp.null, False
         self._src = (qp.P, qp.G, G, max_rows, qp.null)  # what :meth:`again` compares
