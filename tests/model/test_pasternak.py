@@ -258,3 +258,20 @@ def test_a_sweep_of_a_pasternak_bed_gives_what_cold_solves_give(path, values):
     for v, row in zip(values, out.rows):
         cold = pq.solve(set_param(base, path, v), accuracy=1e-10)
         np.testing.assert_allclose(row["reactions"], cold.reactions, rtol=0, atol=1e-8 * np.abs(cold.reactions).max())
+
+
+def test_a_large_pasternak_bed_starts_from_a_coarse_meshs_contact_set():
+    """4225 rows on a 64² Pasternak bed: backend "auto" starts pdas from the 16² mesh's set (its
+    rows are rigid, its soil unknowns soft: a coarse set is close); the answer is a cold
+    start's, with fewer factorisations."""
+    sc = pq.Scene(plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(64, 64),
+                  edges={"left": "simple", "right": "simple"},
+                  loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
+                  foundation=pq.Foundation(model="pasternak", k=2.0e4, shear=2.0e2,
+                                           gap={"profile": "linear", "g0": 0.0, "gx": 0.004, "gy": 0.0}))
+    res = pq.solve(sc, accuracy=1e-8)
+    cold = pq.solve(sc, accuracy=1e-8, options={"predict": False})
+    assert res.kkt.ok and cold.kkt.ok
+    assert res.extras["predicted"]["mesh"] == [16, 16]
+    assert res.extras["factorisations"] < cold.extras["factorisations"]
+    np.testing.assert_allclose(res.reactions, cold.reactions, rtol=0, atol=1e-7 * np.abs(cold.reactions).max())
