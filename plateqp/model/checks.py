@@ -220,7 +220,7 @@ SOIL_MODELS = {"winkler": ("k",), "pasternak": ("k", "shear"), "halfspace": ("E"
 def check_soil_model(sc, f) -> None:
     """The soil model's name and its parameters: each one it takes present and physical
     (``k`` > 0, ``shear`` ≥ 0, ``E`` > 0, −1 < ``nu`` ≤ 0.5), none it does not take."""
-    if f.model not in SOIL_MODELS:
+    if not isinstance(f.model, str) or f.model not in SOIL_MODELS:
         sc._fail("foundation.model", f"unknown soil model {_short(f.model)}; choose one of {list(SOIL_MODELS)}")
     takes = SOIL_MODELS[f.model]
     for key in ("k", "shear", "E", "nu"):
