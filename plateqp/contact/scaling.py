@@ -93,11 +93,10 @@ class Scaled:
         if modes.shape[1]:
             modes = modes / np.linalg.norm(modes, axis=0)
         data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, order == 0, model.K, c.B,
-                   w_load=W_load / W, spacing=contact_spacing(model) / L, derived=model.derived, memo=memo)
+                   w_load=W_load / W, spacing=contact_spacing(model) / L, derived=model.derived, memo=memo,
+                   soil=soil_of(model))
         if memo is not None:  # K̃ = S K S / (F0 W) and B̃ = B S / W do not depend on W (S ∝ W, F0 ∝ W)
             memo.update(K=K, B=B, modes=modes, is_w=data.is_w, spacing=data.spacing, per_W=S / W)
-        if model.n_soil:
-            data.soil = model.scene.foundation.model
         check_distinct_contacts(data, model)
         return data
 
@@ -113,9 +112,7 @@ class Scaled:
         S = W * memo["per_W"]
         data = cls(memo["K"], S * model.f / (F0 * W), memo["B"], c.g0 / W, c.rho * p.D / L**2, S, L, W, F0,
                    memo["modes"], memo["is_w"], model.K, c.B, w_load=W_load / W, spacing=memo["spacing"],
-                   derived=model.derived, memo=memo)
-        if model.n_soil:
-            data.soil = model.scene.foundation.model
+                   derived=model.derived, memo=memo, soil=soil_of(model))
         check_distinct_contacts(data, model)
         return data
 
@@ -157,6 +154,11 @@ def structure(model: Model) -> dict | None:
     value: dict = {}
     model.derived.append((K, B, "structure", value))
     return value
+
+
+def soil_of(model: Model) -> str | None:
+    """The soil model whose surface has unknowns among K's (:attr:`Scaled.soil`), or None."""
+    return model.scene.foundation.model if model.n_soil else None
 
 
 def contact_spacing(model: Model) -> np.ndarray:

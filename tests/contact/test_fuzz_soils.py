@@ -25,27 +25,7 @@ from hypothesis import strategies as st  # noqa: E402
 
 import plateqp as pq  # noqa: E402
 
-from plateqp.cli import main  # noqa: E402
-
-def run(path: Path, *extra: str) -> tuple[int, str, str]:
-    import contextlib
-    import io
-
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main(["solve", str(path), "--json", *extra])
-    return code, out.getvalue(), err.getvalue()
-
-
-def check(code: int, out: str, err: str) -> None:
-    assert code in (0, 2, 3, 4, 5), (code, err)
-    assert "Traceback" not in err, err
-    if code in (2, 3, 4):
-        lines = err.strip().splitlines()
-        assert len(lines) == 1 and lines[0].startswith("plateqp: "), err
-    if code in (0, 5):
-        assert json.loads(out)["status"] in {s.value for s in pq.Status}
-
+from test_fuzz import check, run  # noqa: E402  (the same promises, the same runner)
 
 EXAMPLES = int(os.environ.get("PLATEQP_FUZZ_EXAMPLES", "120"))
 FUZZ = settings(max_examples=EXAMPLES, deadline=None, derandomize="PLATEQP_FUZZ_EXAMPLES" not in os.environ,
