@@ -185,6 +185,7 @@ def cmd_sweep(args) -> int:
         check_file(args.out, force=args.force, label=f"--out {args.out}", flag="--force")
     with _sigterm_as_interrupt() as seen, contextlib.ExitStack() as stack:
         executor, workers = _executor(args, stack)
+        res = None
         try:
             with _stdout_to_stderr():
                 if args.exact:
@@ -194,6 +195,7 @@ def cmd_sweep(args) -> int:
                                 accuracy=args.accuracy, options=opts, executor=executor, max_workers=workers,
                                 refine_breakpoints=not args.no_refine, rtol=args.rtol,
                                 warm_start=not args.no_warm_start, store=args.store)
+            seen.armed = False  # every value is done: a SIGTERM from here on waits for the rows' output
         except SweepInterrupted as exn:
             part = exn.result
             _write_netcdf(part, args.out, args.force)
@@ -202,16 +204,24 @@ def cmd_sweep(args) -> int:
             sys.stdout.flush()
             left = part.interrupted["not_done"]
             where = 'JSON, with "interrupted"' if args.json else "the table"
-            print(f"plateqp: sweep interrupted ({'SIGTERM' if seen else 'Ctrl-C'}), workers stopped: the"
+            print(f"plateqp: sweep interrupted ({'SIGTERM' if seen.signals else 'Ctrl-C'}), workers stopped: the"
                   f" {part.interrupted['done']} of {part.interrupted['of']} values done are on standard output"
                   f" ({where}); not done: {len(left)}"
                   + (f" (from {args.param} = {left[0]})" if left else ""), file=sys.stderr)
-            return 143 if seen else 130
-    _write_netcdf(res, args.out, args.force)
-    if args.json:
-        print(json.dumps({"method": "none" if args.no_refine else "bisection", **res.to_dict()}, indent=1))
-    else:
-        print(res)
+            return 143 if seen.signals else 130
+        except KeyboardInterrupt:
+            if res is None:
+                raise
+            seen.signals.append(None)  # the stop came between the last value and the disarming
+        _write_netcdf(res, args.out, args.force)
+        if args.json:
+            print(json.dumps({"method": "none" if args.no_refine else "bisection", **res.to_dict()}, indent=1))
+        else:
+            print(res)
+    if seen.signals:  # a stop came after the last value: the whole sweep is on standard output
+        print(f"plateqp: stopped after the sweep's {len(res.rows)} values were done: they are all on standard "
+              "output", file=sys.stderr)
+        return 143
     bad = [r for r in res.rows if r["status"] != Status.OPTIMAL.value]
     if bad:
         print(f"plateqp: sweep: {len(bad)} of {len(res.rows)} values failed or missed the asked accuracy "
@@ -239,14 +249,18 @@ def _write_netcdf(res, out, force: bool) -> None:
 @contextlib.contextmanager
 def _sigterm_as_interrupt():
     """While the block runs, SIGTERM raises KeyboardInterrupt (so a sweep stops its workers and
-    keeps its rows, as on Ctrl-C); yields a list that is non-empty once SIGTERM came."""
+    keeps its rows, as on Ctrl-C) while the yielded state is ``armed``; once disarmed (the sweep
+    is done) a SIGTERM is only recorded, so that the rows' output is written whole. The state's
+    ``signals`` is non-empty once SIGTERM came."""
     import signal
+    from types import SimpleNamespace
 
-    seen: list = []
+    seen = SimpleNamespace(signals=[], armed=True)
 
     def on_term(signum, frame):
-        seen.append(signum)
-        raise KeyboardInterrupt
+        seen.signals.append(signum)
+        if seen.armed:
+            raise KeyboardInterrupt
 
     try:
         old = signal.signal(signal.SIGTERM, on_term)
