@@ -48,6 +48,10 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     (:func:`plateqp.contact.routing.fallback_routes`); ``extras["route"]`` says which route
     answered and why each one before it stopped. The first route runs exactly as without it.
     """
+    if model.soil_flexibility is not None:  # a half-space held matrix-free: solved in the contact forces
+        from .pressures import solve_pressures
+
+        return solve_pressures(model, backend, formulation, accuracy, options, check_statics)
     acc = Accuracy.parse(accuracy)  # ProblemError for a bad one, before any work
     options = dict(options or {})
     predict = options.pop("predict", "auto")  # the pipeline's own option, never the backend's
@@ -351,6 +355,10 @@ def solve_bilateral(model: Model) -> Result:
     Solves the sparse saddle-point system [K Bᵀ; B −ρ] (u, R) = (f, g0), which works for a
     floating plate too (as long as the supports hold it).
     """
+    if model.soil_flexibility is not None:  # a half-space held matrix-free: the same system by CG
+        from .pressures import solve_bonded
+
+        return solve_bonded(model)
     t0 = time.perf_counter()
     data = Scaled.from_model(model)
     try:
