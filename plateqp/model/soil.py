@@ -236,13 +236,12 @@ def attach(model, bed_rows: np.ndarray, nodes: np.ndarray, area: np.ndarray) -> 
 
 def halfspace_operator(model, nodes: np.ndarray):
     """H_F of the bed ``nodes`` as an operator (the mesh's own matrix-free route:
-    ``mesh.halfspace_operator``), or None where the mesh offers none or the bed is small enough
-    for the soil's unknowns (:data:`HALFSPACE_OPERATOR_FROM`)."""
+    ``mesh.halfspace_flexibility_operator``), or None where the mesh offers none or the bed is
+    small enough for the soil's unknowns (:data:`HALFSPACE_OPERATOR_FROM`)."""
     fnd = model.scene.foundation
-    make = getattr(model.grid, "halfspace_operator", None)
-    if fnd.model != "halfspace" or nodes.size <= HALFSPACE_OPERATOR_FROM or make is None:
+    if fnd.model != "halfspace" or nodes.size <= HALFSPACE_OPERATOR_FROM:
         return None
-    return make(fnd.region, fnd.E, fnd.nu, nodes)
+    return model.grid.halfspace_flexibility_operator(fnd.region, fnd.E, fnd.nu, nodes)
 
 
 def attach_operator(model, bed_rows: np.ndarray, nodes: np.ndarray, H) -> None:
