@@ -187,29 +187,39 @@ class BedFlexibility(LinearOperator):
             out[:, c0:c0 + cols] = self._apply(X[:, c0:c0 + cols].T, symmetric).T
         return out
 
+    def _forward(self, f: np.ndarray) -> np.ndarray:
+        """The transform of ``f`` (..., rows, cols) zero-padded to :attr:`fft_shape` (its zero rows
+        skipped along x: rfft2's value)."""
+        Ny, Nx = self.fft_shape
+        return scipy.fft.fft(scipy.fft.rfft(f, n=Nx, axis=-1), n=Ny, axis=-2)
+
+    def _inverse(self, F: np.ndarray, rows: int, cols: int) -> np.ndarray:
+        """The first ``rows`` × ``cols`` of the inverse transform of ``F`` (irfft2's, the other rows
+        not transformed along x)."""
+        return scipy.fft.irfft(scipy.fft.ifft(F, axis=-2)[..., :rows, :], n=self.fft_shape[1], axis=-1)[..., :cols]
+
     def _apply(self, X: np.ndarray, symmetric: bool) -> np.ndarray:
         """(k, m) ½(H + Hᵀ) (``symmetric``) or H applied to the rows of ``X`` (k, m)."""
-        ny, nx, shape = self.ny, self.nx, self.fft_shape
+        ny, nx = self.ny, self.nx
         k = X.shape[0]
         Y = np.zeros((k, (ny + 1) * (nx + 1)))
         Y[:, self.nodes] = X
         Y = Y.reshape(k, ny + 1, nx + 1)
         u = Y * self._inv_area
-        fields = np.zeros((k, 5 if symmetric else 4) + shape)
-        for q, (a, b) in enumerate(QUARTERS):
-            fields[:, q, :ny, :nx] = np.where(self._active[q], u[:, b:b + ny, a:a + nx], 0.0)
-        if symmetric:
-            fields[:, 4, :ny + 1, :nx + 1] = Y
-        spectra = scipy.fft.rfft2(fields)
-        del fields
-        Hx = scipy.fft.irfft2(np.einsum("kqyx,qyx->kyx", spectra[:, :4], self._kernel_hat), s=shape)
-        Hx = Hx[:, :ny + 1, :nx + 1]
+        P = np.stack([np.where(self._active[q], u[:, b:b + ny, a:a + nx], 0.0) for q, (a, b) in enumerate(QUARTERS)],
+                     axis=1)
+        spectra = self._forward(P)
+        del P
+        spectra *= self._kernel_hat
+        Hx = self._inverse(spectra.sum(axis=1), ny + 1, nx + 1)
         if not symmetric:
             return Hx.reshape(k, -1)[:, self.nodes]
-        quarters = np.empty((k, 4, ny, nx))
-        for q in range(4):  # the correlations of Y with each kernel: the conjugate transform
-            quarters[:, q] = scipy.fft.irfft2(spectra[:, 4] * self._kernel_hat[q].conj(), s=shape)[:, :ny, :nx]
-        HTy = self._scatter(np.where(self._active, quarters, 0.0)) * self._inv_area
+        # Hᵀ: the correlation of Y with k_ab, which is the convolution with k_a'b' (a' = 1 − a,
+        # b' = 1 − b: k_ab(d) = k_a'b'(1 − d), the quarters mirrored) read one node further on
+        spectra = self._forward(Y)[:, None] * self._kernel_hat[::-1]
+        corr = self._inverse(spectra, ny + 1, nx + 1)[:, :, 1:, 1:]
+        del spectra
+        HTy = self._scatter(np.where(self._active, corr, 0.0)) * self._inv_area
         return 0.5 * (Hx + HTy).reshape(k, -1)[:, self.nodes]
 
 
