@@ -46,7 +46,8 @@ from ..errors import ProblemError
 from .halfspace import boussinesq_factor, polygon_potential
 from .soil import region_cells
 
-#: The quarters of a cell, (a, b): the corner they touch along x and along y.
+#: The quarters of a cell, (a, b): the corner they touch along x and along y; in reverse order
+#: each quarter's mirror (1 − a, 1 − b), whose kernel is k_ab(1 − d) (:func:`quarter_kernels`).
 QUARTERS = ((0, 0), (1, 0), (0, 1), (1, 1))
 #: Points of one block of the kernels' evaluation: its temporaries stay near 2 MB each.
 BLOCK = 2**18
@@ -214,9 +215,9 @@ class BedFlexibility(LinearOperator):
         Hx = self._inverse(spectra.sum(axis=1), ny + 1, nx + 1)
         if not symmetric:
             return Hx.reshape(k, -1)[:, self.nodes]
-        # Hᵀ: the correlation of Y with k_ab, which is the convolution with k_a'b' (a' = 1 − a,
-        # b' = 1 − b: k_ab(d) = k_a'b'(1 − d), the quarters mirrored) read one node further on
-        spectra = self._forward(Y)[:, None] * self._kernel_hat[::-1]
+        # Hᵀ: the correlation of Y with k_ab, which is the convolution with its mirror's kernel
+        # (k_ab(d) = k_a'b'(1 − d), a' = 1 − a, b' = 1 − b) read one node further on
+        spectra = self._forward(Y)[:, None] * self._kernel_hat[::-1]  # the mirrors (QUARTERS reversed)
         corr = self._inverse(spectra, ny + 1, nx + 1)[:, :, 1:, 1:]
         del spectra
         HTy = self._scatter(np.where(self._active, corr, 0.0)) * self._inv_area
