@@ -227,11 +227,13 @@ def load_vector(scene: Scene, mesh, element, cell_dofs: np.ndarray, n_full: int)
     return f
 
 
-def build_model(scene: Scene) -> Model:
+def build_model(scene: Scene, soil_operator: bool | None = None) -> Model:
     """Mesh a scene (after :func:`check_memory`: a mesh too large for the machine is refused
     before any allocation) and assemble its stiffness on the free dofs (``mesh.assemble``), its
     loads (:func:`load_vector`), its two-sided supports (:func:`plateqp.model.constraints.prescribed`)
-    and its contact operator; the same steps on every mesh."""
+    and its contact operator; the same steps on every mesh. ``soil_operator``: a half-space bed
+    held matrix-free (True: wherever the mesh offers the operator; False: never; None: above
+    :data:`plateqp.model.soil.HALFSPACE_OPERATOR_FROM` bed nodes)."""
     check_memory(scene)
     mesh = mesh_generator(scene).from_scene(scene)
     el = ELEMENTS[scene.mesh.element]()
@@ -264,7 +266,7 @@ def build_model(scene: Scene) -> Model:
     if couples(scene.foundation):
         c = model.contacts
         rows = np.flatnonzero(c.source == "bed")
-        H = halfspace_operator(model, c.index[rows])
+        H = halfspace_operator(model, c.index[rows], soil_operator)
         if H is not None:
             attach_operator(model, rows, c.index[rows], H)
         else:

@@ -234,12 +234,13 @@ def attach(model, bed_rows: np.ndarray, nodes: np.ndarray, area: np.ndarray) -> 
     model.soil_nodes = nodes
 
 
-def halfspace_operator(model, nodes: np.ndarray):
+def halfspace_operator(model, nodes: np.ndarray, wanted: bool | None = None):
     """H_F of the bed ``nodes`` as an operator (the mesh's own matrix-free route:
-    ``mesh.halfspace_flexibility_operator``), or None where the mesh offers none or the bed is
-    small enough for the soil's unknowns (:data:`HALFSPACE_OPERATOR_FROM`)."""
+    ``mesh.halfspace_flexibility_operator``), or None where the mesh offers none, where not
+    ``wanted``, or (``wanted`` None) where the bed is small enough for the soil's unknowns
+    (:data:`HALFSPACE_OPERATOR_FROM`)."""
     fnd = model.scene.foundation
-    if fnd.model != "halfspace" or nodes.size <= HALFSPACE_OPERATOR_FROM:
+    if fnd.model != "halfspace" or wanted is False or (wanted is None and nodes.size <= HALFSPACE_OPERATOR_FROM):
         return None
     return model.grid.halfspace_flexibility_operator(fnd.region, fnd.E, fnd.nu, nodes)
 
