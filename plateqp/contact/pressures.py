@@ -35,6 +35,7 @@ import warnings
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
 
 from ..accuracy import Accuracy, Status
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError
@@ -52,6 +53,11 @@ BACKENDS = ("auto", "mprgp")
 TOL_SHARE = 0.1
 #: tighter re-solves (from the answer in hand) while the check fails but the solver converged
 RETRIES = 2
+#: at least this many contact rows: start from the solve of the mesh with half the cells a side
+#: (its contact forces interpolated: the set moves little under refinement)
+START_MIN = 2000
+#: a rigid post's spring in the preconditioner's sparse soil: this many times its stiffest
+RIGID = 100.0
 
 
 class PressureProblem:
@@ -105,6 +111,74 @@ class PressureProblem:
         return ContactSolution(u, R, s)
 
 
+def soil_fit(model, data: Scaled) -> sp.csr_matrix:
+    """S̃, the scaled stiffness of a sparse soil that resembles the half-space: Pasternak's
+    k diag(A) + c2 L with the pressure symbol k + c2 ξ² equal to the half-space's (E/(1 − ν²)/2)·|ξ|
+    at the bed's lowest and highest wavenumbers (π over its size, π over a cell), so that the two
+    differ by at most ½√(ξ₂/ξ₁) between; the posts' springs (a rigid one: :data:`RIGID` × the
+    stiffest). For :func:`preconditioner`."""
+    from ..model.soil import shear_laplacian
+
+    fnd, p = model.scene.foundation, model.scene.plate
+    rows, nodes = model.soil_rows, model.soil_nodes
+    area = model.bed_areas()[nodes]
+    a = fnd.E / (1.0 - fnd.nu**2) / 2.0
+    xi1, xi2 = np.pi / np.sqrt(area.sum()), np.pi / np.sqrt(np.median(area))
+    c2, k = a / (xi1 + xi2), a * xi1 * xi2 / (xi1 + xi2)
+    Sb = (c2 * shear_laplacian(model, nodes) + sp.diags(k * area)).tocoo()
+    to_scaled = max(p.a, p.b) ** 2 / p.D  # a stiffness: the inverse of ρ's scaling
+    diag = np.zeros(data.m)
+    others = np.setdiff1d(np.arange(data.m), rows)
+    if others.size:
+        soft = data.rho[others] > 0
+        stiff = max(to_scaled * Sb.diagonal().max(), (1.0 / data.rho[others][soft]).max(initial=0.0))
+        diag[others] = np.where(soft, 1.0 / np.where(soft, data.rho[others], 1.0), RIGID * stiff)
+    S = sp.csr_matrix((to_scaled * Sb.data, (rows[Sb.row], rows[Sb.col])), shape=(data.m, data.m))
+    return (S + sp.diags(diag)).tocsr()
+
+
+def preconditioner(model, data: Scaled):
+    """v ↦ P⁻¹ v with P = B K⁻¹ Bᵀ + S̃⁻¹ (:func:`soil_fit`'s soil in place of the half-space):
+    by Woodbury's identity P⁻¹ = S̃ − S̃ B (K + Bᵀ S̃ B)⁻¹ Bᵀ S̃, one sparse factorisation (the
+    plate on the fitted soil, definite even for a floating plate), no dense matrix."""
+    S = soil_fit(model, data)
+    B = data.B.tocsr()
+    fac = Factor((data.K + B.T @ S @ B).tocsc())
+    BT = B.T.tocsr()
+
+    def apply(v: np.ndarray) -> np.ndarray:
+        y = S @ v
+        return y - S @ (B @ fac.solve(BT @ y, refine=0))
+    return apply
+
+
+def coarse_start(model, accuracy) -> np.ndarray | None:
+    """The contact forces of the mesh with half the cells a side (solved matrix-free, itself
+    started so while it is large enough), as pressures interpolated linearly to this model's
+    rows × their areas; None where that mesh cannot be built or solved."""
+    from scipy.interpolate import LinearNDInterpolator
+
+    from ..estimate import COARSE_FAILURES, with_mesh
+    from ..model.assembly import build_model
+    from ..model.generators import mesh_cells
+
+    nx, ny = mesh_cells(model.scene)
+    try:
+        coarse_model = build_model(with_mesh(model.scene, max(1, nx // 2), max(1, ny // 2)), soil_operator=True)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PlateQPWarning)
+            coarse = solve_pressures(coarse_model, accuracy=max(Accuracy.parse(accuracy).tol, 1e-6))
+    except (*COARSE_FAILURES, NoEquilibriumError):
+        return None
+    if not coarse.status.solved or coarse_model.soil_flexibility is None:
+        return None
+    cc = coarse_model.contacts
+    p = coarse.reactions / coarse_model.bed_areas()[cc.index]
+    c = model.contacts
+    at = LinearNDInterpolator(cc.xy, np.maximum(p, 0.0), fill_value=0.0)(c.xy)
+    return np.nan_to_num(at) * model.bed_areas()[c.index] * (c.source == "bed")
+
+
 def _pins(data: Scaled) -> np.ndarray:
     """One deflection dof per rigid motion, chosen so that no rigid motion leaves them all at rest
     (pivoted QR of the motions' deflections): K without them is positive definite."""
@@ -130,9 +204,12 @@ def solve_pressures(model, backend: str = "auto", formulation: str = "auto",
                     accuracy: str | float | Accuracy = "default", options: dict | None = None,
                     check_statics: bool = True) -> Result:
     """:func:`plateqp.contact.pipeline.solve_contact` for a model whose half-space is held
-    matrix-free: the module's QP, solved and checked. ``options``: ``maxiter`` (the solver's
-    iterations, default 20 000), ``x0`` (a start of the forces, user units)."""
-    from ..backends.mprgp import solve_bound_qp
+    matrix-free: the module's QP, solved and checked. ``backend``: "auto" (the active-set PCG of
+    :mod:`plateqp.backends.active_pcg`, preconditioned by the plate on a fitted sparse soil
+    (:func:`preconditioner`), MPRGP from its answer where it does not settle) or "mprgp" (MPRGP
+    alone). ``options``: ``maxiter`` (products, default 20 000), ``x0`` (a start of the forces,
+    user units; default from the mesh with half the cells a side where there are at least
+    :data:`START_MIN` rows)."""
     from .pipeline import to_result
 
     check_backend(backend, formulation)
@@ -150,11 +227,15 @@ def solve_pressures(model, backend: str = "auto", formulation: str = "auto",
     if check_statics and not reach.possible and not reach.marginal:
         raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({reach.why}; found by statics, before any solve)")
     pr = PressureProblem(data)
-    t1 = time.perf_counter()
+    if x0 is None and data.m >= START_MIN:
+        x0 = coarse_start(model, acc)
     start = None if x0 is None else np.maximum(np.asarray(x0, dtype=float) / data.F0, 0.0)
-    tol = TOL_SHARE * acc.tol
+    t1 = time.perf_counter()
+    method = "mprgp" if backend == "mprgp" else "pdas-pcg"
+    solver = _Solver(model, data, pr, maxiter)
+    tol, said = TOL_SHARE * acc.tol, []
     for attempt in range(RETRIES + 1):
-        out = solve_bound_qp(pr.matvec, pr.q, lb=0.0, G=pr.G, b=pr.b, x0=start, tol=tol, maxiter=maxiter)
+        method, out = solver.run(method, start, tol, said)
         c = pr.recover(out.x, out.alpha)
         rep = kkt_report(data, c, acc)
         if rep.ok or out.status != "optimal":
@@ -165,18 +246,49 @@ def solve_pressures(model, backend: str = "auto", formulation: str = "auto",
     t2 = time.perf_counter()
     status = (Status.OPTIMAL if rep.ok else Status.INACCURATE) if out.status == "optimal" else (
         Status.MAX_ITER if out.status == "max_iter" else Status.INACCURATE)
-    res = to_result(model, data, c, status, "mprgp", "condensed", acc)
+    res = to_result(model, data, c, status, method, "condensed", acc)
     res.kkt = rep
-    res.iterations = out.iterations
-    res.extras = {"solver_status": out.status, "matvecs": pr.matvecs, "route": {"answered": "mprgp/condensed"},
-                  "soil": "half-space held matrix-free"}
+    res.iterations = solver.iterations
+    res.extras = {"solver_status": out.status, "matvecs": pr.matvecs, "route": {"answered": f"{method}/condensed",
+                  "tried": said}, "soil": "half-space held matrix-free", "started": "given" if x0 is not None else "cold"}
     res.times.update(formulate=t1 - t0, solve=t2 - t1, recover=time.perf_counter() - t2)
     if status != Status.OPTIMAL:
-        why = (f"{out.status} after {out.iterations} iterations; worst KKT residual {rep.worst:.2e}, "
-               f"asked {rep.tol:.0e}")
+        why = f"{out.status}: {out.message}; worst KKT residual {rep.worst:.2e}, asked {rep.tol:.0e}"
         res.extras["why"] = f"{status.value}: {why}"
-        warnings.warn(f"mprgp on the condensed problem: {status.value} ({why})", PlateQPWarning, stacklevel=4)
+        warnings.warn(f"{method} on the condensed problem: {status.value} ({why})", PlateQPWarning, stacklevel=4)
     return res
+
+
+class _Solver:
+    """The solvers of :func:`solve_pressures` on one problem: the active-set PCG (its
+    preconditioner built once), MPRGP from its answer where it does not settle."""
+
+    def __init__(self, model, data: Scaled, pr: PressureProblem, maxiter: int) -> None:
+        self.model, self.data, self.pr, self.maxiter = model, data, pr, maxiter
+        self.precond = None
+        self.iterations = 0
+
+    def run(self, method: str, start, tol: float, said: list):
+        from ..backends.active_pcg import active_set_pcg
+        from ..backends.mprgp import solve_bound_qp
+
+        pr, d = self.pr, self.data
+        if method == "pdas-pcg":
+            if self.precond is None:
+                self.precond = preconditioner(self.model, d)
+            c = 1.0 / np.mean(d.rho[self.model.soil_rows])  # the soil's point stiffness
+            out = active_set_pcg(pr.matvec, pr.q, precond=self.precond, G=pr.G, b=pr.b, x0=start, c=c, tol=tol,
+                                 maxiter=self.maxiter - pr.matvecs)
+            self.iterations += out.iterations
+            said.append({"method": method, "status": out.status, "why": out.message})
+            if out.status == "optimal":
+                return method, out
+            method, start = "mprgp", out.x
+        out = solve_bound_qp(pr.matvec, pr.q, lb=0.0, G=pr.G, b=pr.b, x0=start, tol=tol,
+                             maxiter=max(self.maxiter - pr.matvecs, 1))
+        self.iterations += out.iterations
+        said.append({"method": "mprgp", "status": out.status, "why": out.message})
+        return "mprgp", out
 
 
 #: the bonded comparison's tolerance (the solver's, in gap units of the deflection scale)

@@ -128,20 +128,26 @@ def _bed_cells(model, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return cells[keep], corners[keep]
 
 
-def pasternak_stiffness(model, nodes: np.ndarray, area: np.ndarray) -> sp.csr_matrix:
-    """K_s = k diag(area) + c2 L over the soil's unknowns at ``nodes`` (mesh node numbers, the
-    bed's contact order) with tributary ``area``; L the shear layer's Laplacian (the module's
-    text). Exactly symmetric."""
-    fnd = model.scene.foundation
+def shear_laplacian(model, nodes: np.ndarray) -> sp.csr_matrix:
+    """L, the Laplacian's stiffness ∫∇v·∇v dA over the bed's cells (the module's text) on the
+    soil's points ``nodes``, exactly symmetric."""
     mesh = model.grid
     cells, corners = _bed_cells(model, nodes)
-    Ke = fnd.shear * laplacian_cells(mesh.nodes[mesh.cells[cells]])
+    Ke = laplacian_cells(mesh.nodes[mesh.cells[cells]])
     k = corners.shape[1]
     rows = np.repeat(corners, k, axis=1).ravel()
     cols = np.tile(corners, (1, k)).ravel()
     m = nodes.size
     L = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(m, m))
-    Ks = (L + L.T) * 0.5 + sp.diags(fnd.k * area)
+    return ((L + L.T) * 0.5).tocsr()
+
+
+def pasternak_stiffness(model, nodes: np.ndarray, area: np.ndarray) -> sp.csr_matrix:
+    """K_s = k diag(area) + c2 L over the soil's unknowns at ``nodes`` (mesh node numbers, the
+    bed's contact order) with tributary ``area``; L the shear layer's Laplacian (the module's
+    text). Exactly symmetric."""
+    fnd = model.scene.foundation
+    Ks = fnd.shear * shear_laplacian(model, nodes) + sp.diags(fnd.k * area)
     Ks = Ks.tocsr()
     Ks.sum_duplicates()
     Ks.sort_indices()
