@@ -55,14 +55,17 @@ class ActiveSetResult:
     message: str
 
 
-def _pcg(apply, rhs, x, precond, project, rtol, budget):
+def _pcg(apply, rhs, x, precond, project, rtol, budget, Ax=None):
     """Projected preconditioned CG on the equations apply(x) = rhs (on the current set), from x
-    (feasible for the projection's equalities): x, steps."""
-    r = project(rhs - apply(x))
+    (feasible for the projection's equalities; ``Ax`` its product if known): x, steps. Stops when
+    the residual's preconditioned norm is ``rtol`` of the right-hand side's (estimated by the
+    start's residual and rhs's plain norms: no product spent on it)."""
+    r = project(rhs - (apply(x) if Ax is None else Ax))
     z = project(precond(r))
     p = z.copy()
     rz = r @ z
-    stop = rtol * max(np.sqrt(abs(project(precond(project(rhs))) @ project(rhs))), 1e-300)
+    nr = np.linalg.norm(r)
+    stop = rtol * max(np.sqrt(abs(rz)) * np.linalg.norm(project(rhs)) / max(nr, 1e-300), 1e-300)
     steps = 0
     while np.sqrt(abs(rz)) > stop and steps < budget:
         Ap = apply(p)
@@ -81,9 +84,10 @@ def _pcg(apply, rhs, x, precond, project, rtol, budget):
 
 def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=None, b=None, x0=None,
                    active=None, c: float = 1.0, tol: float = 1e-8, maxiter: int = 20000,
-                   max_outer: int = MAX_OUTER) -> ActiveSetResult:
+                   max_outer: int = MAX_OUTER, precise: Callable | None = None) -> ActiveSetResult:
     """Solve the module's QP; ``active`` (bool, m) or ``x0`` start the set (default: where the
-    gradient at x0, or at 0, is negative). See the module's contract."""
+    gradient at x0, or at 0, is negative); ``precise``: a more accurate (dearer) product for the
+    last solves, once the set has settled. See the module's contract."""
     q = np.asarray(q, dtype=float)
     m = q.size
     k = 0 if G is None else G.shape[1]
@@ -91,9 +95,11 @@ def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=No
     b = np.zeros(0) if G is None else np.asarray(b, dtype=float)
     count = [0]
 
+    product = [matvec]
+
     def M(v):
         count[0] += 1
-        return matvec(v)
+        return product[0](v)
 
     P = precond or (lambda v: v)
     x = np.zeros(m) if x0 is None else np.maximum(np.asarray(x0, dtype=float), 0.0)
@@ -101,6 +107,7 @@ def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=No
     g = M(x) + q
     A = np.asarray(active, dtype=bool).copy() if active is not None else (x - c * g) > 0
     seen, steps, final, status, message = set(), 0, False, "cycled", f"{max_outer} active sets tried"
+    Mx, moved = None, True
     for sets in range(1, max_outer + 1):
         idx = np.flatnonzero(A)
         GA = Gm[idx]
@@ -125,7 +132,9 @@ def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=No
         xa = x[idx]
         if k:  # onto G_Aᵀ x = b
             xa = xa + GA @ np.linalg.solve(GtG, b - GA.T @ xa)
-        xa, n = _pcg(apply, -q[idx], xa, pre, project, 0.1 * tol if final else INNER_RTOL, maxiter - count[0])
+        # the last product is this start's where x is already zero off A (no equality moved it)
+        known = Mx[idx] if (Mx is not None and not moved and not k and not np.any(x[~A])) else None
+        xa, n = _pcg(apply, -q[idx], xa, pre, project, 0.1 * tol if final else INNER_RTOL, maxiter - count[0], known)
         steps += n
         x = np.zeros(m)
         x[idx] = xa
@@ -136,15 +145,21 @@ def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=No
         if count[0] >= maxiter:
             status, message = "max_iter", f"{count[0]} products"
             break
+        moved = False
         if np.array_equal(new, A):
+            if not final:  # settled: solve it again tightly (on the accurate product, if given)
+                final = True
+                if precise is not None:
+                    product[0], moved = precise, True
+                continue
             scale = max(np.linalg.norm(q), np.linalg.norm(Mx), np.linalg.norm(Gm @ alpha), 1e-300)
             natural = np.linalg.norm(np.minimum(x, g)) / scale
             eq = np.linalg.norm(Gm.T @ x - b) / max(np.linalg.norm(b), np.linalg.norm(Gm, 2) * np.linalg.norm(x), 1e-300) if k else 0.0
-            if final and natural <= tol and eq <= tol:
+            if natural <= tol and eq <= tol:
                 status, message = "optimal", f"set settled after {sets} sets, natural residual {natural:.1e}"
                 break
-            final = True
-            continue
+            status, message = "stalled", f"the settled set's natural residual {natural:.1e} stays above {tol:.0e}"
+            break
         key = new.tobytes()
         if key in seen:
             status, message = "cycled", f"an active set came back after {sets} sets"
