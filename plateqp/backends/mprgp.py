@@ -56,7 +56,7 @@ GAMMA = 1.0
 #: Power iterations for ``‖M‖``: at most this many, fewer once the estimate changes by < 1 %.
 POWER_STEPS = 12
 #: SMALBE: the start ``ρ₀ = RHO_START · ‖M‖ / ‖G‖₂²``, the growth factor, and the limit ``ρ / ρ₀``.
-RHO_START, RHO_GROWTH, RHO_LIMIT = 10.0, 10.0, 1e10
+RHO_START, RHO_GROWTH, RHO_LIMIT = 1.0, 10.0, 1e10
 #: SMALBE's inner tolerance: ``‖gᴾ‖ / scale_g ≤ min(ETA, INNER_M · ‖Gᵀx − b‖ / scale_e)``.
 ETA, INNER_M = 1e-1, 1.0
 #: Steps without a new best projected gradient (by 0.1 %) after which the solve is stalled.
