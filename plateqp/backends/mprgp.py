@@ -27,8 +27,9 @@ Contract:
   scaling the problem does not change the answer. ``"unbounded"``: a direction of zero
   curvature and descent that no bound stops was met (``x`` is the last iterate).
   ``"max_iter"``: ``maxiter`` steps taken. ``"stalled"``: the projected gradient made no
-  progress in ``STALL_STEPS`` steps (rounding), or the penalty grew past ``RHO_LIMIT`` times
-  its start (equalities that the bounds make infeasible). ``message`` says why, in one line.
+  progress in ``STALL_STEPS`` steps (rounding), or the equality residual in ``STALL_ROUNDS``
+  rounds, or the penalty grew past ``RHO_LIMIT`` times its start (equalities that the bounds
+  make infeasible). ``message`` says why, in one line.
 - **Cost.** ``matvecs`` counts every call of ``matvec``: the power iterations, one per CG or
   proportioning step, two per expansion step, one per fresh gradient. ``iterations`` counts
   the MPRGP steps of every SMALBE round. No ``m × m`` array is formed; no input is changed.
@@ -61,6 +62,8 @@ RHO_START, RHO_GROWTH, RHO_LIMIT = 1.0, 10.0, 1e10
 ETA, INNER_M = 1e-1, 1.0
 #: Steps without a new best projected gradient (by 0.1 %) after which the solve is stalled.
 STALL_STEPS = 500
+#: SMALBE rounds without a new best equality residual (by 0.1 %) after which the solve is stalled.
+STALL_ROUNDS = 50
 #: A curvature ``pᵀAp ≤ CURVATURE_FLOOR · ‖A‖ ‖p‖²`` counts as zero.
 CURVATURE_FLOOR = 1e-13
 
@@ -308,7 +311,9 @@ def _smalbe(prob: _Problem, y, maxiter, tol, callback):
     normG2 = float(np.linalg.norm(prob.G, 2) ** 2) if k else 0.0
     rho0 = RHO_START * normM / normG2 if k and normM > 0 else (1.0 / normG2 if k else 0.0)
     rd = _Round(prob, rho0, np.zeros(k), normM)
-    steps, rounds, lagr_prev = 0, 0, -np.inf
+    steps, rounds, lagr_prev, best, since = 0, 0, -np.inf, np.inf, 0
+    infeasible = ("stalled: the equality residual stopped falling above tol: the equalities may be "
+                  "infeasible with the bounds")
 
     def on_step(yy):
         nonlocal steps
@@ -341,10 +346,9 @@ def _smalbe(prob: _Problem, y, maxiter, tol, callback):
         lagr = 0.5 * y @ (g + rd.c) + rd.alpha @ prob.b + 0.5 * rd.rho * (prob.b @ prob.b)
         My = g - rd.c - rd.rho * (prob.G @ (prob.G.T @ y))
         rho = rd.rho * RHO_GROWTH if lagr < lagr_prev + 0.5 * rd.rho * (r @ r) else rd.rho
-        if rho > RHO_LIMIT * rho0:
-            return rd, y, g, steps, rounds, "stalled", ("stalled: the penalty grew past its limit with the "
-                                                        "equality residual still above tol: the equalities "
-                                                        "may be infeasible with the bounds")
+        best, since = (float(r @ r), 0) if r @ r < 0.998 * best else (best, since + 1)
+        if rho > RHO_LIMIT * rho0 or since > STALL_ROUNDS:
+            return rd, y, g, steps, rounds, "stalled", infeasible
         lagr_prev = lagr
         rd = _Round(prob, rho, rd.alpha - rd.rho * r, normM)
         g = My + rho * (prob.G @ (prob.G.T @ y)) + rd.c  # the new round's gradient, without a matvec

@@ -396,8 +396,8 @@ def test_an_equality_infeasible_with_the_bounds_is_not_optimal():
     q = rng.standard_normal(25)
     G = np.ones((25, 1))
     res = no_numpy_warnings(lambda: solve_bound_qp(lambda v: M @ v, q, G=G, b=np.array([-1.0]), maxiter=3000))
-    assert res.status in ("stalled", "max_iter")
-    assert "equalit" in res.message
+    assert res.status == "stalled"
+    assert "equalities may be infeasible" in res.message
     assert res.iterations <= 3000
 
 
