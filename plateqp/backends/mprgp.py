@@ -46,7 +46,7 @@ import numpy as np
 
 from ..errors import ProblemError
 
-__all__ = ["BoundQPResult", "solve_bound_qp"]
+__all__ = ["BoundQPResult", "backends", "mprgp_lcp", "solve_bound_qp"]
 
 #: ``ᾱ = ALPHA_FACTOR / ‖A‖``: inside MPRGP's range ``(0, 2/‖A‖]`` with room for the estimate of ``‖A‖``
 #: being low (power iterations approach ``‖A‖`` from below); halved whenever an expansion step
@@ -376,3 +376,43 @@ def solve_bound_qp(matvec: Callable[[np.ndarray], np.ndarray], q, *, lb=0.0, G=N
                          equality_residual=res, equality_scale=se,
                          norm_estimate=rd.normM,
                          rho=rd.rho, outer_iterations=rounds)
+
+
+# -- as a backend: LCP(M, q) with M symmetric positive semidefinite (the condensed and dual forms) ---------
+
+#: The stopping tolerance of each accuracy preset (the contract's rule on ‖gᴾ‖).
+ACCURACY: dict[str, dict[str, float]] = {"low": {"tol": 1e-6}, "default": {"tol": 1e-9}, "high": {"tol": 1e-12}}
+#: Keys accepted in the ``options`` dict of the backend's ``solve``.
+OPTIONS = ("max_iter", "z0") + tuple(ACCURACY["default"])
+#: The products at most, unless ``max_iter`` says otherwise.
+MAX_ITER = 20_000
+
+
+def mprgp_lcp(M, q, max_iter=None, z0=None, *, accuracy="default", tol=None):
+    """LCP(M, q) (M symmetric positive semidefinite) as min ½ zᵀMz + qᵀz, z ≥ 0, by
+    :func:`solve_bound_qp` on the products of M: the backend ``mprgp`` of the standard forms (a
+    half-space held matrix-free is solved in :mod:`plateqp.contact.pressures` instead)."""
+    import time
+
+    import scipy.sparse as sp
+
+    from .base import Status
+    from .lcp import answer, check_int, settings
+
+    t0 = time.perf_counter()
+    s = settings(ACCURACY, accuracy, ("tol",), tol=tol)
+    M = M.toarray() if sp.issparse(M) else np.asarray(M, dtype=float)
+    q = np.asarray(q, dtype=float)
+    limit = MAX_ITER if max_iter is None else check_int("max_iter", max_iter, 1)
+    out = solve_bound_qp(lambda v: M @ v, q, lb=0.0, x0=z0, tol=s["tol"], maxiter=limit)
+    status = {"optimal": Status.OPTIMAL, "max_iter": Status.MAX_ITER, "unbounded": Status.UNBOUNDED}.get(
+        out.status, Status.INACCURATE)
+    return answer(q, out.x, M @ out.x + q, status, t0, out.iterations, out.message,
+                  {"matvecs": out.matvecs, "active": out.x == 0})
+
+
+def backends() -> list:
+    """The backend this module provides: ``mprgp``, iterative, warm-started by ``z0``."""
+    from .lcp import LCPBackend
+
+    return [LCPBackend("mprgp", mprgp_lcp, OPTIONS, exact=False)]

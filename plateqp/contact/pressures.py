@@ -41,6 +41,7 @@ from ..accuracy import Accuracy, Status
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError
 from ..linalg.factor import Factor
 from ..results import Result
+from .answer import to_result
 from .formulations import ContactSolution
 from .kkt import kkt_report
 from .scaling import Scaled
@@ -217,8 +218,6 @@ def solve_pressures(model, backend: str = "auto", formulation: str = "auto",
     alone). ``options``: ``maxiter`` (products, default 20 000), ``x0`` (a start of the forces,
     user units; default from the mesh with half the cells a side where there are at least
     :data:`START_MIN` rows)."""
-    from .pipeline import to_result
-
     check_backend(backend, formulation)
     acc = Accuracy.parse(accuracy)
     options = dict(options or {})
@@ -309,8 +308,6 @@ def solve_bonded(model) -> Result:
     SolverError (the comparison has no accuracy to ask, so it never returns a rough answer)."""
     from ..backends.mprgp import solve_bound_qp
     from ..errors import SolverError
-    from .pipeline import to_result
-
     t0 = time.perf_counter()
     data = Scaled.from_model(model, operator=True)
     pr = PressureProblem(data)

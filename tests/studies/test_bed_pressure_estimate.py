@@ -3,7 +3,6 @@ force between plate and soil over the node's area, on every soil model. On Winkl
 is k × the compression (Winkler's law); a coupled soil's settlement is no spring's compression
 (Pasternak's shear carries load; the half-space has no k at all, which raised TypeError)."""
 
-import numpy as np
 import pytest
 
 import plateqp as pq
