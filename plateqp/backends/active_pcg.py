@@ -105,6 +105,10 @@ def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=No
     x = np.zeros(m) if x0 is None else np.maximum(np.asarray(x0, dtype=float), 0.0)
     alpha = np.zeros(k)
     g = M(x) + q
+    if k:  # the equalities' multipliers that fit the start best where it presses (everywhere at 0)
+        on = x > 0 if np.any(x > 0) else np.ones(m, dtype=bool)
+        alpha = np.linalg.lstsq(Gm[on], g[on], rcond=None)[0]
+        g = g - Gm @ alpha
     A = np.asarray(active, dtype=bool).copy() if active is not None else (x - c * g) > 0
     seen, steps, final, status, message = set(), 0, False, "cycled", f"{max_outer} active sets tried"
     Mx, moved = None, True

@@ -283,8 +283,10 @@ class _Solver:
             if self.precond is None:
                 self.precond = preconditioner(self.model, d)
             c = 1.0 / np.mean(d.rho[self.model.soil_rows])  # the soil's point stiffness
-            out = active_set_pcg(pr.matvec, pr.q, precond=self.precond, G=pr.G, b=pr.b, x0=start, c=c, tol=tol,
-                                 maxiter=self.maxiter - pr.matvecs, precise=pr.precise)
+            # a floating plate without a start: every row in contact (the bonded soil holds it)
+            every = np.ones(d.m, dtype=bool) if start is None and pr.G is not None else None
+            out = active_set_pcg(pr.matvec, pr.q, precond=self.precond, G=pr.G, b=pr.b, x0=start, active=every, c=c,
+                                 tol=tol, maxiter=self.maxiter - pr.matvecs, precise=pr.precise)
             self.iterations += out.iterations
             said.append({"method": method, "status": out.status, "why": out.message})
             if out.status == "optimal":

@@ -108,3 +108,25 @@ def test_what_needs_the_soil_as_unknowns_is_refused_not_answered_as_a_rigid_bed(
 
     with pytest.raises(ProblemError, match="matrix-free"):
         contact_qp(res.model)
+
+
+def test_a_rigid_punch_held_matrix_free_settles_as_boussinesq_says():
+    """A square plate 1e3 times stiffer than its soil resting on a circular bed of radius a (the
+    grid's cells centred in the circle), under a central P, floating: held matrix-free by size
+    (more than HALFSPACE_OPERATOR_FROM bed nodes), it settles P (1 − ν²)/(2 a E) (Boussinesq's
+    rigid circular punch; Johnson, Contact Mechanics, § 3.2) within 3 %, closer on the finer
+    mesh, with Σ R = P."""
+    P, a, E_s, nu_s = 1e5, 1.0, 3e7, 0.3
+    h = 0.5
+    ref = P * (1 - nu_s**2) / (2 * a * E_s)
+    errs = []
+    for n in (48, 64):
+        sc = pq.Scene(plate=pq.Plate(a=2.4, b=2.4, h=h, E=1e3 * E_s * a**3 / h**3, nu=0.2),
+                      mesh=pq.MeshSpec(nx=n, ny=n), loads=[pq.PointLoad(P=P, x=1.2, y=1.2)],
+                      foundation=pq.Foundation(model="halfspace", E=E_s, nu=nu_s, region={"circle": [1.2, 1.2, a]}))
+        res = pq.solve(sc, accuracy=1e-8)
+        assert res.model.soil_flexibility is not None and res.model.contacts.m > soil.HALFSPACE_OPERATOR_FROM
+        assert res.status == pq.Status.OPTIMAL and res.kkt.ok
+        assert res.reactions.sum() == pytest.approx(P, rel=1e-8)
+        errs.append(abs(res.deflection(1.2, 1.2) / ref - 1))
+    assert errs[1] < 0.03 and errs[1] < errs[0], errs
