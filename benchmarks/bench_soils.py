@@ -140,7 +140,7 @@ def memory_row(n: int) -> dict:
     import subprocess
 
     def run(raw: bool) -> list[str]:
-        code = CHILD.format(here=str(HERE), n=n, raw=raw)
+        code = CHILD.format(here=str(Path(__file__).resolve().parent), n=n, raw=raw)  # the scripts' own folder
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
         return out.stdout.split()
 
