@@ -128,7 +128,8 @@ else:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = pq.solve(bs.scene("halfspace", n), accuracy=1e-8)
-    extra = f" {{res.status.value}} {{res.kkt.worst:.3e}} {{res.extras.get('matvecs', 0)}} {{res.model.contacts.m}}"
+    extra = (f" {{res.status.value}} {{res.kkt.worst:.3e}} {{res.extras.get('matvecs', 0)}} {{res.model.contacts.m}} "
+             f"{{res.backend}}/{{res.formulation}}")
 t = time.process_time() - t0
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 print(f"{{(peak - base) / 1024:.1f}} {{t:.3f}}" + extra)
@@ -148,7 +149,7 @@ def memory_row(n: int) -> dict:
     row = dict(soil="halfspace", mesh=n, memory_raw_mb=float(raw[0]), memory_solve_mb=float(sol[0]),
                raw_s=float(raw[1]), solve_s=float(sol[1]), solve_ratio=float(sol[1]) / float(raw[1]),
                status=sol[2], kkt_worst=float(sol[3]), matvecs=int(sol[4]), contacts=int(sol[5]),
-               matrix_free=True, route="mprgp/condensed (fresh process)")
+               matrix_free=True, route=f"{sol[6]} (fresh process)")
     print(f"halfspace  {n:4d}  memory: raw {raw[0]} MB, solve {sol[0]} MB; CPU raw {raw[1]} s, solve {sol[1]} s; "
           f"{sol[2]} kkt {sol[3]}", flush=True)
     return row
