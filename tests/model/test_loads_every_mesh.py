@@ -99,14 +99,16 @@ def w_rows_resultant(model):
     return f.sum(), (f[:, None] * model.grid.nodes).sum(axis=0) / f.sum()
 
 
-PATCHES = [((0.3, 0.55, 0.2, 0.45), 0.0625, (0.425, 0.325), []),  # inside, its outline cutting cells
-           ((0.8, 1.4, -0.2, 0.3), 0.2 * 0.3, (0.9, 0.15), [])]  # over a corner: the part on the plate
+# (box, its area on the plate, its centroid, holes)
+PATCHES = {"inside": ((0.3, 0.55, 0.2, 0.45), 0.0625, (0.425, 0.325), []),  # its outline cutting cells
+           "over-a-corner": ((0.8, 1.4, -0.2, 0.3), 0.2 * 0.3, (0.9, 0.15), [])}  # the part on the plate
 AROUND_A_HOLE = ((0.2, 0.8, 0.2, 0.8), 0.36 - 0.04, (0.5 - 0.04 * 0.1 / 0.32, 0.5),
                  [[[0.5, 0.4], [0.7, 0.4], [0.7, 0.6], [0.5, 0.6]]])  # a hole: triangles only
 
 
 @pytest.mark.parametrize("element, box, area, centroid, holes",
-                         [(el, *p) for el in ("acm", "bfs", "dkt") for p in PATCHES] + [("dkt", *AROUND_A_HOLE)])
+                         [pytest.param(el, *p, id=f"{el}-{name}") for el in ("acm", "bfs", "dkt")
+                          for name, p in PATCHES.items()] + [pytest.param("dkt", *AROUND_A_HOLE, id="dkt-around-a-hole")])
 def test_patch_total_is_q_times_its_area_exactly(element, box, area, centroid, holes):
     F, c = load_resultant(build_model(patch_scene(element, box, holes)))
     assert F == pytest.approx(Q * area, rel=1e-12)
@@ -115,7 +117,7 @@ def test_patch_total_is_q_times_its_area_exactly(element, box, area, centroid, h
 
 def test_patch_on_triangles_is_carried_by_the_w_rows():
     """On triangles the patch's total and centroid are those of the w rows of f alone."""
-    for box, area, centroid, holes in PATCHES + [AROUND_A_HOLE]:
+    for box, area, centroid, holes in [*PATCHES.values(), AROUND_A_HOLE]:
         F, c = w_rows_resultant(build_model(patch_scene("dkt", box, holes)))
         assert F == pytest.approx(Q * area, rel=1e-12)
         np.testing.assert_allclose(c, centroid, atol=1e-12)

@@ -231,8 +231,8 @@ def straddles(model, region) -> int:
     ([0.2, 0.65, 0.3, 0.7], 0.45 * 0.4 - 0.15 * 0.2, [{"polygon": [[0.5, 0.4], [0.8, 0.4], [0.8, 0.6], [0.5, 0.6]]}]),
 ])
 def test_bed_areas_on_triangles_sum_to_the_box_exactly(region, area, holes):
-    """Triangles only: the box's outline is a line of the mesh (the grid lumps a box region to
-    its nodes)."""
+    """Triangles only: the box's outline is a line of the mesh (a box bed on the grid keeps its
+    cell rule: every cell centred in the box)."""
     m = build_model(bedded_square(region, holes=holes, supports=[pq.Support(0.23, 0.5)]))
     assert m.bed_areas().sum() == pytest.approx(area, rel=1e-12)
     assert straddles(m, region) == 0  # the outline runs along element edges
@@ -399,7 +399,7 @@ def test_bad_openings_on_triangles(opening, words):
 
 @pytest.mark.parametrize("mesh, fine, coarse", [("grid", pq.MeshSpec(1000, 1000, "acm"), pq.MeshSpec(2, 2, "acm")),
                                                 ("triangles", pq.MeshSpec(element="dkt", size=1e-3),
-                                                 pq.MeshSpec(element="dkt", size=0.5))])
+                                                 pq.MeshSpec(element="dkt", size=0.5))], ids=["grid", "triangles"])
 def test_bed_scale_is_checked_at_the_element_size(mesh, fine, coarse):
     """The bed's node spring is about k h² with h the element size (the grid's cell, the triangle
     mesh's size): a bed flexible enough against a 1e-181 plate at h = 1e-3 passes, at h = 0.5 it
