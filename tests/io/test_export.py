@@ -187,7 +187,7 @@ def test_exported_qps_round_trip_solved_elsewhere(tmp_path, mesh):
     path = write_qps(e, tmp_path / "p.qps")
     qp, info = read_qps(path, with_info=True)
     assert qp.n == e.qp.n and info.name == e.name
-    x, zG, _ = clarabel_solve(qp.P, qp.q, qp.G, qp.h)
+    _, zG, _ = clarabel_solve(qp.P, qp.q, qp.G, qp.h)
     ref = pq.solve(scene_on(mesh), formulation="primal", accuracy="high")
     np.testing.assert_allclose(e.meta["F0"] * zG, ref.reactions, atol=1e-6 * ref.reactions.max())
 

@@ -53,9 +53,9 @@ def _disc(size=R / 16, **kw):
 
 # a plate with a closed form on each mesh: its centre, the centre's w and Mx and their tolerances
 PLATES = {
-    "grid": dict(centre=(0.5, 0.5), w=0.0040624 * Q / D, w_rel=2e-3, Mx=0.0479 * Q, Mx_rel=0.03),
-    "triangles": dict(centre=(0.0, 0.0), w=R**4 / (64 * _disc().plate.D), w_rel=0.01,
-                      Mx=(1 + NU) * R**2 / 16, Mx_rel=0.02),
+    "grid": {"centre": (0.5, 0.5), "w": 0.0040624 * Q / D, "w_rel": 2e-3, "Mx": 0.0479 * Q, "Mx_rel": 0.03},
+    "triangles": {"centre": (0.0, 0.0), "w": R**4 / (64 * _disc().plate.D), "w_rel": 0.01,
+                  "Mx": (1 + NU) * R**2 / 16, "Mx_rel": 0.02},
 }
 
 

@@ -170,7 +170,7 @@ def test_principal_stress_marks_the_largest_nodal_s1(pairs):
     ax = fig.axes[0]
     (mark,) = [ln for ln in ax.lines if ln.get_marker() == "+"]
     np.testing.assert_allclose(np.ravel(mark.get_data()), one.model.grid.nodes[k])
-    lev = [c for c in ax.collections if hasattr(c, "levels") and c.filled][0].levels
+    lev = next(c for c in ax.collections if hasattr(c, "levels") and c.filled).levels
     assert lev[0] <= min(s1.min(), two.nodal("s1").min()) and lev[-1] >= s1.max()
 
 
@@ -185,7 +185,7 @@ def test_surface_difference_sections_reactions(pairs):
     zlo, zhi = ax.get_zlim()
     assert zlo > zhi and zlo >= one.w_nodes().max()  # inverted: w positive down
     dif = pl.plot_difference(one, two)
-    lev = [c for c in dif.axes[0].collections if hasattr(c, "levels") and c.filled][0].levels
+    lev = next(c for c in dif.axes[0].collections if hasattr(c, "levels") and c.filled).levels
     dw = one.w_nodes() - two.w_nodes()
     assert lev[0] <= dw.min() and lev[-1] >= dw.max()
     secs = pl.default_sections(one)
@@ -195,7 +195,7 @@ def test_surface_difference_sections_reactions(pairs):
     fig = pl.plot_sections(one, two, secs)
     assert len(fig.axes) == len(secs)
     (line,) = fig.axes[0].lines[:1]
-    s, w = line.get_data()
+    _s, w = line.get_data()
     _lab, p0, p1 = secs[0]
     np.testing.assert_allclose(w[-1], one.deflection(*p1), rtol=1e-9)
     fig = pl.plot_reactions(one, two)
