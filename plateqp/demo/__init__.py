@@ -571,6 +571,8 @@ def run(names: list[str] | None = None, out: Path | None = None, *, study_mesh: 
         print(f"\n{st.name}: {st.title}")
         for line in st.lines:
             print(f"  {line}")
+        for line in st.table.splitlines():
+            print(f"  {line}")
     write_files(out, runs, studies, table, force=force)
     n_png = sum(len(r.figures) for r in runs) + sum(len(st.figures) for st in studies)
     print(f"\nwrote {n_png} figures, {len(runs) + len(studies)} JSON files and report.html to {out}"
