@@ -1,5 +1,6 @@
-"""``plateqp demo``: solve the built-in scenes, compare with two-sided support, run the source
-paper's figure 5 and 6 studies (:mod:`plateqp.demo.paper`: "fig5", "fig6"), write a report.
+"""``plateqp demo``: solve the built-in scenes, compare with two-sided support, run the studies
+(:data:`plateqp.demo.paper.STUDIES`: the source paper's "fig5", "fig6", "regulate", and "soils",
+one heaved slab on three soils), write a report.
 
 For each scene: the one-sided solve (:func:`plateqp.solve`, accuracy "high") and, when the
 scene has one-sided supports, the source paper's comparison (:func:`plateqp.solve_bilateral`:
