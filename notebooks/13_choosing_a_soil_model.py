@@ -51,26 +51,17 @@
 import time
 import numpy as np
 import matplotlib.pyplot as plt
-from scipy.optimize import brentq
 import plateqp as pq
 from plateqp.model.assembly import build_model
+from plateqp.demo import soils as slab   # the scene and its calibration, shared with `plateqp demo soils`
 
 start = time.perf_counter()
-E, H, NU = 3e10, 0.25, 0.2            # concrete slab [Pa, m]
-E_S, NU_S = 3e7, 0.3                  # the soil: a stiff clay [Pa]
-Q = 25e3 * H                          # self-weight [Pa]
-P = 1.5e5                             # the machine foot [N]
-plate = pq.Plate(a=4.0, b=4.0, h=H, E=E, nu=NU)
-mesh = pq.MeshSpec(nx=20, ny=20)      # 441 bed nodes: the half-space's dense block stays small
-heave = {"profile": "bump", "x": 1.0, "y": 2.0, "radius": 1.0, "depth": 2e-3}   # g0 < 0: heave
-foot = pq.PointLoad(P=P, x=3.0, y=2.0)
-
-
-def scene(foundation, loads=(pq.UniformLoad(Q), foot)):
-    return pq.Scene(plate=plate, mesh=mesh, loads=list(loads), foundation=foundation)
-
-
-half = dict(model="halfspace", E=E_S, nu=NU_S)
+E, H, NU = slab.E, slab.H, slab.NU       # concrete slab [Pa, m]: 4 m × 4 m, 25 cm thick
+E_S, NU_S = slab.E_S, slab.NU_S          # the soil: a stiff clay [Pa]
+Q, P = slab.Q, slab.P                    # self-weight [Pa], the machine foot [N] at (3, 2)
+heave = slab.HEAVE                       # a bump 2 mm deep, 1 m in radius, at (1, 2): g0 < 0, heave
+scene = slab.slab_scene                  # scene(foundation, loads=[self-weight, foot]) on a 20 × 20 grid
+half = dict(model="halfspace", E=E_S, nu=NU_S)   # 441 bed nodes: the half-space's dense block stays small
 
 # %% [markdown]
 # ## Comparable stiffness
@@ -83,28 +74,19 @@ half = dict(model="halfspace", E=E_S, nu=NU_S)
 #    (on a free plate under uniform q both settle exactly q/k: exercise 1).
 # 2. **c2** from the machine foot alone: the shear layer's modulus for which the Pasternak bed
 #    settles under the foot as much as the half-space does (a root in one variable).
+#
+# The scene and these two steps live in `plateqp.demo.soils` (`slab_scene`, `calibrate`), so
+# that `plateqp demo soils` shows the same slab on the same three soils.
 
 # %%
-bonded_hs = pq.solve_bilateral(scene(pq.Foundation(**half), [pq.UniformLoad(Q)]))
-areas = bonded_hs.model.bed_areas()
-k = Q / (bonded_hs.w_nodes() @ areas / areas.sum())
-w_foot = pq.solve_bilateral(scene(pq.Foundation(**half), [foot])).deflection(3.0, 2.0)
-
-
-def foot_error(c2):
-    bonded = pq.solve_bilateral(scene(pq.Foundation(model="pasternak", k=k, shear=c2), [foot]))
-    return bonded.deflection(3.0, 2.0) - w_foot
-
-
-c2 = brentq(foot_error, 0.0, 1e8, xtol=1e4)
-print(f"k = {k / 1e6:.2f} MN/m³, c2 = {c2 / 1e6:.2f} MN/m, soil length √(c2/k) = {np.sqrt(c2 / k):.2f} m")
-print(f"under the foot alone, bonded: half-space {w_foot * 1e3:.3f} mm, "
-      f"Winkler {(foot_error(0.0) + w_foot) * 1e3:.3f} mm")
+cal = slab.calibrate()   # both steps above: bonded solves, then brentq for c2 (read its twenty lines)
+k, c2 = cal.k, cal.c2
+print(f"k = {k / 1e6:.2f} MN/m³, c2 = {c2 / 1e6:.2f} MN/m, soil length √(c2/k) = {cal.length:.2f} m")
+print(f"under the foot alone, bonded: half-space {cal.w_foot * 1e3:.3f} mm, "
+      f"Winkler {cal.w_foot_winkler * 1e3:.3f} mm")
 a_eq = np.sqrt(16.0 / np.pi)   # the rigid disc of the slab's area: P (1 − ν²)/(2 a E) over P/A
 print(f"a rigid disc of the same area would give k = {2 * a_eq * E_S / (16.0 * (1 - NU_S**2)) / 1e6:.2f} MN/m³")
-soils = {"Winkler": pq.Foundation(k=k, gap=heave),
-         "Pasternak": pq.Foundation(model="pasternak", k=k, shear=c2, gap=heave),
-         "half-space": pq.Foundation(**half, gap=heave)}
+soils = slab.beds(cal)   # Winkler, Pasternak and the half-space, all heaved by the bump
 
 # %% [markdown]
 # The fitted k (9.4 MN/m³) is close to what a rigid disc of the slab's area would give on this
@@ -125,12 +107,8 @@ for name, fnd in soils.items():
     assert one[name].status == pq.Status.OPTIMAL and one[name].kkt.ok
 
 
-def pressure(res):
-    """The contact pressure at each bed node: its reaction over its tributary area [Pa]."""
-    return res.reactions / res.model.bed_areas()[res.model.contacts.index]
-
-
-section = ((0.0, 2.0), (4.0, 2.0))   # through the heave and the foot
+pressure = slab.pressure   # the contact pressure at each bed node: its reaction over its tributary area [Pa]
+section = slab.SECTION     # y = 2 m, through the heave and the foot
 print(f"{'':11s} {'lifted':>7s} {'p max':>8s} {'w foot':>7s} {'Mx max':>7s} | bonded: {'p min':>7s} {'Mx max':>7s}"
       f" {'max |Δw|':>8s}")
 for name in soils:

@@ -76,7 +76,7 @@ def main(argv=None) -> int:
     d = sub.add_parser("demo", help="solve a built-in scene and print a summary")
     from ..demo import names_all  # matplotlib stays unimported until a figure is drawn
 
-    d.add_argument("name", nargs="?", help=f"a built-in scene or a study of the paper's figures: one of: "
+    d.add_argument("name", nargs="?", help=f"a built-in scene or a study (the paper's figures, regulation, the soils): one of: "
                    f"{', '.join(names_all())} (default: all)")
     d.add_argument("--out", metavar="DIR", help="folder for the figures, JSON files and report.html "
                    "(default: ./plateqp-demo)")

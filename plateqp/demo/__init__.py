@@ -1,5 +1,6 @@
-"""``plateqp demo``: solve the built-in scenes, compare with two-sided support, run the source
-paper's figure 5 and 6 studies (:mod:`plateqp.demo.paper`: "fig5", "fig6"), write a report.
+"""``plateqp demo``: solve the built-in scenes, compare with two-sided support, run the studies
+(:data:`plateqp.demo.paper.STUDIES`: the source paper's "fig5", "fig6", "regulate", and "soils",
+one heaved slab on three soils), write a report.
 
 For each scene: the one-sided solve (:func:`plateqp.solve`, accuracy "high") and, when the
 scene has one-sided supports, the source paper's comparison (:func:`plateqp.solve_bilateral`:
@@ -570,6 +571,8 @@ def run(names: list[str] | None = None, out: Path | None = None, *, study_mesh: 
     for st in studies:
         print(f"\n{st.name}: {st.title}")
         for line in st.lines:
+            print(f"  {line}")
+        for line in st.table.splitlines():
             print(f"  {line}")
     write_files(out, runs, studies, table, force=force)
     n_png = sum(len(r.figures) for r in runs) + sum(len(st.figures) for st in studies)

@@ -27,7 +27,8 @@ uniformity measures (:func:`plateqp.studies.design.uniformity`) on a log grid of
 that minimises each (:func:`plateqp.studies.design.most_uniform_stiffness` with ``measure=``).
 
 **"regulate"** lives in :mod:`plateqp.demo.regulation` (the paper's gap regulation on the
-``heave`` scene); :func:`run_study` runs it like the other two.
+``heave`` scene) and **"soils"** in :mod:`plateqp.demo.soils` (one heaved slab on Winkler's,
+Pasternak's and the half-space's soil); :func:`run_study` runs them like the other two.
 
 This module computes; figures come from :mod:`plateqp.plotting.studies`, words from
 :func:`path_lines` and :func:`contour_lines`. Support numbers users read are 1-based.
@@ -48,7 +49,8 @@ from ..plotting.data import support_spacing
 from ..model.scene import Scene
 
 #: The studies ``plateqp demo`` knows besides the scenes, and the figures each draws.
-STUDIES = {"fig5": ("schemes", "sections"), "fig6": ("pressure", "uniformity"), "regulate": ("reactions",)}
+STUDIES = {"soils": ("pressure", "sections"), "fig5": ("schemes", "sections"), "fig6": ("pressure", "uniformity"),
+           "regulate": ("reactions",)}
 #: The paper's values (kgf/cm): the softest stiffness of figure 5, the most uniform of figure 6.
 PAPER_C_SOFTEST = 5.0
 PAPER_C_UNIFORM = 3.2
@@ -315,15 +317,17 @@ class StudyRun:
     data: dict
     t: float
     ok: bool = True
+    table: str = ""  # a plain-text table of the study's numbers, printed as it is
 
 
-TITLES = {"fig5": "Figure 5: the working scheme as the support stiffness falls (heaved supports 1, 2, 8)",
+TITLES = {"soils": "One heaved slab on Winkler, Pasternak and half-space soil: pressure, lift-off, moments",
+          "fig5": "Figure 5: the working scheme as the support stiffness falls (heaved supports 1, 2, 8)",
           "fig6": "Figure 6: the contact pressure along an elastic contour, and its most uniform stiffness",
           "regulate": "Regulating the interaction forces by changing the gaps (the paper's third claim)"}
 
 
 def run_study(name: str, figures: bool = True, mesh: int | None = None, dpi: int = 100) -> StudyRun:
-    """Compute one study ("fig5", "fig6" or "regulate"), its lines, JSON and (``figures``) its PNGs."""
+    """Compute one study ("fig5", "fig6", "regulate" or "soils"), its lines, JSON and (``figures``) its PNGs."""
     import time
 
     if name not in STUDIES:
@@ -332,6 +336,7 @@ def run_study(name: str, figures: bool = True, mesh: int | None = None, dpi: int
     units = ("cm", "kgf")
     figs: dict[str, bytes] = {}
     caps: dict[str, str] = {}
+    table = ""
 
     def put(stem, caption, make):
         if stem not in STUDIES[name]:  # output_files must know every file the demo may write
@@ -366,6 +371,14 @@ def run_study(name: str, figures: bool = True, mesh: int | None = None, dpi: int
                 "panel).", lambda: plot_scheme_sections([s.result for s in p.schemes],
                                                         [f"{j}: κ = {_k(s.kappa)}" for j, s in
                                                          enumerate(p.schemes, 1)], p.sections, units))
+    elif name == "soils":
+        from . import soils as sl
+
+        st = sl.soil_study(mesh=mesh)
+        story, lines, table, data, ok = sl.story(st), sl.lines(st), sl.table(st), sl.data(st), st.ok
+        if figures:
+            for stem, (caption, make) in sl.figures(st).items():
+                put(stem, caption, make)
     elif name == "regulate":
         from .regulation import regulation, regulation_lines
 
@@ -412,7 +425,7 @@ def run_study(name: str, figures: bool = True, mesh: int | None = None, dpi: int
                 "dashed: the minimum of each; dotted: the paper's c = 3.2 kgf/cm in this scene.",
                 lambda: plot_uniformity(q.grid, q.measures, {m: u.c / q.unit for m, u in q.optima.items()},
                                         {"paper's 3.2 kgf/cm": PAPER_C_UNIFORM / q.unit}))
-    return StudyRun(name, TITLES[name], story, lines, figs, caps, data, time.perf_counter() - t0, ok)
+    return StudyRun(name, TITLES[name], story, lines, figs, caps, data, time.perf_counter() - t0, ok, table)
 
 
 def _k(k: float) -> str:

@@ -167,6 +167,8 @@ def report_html(runs: list, table: str, studies: list = ()) -> str:
         parts.append(f"<h2 id='{e(st.name)}'>Study “{e(st.name)}”: {e(st.title)}</h2>")
         parts.append(f"<pre class='story'>{e(st.story)}</pre>")
         parts.append("<ul>" + "".join(f"<li>{e(s)}</li>" for s in st.lines) + "</ul>")
+        if getattr(st, "table", ""):
+            parts.append(f"<pre>{e(st.table)}</pre>")
         for stem, png in st.figures.items():
             parts.append(f"<figure>{_img(png, stem)}<figcaption><b>{e(stem)}.png</b>: {e(st.captions[stem])}"
                          "</figcaption></figure>")

@@ -1,10 +1,13 @@
-"""Results where users work: VTK through meshio, xarray datasets and pandas tables.
+"""Results where users work: VTK through meshio, xarray datasets and pandas tables, on the
+rectangle grid and on triangles.
 
 External references: Timoshenko & Woinowsky-Krieger's table for the simply supported square
-under uniform load (centre w = 0.0040624 q a⁴/D, Mx = 0.0479 q a², ν = 0.3); statics (a free
-square plate on four corner supports under uniform load: each reaction q a²/4; a floating plate
-on a bed: the bed's reactions sum to the load). The files are read back with meshio, not with
-plateqp, and the nodal values compared with :meth:`Result.deflection` at the same points.
+under uniform load (centre w = 0.0040624 q a⁴/D, Mx = 0.0479 q a², ν = 0.3); the clamped circular
+plate of radius R under uniform q (ibid. § 62: centre w = q R⁴ / 64 D, M = (1 + ν) q R² / 16);
+statics (a free square plate on four corner supports under uniform load: each reaction q a²/4; a
+floating plate on a bed: the bed's reactions sum to the load). The files are read back with
+meshio, not with plateqp, and the nodal values compared with :meth:`Result.deflection` at the
+same points.
 """
 
 from __future__ import annotations
@@ -39,24 +42,57 @@ def simple():
     return pq.solve(_scene(edges={k: "simple" for k in ("left", "right", "bottom", "top")}))
 
 
+R = 1.0  # the disc on triangles: q = 1, E = 1e7, h = 0.01, ν = NU
+
+
+def _disc(size=R / 16, **kw):
+    return pq.Scene(name="disc", plate=pq.Plate(shape={"circle": [0.0, 0.0, R]}, h=0.01, E=1.0e7, nu=NU),
+                    mesh=pq.MeshSpec(element="dkt", size=size), edges={"all": pq.Edge("clamped")},
+                    loads=[pq.UniformLoad(1.0)], **kw)
+
+
+# a plate with a closed form on each mesh: its centre, the centre's w and Mx and their tolerances
+PLATES = {
+    "grid": {"centre": (0.5, 0.5), "w": 0.0040624 * Q / D, "w_rel": 2e-3, "Mx": 0.0479 * Q, "Mx_rel": 0.03},
+    "triangles": {"centre": (0.0, 0.0), "w": R**4 / (64 * _disc().plate.D), "w_rel": 0.01,
+                  "Mx": (1 + NU) * R**2 / 16, "Mx_rel": 0.02},
+}
+
+
+@pytest.fixture(scope="module", params=sorted(PLATES))
+def plate(request, simple):
+    """(mesh, its solved plate, its closed form): the simply supported square on the grid (BFS
+    16²), the clamped disc on DKT triangles of size R/16."""
+    if request.param == "grid":
+        return request.param, simple, PLATES["grid"]
+    pytest.importorskip("gmsh")
+    return request.param, pq.solve(_disc()), PLATES["triangles"]
+
+
 @pytest.fixture(scope="module")
 def corners():
     sup = [{"x": x, "y": y} for x, y in ((0, 0), (1, 0), (1, 1), (0, 1))]
     return pq.solve(_scene(supports=sup), backend="lemke", accuracy="high")
 
 
-def test_vtu_plate_fields_match_the_table_and_the_result(simple, tmp_path):
-    paths = vtk.write_vtu(simple, tmp_path, "slab")
+def test_vtu_plate_fields_match_the_closed_form_and_the_result(plate, tmp_path):
+    mesh_kind, res, ref = plate
+    paths = vtk.write_vtu(res, tmp_path, "slab")
     assert [p.name for p in paths] == ["slab.vtu"]  # no discrete supports: no supports file
     mesh = meshio.read(paths[0])
-    assert mesh.cells[0].type == "quad" and len(mesh.cells[0].data) == 16 * 16
+    if mesh_kind == "grid":
+        assert mesh.cells[0].type == "quad" and len(mesh.cells[0].data) == 16 * 16
+    else:
+        tri = res.model.grid.triangles
+        assert mesh.cells[0].type == "triangle" and len(mesh.cells[0].data) == len(tri)
+        np.testing.assert_array_equal(mesh.cells[0].data, tri)
     xy = mesh.points[:, :2]
-    k = int(np.argmin(np.hypot(xy[:, 0] - 0.5, xy[:, 1] - 0.5)))
+    k = int(np.argmin(np.hypot(xy[:, 0] - ref["centre"][0], xy[:, 1] - ref["centre"][1])))
     w = mesh.point_data["w"]
-    assert w[k] == pytest.approx(0.0040624 * Q / D, rel=2e-3)
-    assert mesh.point_data["Mx"][k] == pytest.approx(0.0479 * Q, rel=0.03)
-    # every node's w is the result's own deflection there (BFS is conforming: w is nodal)
-    np.testing.assert_allclose(w, simple.deflection(xy[:, 0], xy[:, 1]), rtol=0, atol=1e-12 * abs(w).max())
+    assert w[k] == pytest.approx(ref["w"], rel=ref["w_rel"])
+    assert mesh.point_data["Mx"][k] == pytest.approx(ref["Mx"], rel=ref["Mx_rel"])
+    # every node's w is the result's own deflection there (BFS and DKT: w is nodal)
+    np.testing.assert_allclose(w, res.deflection(xy[:, 0], xy[:, 1]), rtol=0, atol=1e-12 * abs(w).max())
     np.testing.assert_allclose(mesh.point_data["displacement"][:, 2], -w)
     s1 = mesh.point_data["s1"]
     assert np.all(s1 >= mesh.point_data["s2"])
@@ -84,6 +120,18 @@ def test_vtu_refuses_to_overwrite_and_checks_every_target_first(corners, tmp_pat
     assert meshio.read(tmp_path / "corners-supports.vtu").points.shape == (4, 3)
 
 
+def test_vtu_supports_on_triangles(tmp_path):
+    """The supports' file of a triangle scene: numbered from 1, the result's reactions."""
+    pytest.importorskip("gmsh")
+    sc = _disc(size=R / 4, supports=[pq.Support(0.5, 0.0, gap=0.0), pq.Support(-0.5, 0.0, gap=-1e-3)])
+    sc.edges = {"all": pq.Edge("simple")}
+    res = pq.solve(sc)
+    paths = res.write_vtu(tmp_path, "posts")
+    sup = meshio.read(paths[1])
+    np.testing.assert_allclose(sup.point_data["number"], [1, 2])
+    np.testing.assert_allclose(sup.point_data["reaction"], res.reactions)
+
+
 def test_bed_reactions_at_nodes_sum_to_the_load(tmp_path):
     res = pq.solve(_scene(mesh={"nx": 8, "ny": 8, "element": "bfs"}, foundation={"k": 1e7}))
     mesh = meshio.read(vtk.write_vtu(res, tmp_path, "bed")[0])
@@ -93,13 +141,28 @@ def test_bed_reactions_at_nodes_sum_to_the_load(tmp_path):
     assert set(np.unique(mesh.point_data["contact"])) <= {0.0, 1.0}
 
 
-def test_xarray_dataset_on_node_coordinates(simple):
-    ds = fields_mod.to_xarray(simple)
-    assert ds["w"].dims == ("y", "x") and ds.sizes == {"y": 17, "x": 17}
-    assert float(ds["w"].sel(x=0.5, y=0.5)) == pytest.approx(0.0040624 * Q / D, rel=2e-3)
-    assert float(ds["Mx"].sel(x=0.5, y=0.5)) == pytest.approx(0.0479 * Q, rel=0.03)
-    xs, ys = np.meshgrid(ds["x"].values, ds["y"].values)
-    np.testing.assert_allclose(ds["w"].values, simple.deflection(xs, ys), atol=1e-12 * float(abs(ds["w"]).max()))
+def test_xarray_dataset_on_node_coordinates(plate):
+    """The grid's dataset on (y, x), the triangles' on their nodes (with the triangles): w is the
+    result's deflection at the coordinates, the centre's values the closed form's."""
+    mesh_kind, res, ref = plate
+    ds = fields_mod.to_xarray(res)
+    if mesh_kind == "grid":
+        assert ds["w"].dims == ("y", "x") and ds.sizes == {"y": 17, "x": 17}
+        assert float(ds["w"].sel(x=0.5, y=0.5)) == pytest.approx(ref["w"], rel=ref["w_rel"])
+        assert float(ds["Mx"].sel(x=0.5, y=0.5)) == pytest.approx(ref["Mx"], rel=ref["Mx_rel"])
+        xs, ys = np.meshgrid(ds["x"].values, ds["y"].values)
+    else:
+        mesh = res.model.grid
+        assert ds["w"].dims == ("node",) and ds.sizes["node"] == mesh.n_nodes
+        np.testing.assert_allclose(ds["x"].values, mesh.nodes[:, 0])
+        np.testing.assert_allclose(ds["y"].values, mesh.nodes[:, 1])
+        np.testing.assert_array_equal(ds["triangles"].values, mesh.triangles)
+        k = int(np.argmin(np.hypot(ds["x"].values, ds["y"].values)))
+        assert float(ds["w"][k]) == pytest.approx(ref["w"], rel=ref["w_rel"])
+        assert float(ds["Mx"][k]) == pytest.approx(ref["Mx"], rel=ref["Mx_rel"])
+        xs, ys = ds["x"].values, ds["y"].values
+    w = ds["w"].values
+    np.testing.assert_allclose(w, res.deflection(xs, ys), atol=1e-12 * abs(w).max())
     assert ds["w"].attrs["units"] == "L" and ds.attrs["status"] == "optimal"
 
 

@@ -1,5 +1,8 @@
 """Scene paths (plateqp.model.paths): get and set a scene field named with dots; bad paths and values
-say what exists."""
+say what exists; on a triangle mesh the edges take its own names (``all``, ``outer_0-1``, ``hole0``).
+
+External reference for the edge set by a path: the clamped circular plate's w0 = q R⁴ / 64 D
+(Timoshenko & Woinowsky-Krieger § 62)."""
 
 from __future__ import annotations
 
@@ -98,3 +101,36 @@ def test_sweep_of_a_table_is_one_line_exit_2(capsys, path):
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and err.startswith("plateqp: ") and "internal error" not in err, err
     assert path in err
+
+
+# -- the triangle meshes' edge names ------------------------------------------------------------
+
+L_SHAPE = [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]
+
+
+def l_plate() -> pq.Scene:
+    pytest.importorskip("gmsh")
+    return pq.Scene(plate=pq.Plate(shape={"polygon": L_SHAPE}), mesh=pq.MeshSpec(element="dkt", size=0.25),
+                    loads=[pq.UniformLoad(1.0)])
+
+
+def test_paths_take_the_triangle_edge_names():
+    pytest.importorskip("gmsh")
+    sc = pq.Scene(plate=pq.Plate(shape={"circle": [0.0, 0.0, 1.0]}, h=0.01, E=1e7, nu=0.3),
+                  mesh=pq.MeshSpec(element="dkt", size=1 / 8), edges={"all": "simple"}, loads=[pq.UniformLoad(1.0)])
+    assert get_param(sc, "edges.all") == "simple"
+    clamped = set_param(sc, "edges.all", "clamped")
+    D = sc.plate.D
+    assert pq.solve(clamped).deflection(0.0, 0.0) == pytest.approx(1.0 / (64 * D), rel=0.01)
+    L = l_plate()
+    L2 = set_param(set_param(L, "edges.outer_0-1", "clamped"), "edges.outer_4-5.kind", "simple")
+    assert L2.edges["outer_0-1"].kind == "clamped" and L2.edges["outer_4-5"].kind == "simple"
+    holed = set_param(pq.Scene(plate=L.plate, mesh=L.mesh, holes=[{"circle": [0.5, 0.5, 0.2]}]), "edges.hole0", "clamped")
+    assert holed.edges["hole0"].kind == "clamped"
+
+
+@pytest.mark.parametrize("path, words", [("edges.outr", "unknown edge"), ("edges.hole3", "no hole 3"),
+                                         ("edges.outer_2-9", "segments")])
+def test_paths_refuse_bad_triangle_edge_names(path, words):
+    with pytest.raises(pq.SceneError, match=words):
+        set_param(l_plate(), path, "simple")

@@ -2,7 +2,11 @@
 
 References: the plate's constitutive law written out by hand (M = −D (κx + ν κy), …), the
 invariants of the principal stresses, and, for the nodal average, each kept cell evaluated
-point by point with ``Result.at`` just inside its corners and averaged by hand.
+point by point with ``Result.at`` just inside its corners and averaged by hand; a quadratic
+deflection has constant curvatures, which every element reproduces exactly, so its moments
+M = −D_b κ are exact at every node; on triangles, Timoshenko & Woinowsky-Krieger, Theory of
+plates and shells, § 62 (clamped circular plate of radius R under uniform q:
+M_r = q ((1 + ν) R² − (3 + ν) r²) / 16, so M = (1 + ν) q R² / 16 at the centre, w0 = q R⁴ / 64 D).
 """
 
 from __future__ import annotations
@@ -101,3 +105,75 @@ def test_unknown_quantity(result):
         result.nodal("sigma")
     with pytest.raises(ValueError, match="unknown quantity"):
         post.from_curvatures(result.scene.plate, "w2", 0.0, 0.0, 0.0)
+
+
+R, NU, Q = 1.0, 0.3, 1.0  # the plates below: radius (disc), Poisson's ratio, load
+
+
+@pytest.mark.parametrize("element", ["acm", "bfs", "dkt"])
+def test_constant_curvature_patch_gives_exact_nodal_moments(element):
+    """w = ½(A x² + B y²) + C x y on a free plate (an L of any triangles; a grid with an
+    opening): κ constant, so every node's averaged moments are −D_b κ exactly."""
+    if element == "dkt":
+        pytest.importorskip("gmsh")
+        sc = pq.Scene(plate=pq.Plate(shape={"polygon": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]}, nu=NU),
+                      mesh=pq.MeshSpec(element="dkt", size=0.3), loads=[pq.UniformLoad(1.0)])
+    else:
+        sc = pq.Scene(plate=pq.Plate(a=2.0, b=2.0, nu=NU), mesh=pq.MeshSpec(8, 8, element),
+                      openings=[pq.Opening(1.0, 2.0, 1.0, 2.0)], loads=[pq.UniformLoad(1.0)])
+    model = build_model(sc)
+    A, B, C = 0.3, -0.7, 0.2
+    x, y = model.grid.node_xy().T
+    dofs = {"w": 0.5 * (A * x**2 + B * y**2) + C * x * y, "wx": A * x + C * y, "wy": B * y + C * x,
+            "wxy": np.full_like(x, C)}
+    names = model.element.dof_names
+    u = np.zeros(model.n_full)
+    for k, name in enumerate(names):
+        u[k::len(names)] = dofs[name]
+    op = post.NodalOperator(model)
+    on = np.isfinite(op(u, sc.plate, "Mx"))  # the grid's nodes inside the opening have no value
+    assert on.all() if element == "dkt" else on.sum() > 0.5 * len(on)
+    for q, want in zip(("Mx", "My", "Mxy"), post.moments(sc.plate, A, B, C)):
+        np.testing.assert_allclose(op(u, sc.plate, q)[on], want, rtol=1e-9, atol=1e-12)
+
+
+# -- nodal fields on triangles: the clamped disc ------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def clamped() -> pq.Result:
+    """The clamped disc of radius R under uniform q, on DKT triangles of size R/16."""
+    pytest.importorskip("gmsh")
+    return pq.solve(pq.Scene(name="disc", plate=pq.Plate(shape={"circle": [0.0, 0.0, R]}, h=0.01, E=1.0e7, nu=NU),
+                             mesh=pq.MeshSpec(element="dkt", size=R / 16), edges={"all": pq.Edge("clamped")},
+                             loads=[pq.UniformLoad(Q)]))
+
+
+def radial(res, quantity_xy):
+    """M_r at the nodes from the nodal (Mx, My, Mxy): M_r = Mx c² + My s² + 2 Mxy s c."""
+    xy = res.model.grid.nodes
+    r = np.hypot(*xy.T)
+    c, s = xy[:, 0] / np.where(r > 0, r, 1), xy[:, 1] / np.where(r > 0, r, 1)
+    Mx, My, Mxy = (res.nodal(q) for q in quantity_xy)
+    return r, Mx * c * c + My * s * s + 2 * Mxy * s * c
+
+
+def test_nodal_moment_of_the_clamped_disc_against_the_closed_form(clamped):
+    r, Mr = radial(clamped, ("Mx", "My", "Mxy"))
+    k = int(np.argmin(r))  # the node nearest the centre (r ≈ 0.03 R at R/16)
+    exact = Q * ((1 + NU) * R**2 - (3 + NU) * r**2) / 16
+    assert Mr[k] == pytest.approx((1 + NU) * Q * R**2 / 16, rel=0.02)
+    assert Mr[k] == pytest.approx(exact[k], rel=0.01)
+    inner = r < 0.9 * R  # away from the clamped edge, within 2 % of the largest moment
+    assert np.abs(Mr - exact)[inner].max() < 0.02 * (1 + NU) * Q * R**2 / 16
+    assert clamped.nodal("Mx").shape == (clamped.model.grid.n_nodes,)
+
+
+def test_nodal_principal_stresses_are_ordered_and_w_max_is_the_centre(clamped):
+    s1, s2 = clamped.nodal("s1"), clamped.nodal("s2")
+    assert np.all(np.isfinite(s1)) and np.all(s1 >= s2)
+    assert np.any(s1 > s2 * (1 + 1e-3))  # not trivially equal
+    np.testing.assert_array_equal(clamped.nodal("w"), clamped.w_nodes())
+    w, x, y = clamped.w_max()
+    assert w == pytest.approx(Q * R**4 / (64 * clamped.scene.plate.D), rel=0.01)
+    assert np.hypot(x, y) < R / 16

@@ -1,8 +1,13 @@
 """Regions take the same shapes everywhere: a patch load, a bed region and a cut-out are each a
 box [x0, x1, y0, y1], a polygon { polygon = [[x, y], ...] } or a circle { circle = [xc, yc, r] },
-on the rectangle grid (ACM, BFS) and on triangles (DKT) alike.
+on the rectangle grid (ACM, BFS) and on triangles (DKT) alike. On triangles a bed region's
+outline inside the plate is a line of the gmsh mesh, so the region is a union of whole triangles
+and the springs' tributary areas sum to the region's area exactly, and an opening is the box cut
+out exactly (a rectangular hole).
 
-External references: the area of a disc, πr², and of its quarter at a corner (statics: the
+External references: the area of a disc, πr², and of its quarter at a corner, of a box and of a
+circular segment by elementary geometry; Winkler's bed under a load that covers exactly the
+bedded part: a rigid translation w = q / k of the whole plate (no bending); statics (the
 reactions of a two-sided plate sum to the load); Navier's double series for a simply supported
 rectangle (Timoshenko & Woinowsky-Krieger, Theory of plates and shells, § 28), its load
 coefficients over a disc in closed form, ∫∫_disc sin αx sin βy dA = sin αxc sin βyc · 2π r J1(ρr)/ρ,
@@ -165,6 +170,103 @@ def test_circular_bed_agrees_between_grid_and_triangles():
     assert diffs[0] < 0.01 and diffs[1] < diffs[0] / 2
 
 
+L_REGION = [[-0.2, -0.2], [0.7, -0.2], [0.7, 0.3], [0.35, 0.3], [0.35, 0.8], [-0.2, 0.8]]  # over a corner
+SQ = [[0, 0], [1, 0], [1, 1], [0, 1]]
+
+
+def bedded_square(region, size=1 / 8, shape=None, holes=(), loads=None, k=1e4, supports=()):
+    """A free plate (the unit square given as a polygon, or ``shape``) on DKT triangles of
+    ``size``, on a bed over ``region``."""
+    return pq.Scene(plate=pq.Plate(shape=shape or {"polygon": SQ}, h=0.01, E=1e7, nu=0.3),
+                    mesh=pq.MeshSpec(element="dkt", size=size), holes=list(holes),
+                    loads=loads or [pq.UniformLoad(1.0)], supports=list(supports),
+                    foundation=pq.Foundation(k=k, region=region))
+
+
+@pytest.mark.parametrize("mesh", ["grid", "triangles"])
+def test_polygon_bed_over_a_corner(mesh):
+    """An L-shaped region over the square's corner, its sides on no cell line: the areas sum to
+    its part on the plate (0.7 × 0.3 + 0.35 × 0.5) exactly, the region comes back from the
+    scene's dict, and statics holds; on triangles no triangle is cut by it: the triangles whose
+    centroid lies in it (matplotlib's point-in-polygon) have that area too."""
+    from matplotlib.path import Path
+
+    region = {"polygon": L_REGION}
+    if mesh == "grid":
+        sc = bedded("acm", 16, region, supports=[pq.Support(0.9, 0.9)])
+    else:
+        sc = bedded_square(region, supports=[pq.Support(0.9, 0.9)])
+    m = build_model(sc)
+    area = 0.7 * 0.3 + 0.35 * 0.5
+    assert m.bed_areas().sum() == pytest.approx(area, rel=1e-12)
+    if mesh == "triangles":
+        g = m.grid
+        inside = Path(np.array(L_REGION)).contains_points(g.nodes[g.triangles].mean(axis=1))
+        assert g.areas()[inside].sum() == pytest.approx(area, rel=1e-12)
+    back = pq.Scene.from_dict(sc.to_dict())
+    assert back.foundation.region == region
+    res = pq.solve(sc)
+    assert res.kkt.ok and res.reactions.sum() == pytest.approx(1.0, rel=1e-8)  # statics
+
+
+def straddles(model, region) -> int:
+    """How many triangles have vertices strictly on both sides of one of the region's lines."""
+    x0, x1, y0, y1 = region
+    p = model.grid.nodes[model.grid.triangles]
+    tol = 1e-9
+    n = 0
+    for axis, v in ((0, x0), (0, x1), (1, y0), (1, y1)):
+        c = p[:, :, axis]
+        o = p[:, :, 1 - axis].mean(axis=1)  # within the line's extent along the other axis
+        lo, hi = (y0, y1) if axis == 0 else (x0, x1)
+        inside_span = (o > lo) & (o < hi)
+        n += int(np.sum(inside_span & (c.min(axis=1) < v - tol) & (c.max(axis=1) > v + tol)))
+    return n
+
+
+@pytest.mark.parametrize("region, area, holes", [
+    ([0.0, 0.5, 0.0, 1.0], 0.5, []),  # half the plate: two sides on the boundary
+    ([0.23, 0.71, 0.37, 1.4], 0.48 * 0.63, []),  # crossing the top edge
+    ([0.1, 0.9, 0.1, 0.9], 0.64 - 0.04, [{"polygon": [[0.4, 0.4], [0.6, 0.4], [0.6, 0.6], [0.4, 0.6]]}]),
+    ([0.2, 0.65, 0.3, 0.7], 0.45 * 0.4 - 0.15 * 0.2, [{"polygon": [[0.5, 0.4], [0.8, 0.4], [0.8, 0.6], [0.5, 0.6]]}]),
+])
+def test_bed_areas_on_triangles_sum_to_the_box_exactly(region, area, holes):
+    """Triangles only: the box's outline is a line of the mesh (a box bed on the grid keeps its
+    cell rule: every cell centred in the box)."""
+    m = build_model(bedded_square(region, holes=holes, supports=[pq.Support(0.23, 0.5)]))
+    assert m.bed_areas().sum() == pytest.approx(area, rel=1e-12)
+    assert straddles(m, region) == 0  # the outline runs along element edges
+    bed = m.contacts.xy[m.contacts.source == "bed"]
+    x0, x1, y0, y1 = region
+    assert np.all((bed[:, 0] >= x0 - 1e-12) & (bed[:, 0] <= x1 + 1e-12) & (bed[:, 1] >= y0 - 1e-12)
+                  & (bed[:, 1] <= y1 + 1e-12))  # no spring outside the region
+
+
+def test_load_on_the_bedded_part_translates_the_plate_on_triangles():
+    """A free square, bed on its left half, the same pressure on that half only: on triangles the
+    bed takes each node's load where it acts, and the whole plate sinks by q / k without bending
+    (triangles only: on the grid the consistent load's nodal couples bend the plate)."""
+    q, k, region = 3.0, 1e3, [0.0, 0.5, 0.0, 1.0]
+    sc = bedded_square(region, loads=[pq.PatchLoad(q, *region)], k=k)
+    res = pq.solve(sc, accuracy="high")
+    assert res.kkt.ok and res.reactions.sum() == pytest.approx(q * 0.5, rel=1e-10)
+    pts = np.array([[0.1, 0.2], [0.45, 0.9], [0.9, 0.5], [0.7, 0.05]])
+    np.testing.assert_allclose(res.deflection(*pts.T), q / k, rtol=1e-7)
+
+
+def test_bed_region_on_a_circular_plate():
+    """A strip of a disc (triangles): the areas sum to the strip's part of the meshed disc (the
+    polygon of its boundary nodes) exactly, and to the true circular segment within the chords'
+    error."""
+    region = [-2.0, 2.0, -0.5, 0.3]
+    m = build_model(bedded_square(region, shape={"circle": [0.5, 0.5, 0.5]}, size=1 / 16,
+                                  supports=[pq.Support(0.5, 0.5)]))
+    d, r = 0.2, 0.5  # the segment below y = 0.3 of the circle of centre (0.5, 0.5)
+    seg = r * r * math.acos(d / r) - d * math.sqrt(r * r - d * d)
+    assert m.bed_areas().sum() == pytest.approx(seg, rel=5e-3)
+    assert straddles(m, region) == 0
+
+
 def test_polygon_bed_on_the_grid():
     """An L-shaped bed on the grid: its springs' areas are the L's area (its sides on cell lines),
     no spring outside it, and statics holds."""
@@ -187,18 +289,30 @@ BAD = [
     ({"polygon": [[0.1, 0.1], [0.6, 0.6], [0.6, 0.1], [0.1, 0.6]]}, "self-intersecting"),
     ({"square": [0.5, 0.5, 0.1]}, r"must be \[x0, x1, y0, y1\], \{ polygon"),
     ([0.6, 0.2, 0.1, 0.3], "needs x0 < x1"),
+    ({"circle": [2.5, 2.5, 0.2]}, "does not overlap the plate"),
+    ({"polygon": [[0, 0], [1, 1], [1, 0], [0, 1]]}, "self-intersecting"),
 ]
 
 
-@pytest.mark.parametrize("element", ["acm", "dkt"])
+@pytest.mark.parametrize("element", ["acm", "dkt", "dkt-polygon"])
 def test_bad_regions_name_their_field(element):
     """The same mistakes give the same message naming the field, for a patch and for a bed, on
-    both meshes."""
+    both meshes (on triangles also on the square given as a polygon)."""
     for region, words in BAD:
+        if element == "dkt-polygon":
+            with pytest.raises(pq.SceneError, match=rf"foundation\.region[.\w]*: .*{words}"):
+                bedded_square(region)
+            continue
         with pytest.raises(pq.SceneError, match=rf"loads\.0\.region[.\w]*: .*{words}"):
             rect(element, 8, [pq.PatchLoad(1.0, region=region)])
         with pytest.raises(pq.SceneError, match=rf"foundation\.region[.\w]*: .*{words}"):
             bedded(element, 8, region)
+
+
+def test_a_region_of_no_known_form_is_named():
+    with pytest.raises(pq.SceneError, match=r"foundation.region: must be \[x0, x1, y0, y1\], \{ polygon"):
+        pq.Scene(mesh=pq.MeshSpec(8, 8), loads=[pq.UniformLoad(1.0)],
+                 foundation=pq.Foundation(k=1e3, region={"square": L_REGION}))
 
 
 def test_a_patch_takes_a_box_or_a_region_not_both():
@@ -242,6 +356,62 @@ def test_openings_share_the_region_checks():
         rect("acm", 8, [pq.UniformLoad(1.0)], openings=[pq.Opening(0.6, 0.2, 0.1, 0.3)])
     with pytest.raises(pq.SceneError, match=r"loads\.0\.region: needs x0 < x1 and y0 < y1"):
         rect("acm", 8, [pq.PatchLoad(1.0, region=[0.6, 0.2, 0.1, 0.3])])
+
+
+def square_with_an_opening(opening, loads, **kw) -> pq.Scene:
+    """The unit square given as a polygon, on DKT triangles of size 1/8, with an opening."""
+    return pq.Scene(name="sq", plate=pq.Plate(shape={"polygon": SQ}, h=0.01, E=1e7, nu=0.3),
+                    mesh=pq.MeshSpec(element="dkt", size=1 / 8), loads=loads, openings=[pq.Opening(*opening)], **kw)
+
+
+def test_opening_on_triangles_is_cut_out_exactly():
+    """A free square with an opening, on a tensionless bed under uniform q: the plate sinks by
+    q / k everywhere (a rigid translation), and the bed carries q × (1 − the opening's area),
+    exactly; no node lies strictly inside the opening (triangles only: on the grid the consistent
+    load's nodal couples bend the plate)."""
+    q, k = 2.0, 100.0
+    sc = square_with_an_opening((0.3, 0.55, 0.35, 0.6), [pq.UniformLoad(q)], foundation=pq.Foundation(k=k))
+    res = pq.solve(sc, accuracy="high")
+    assert res.kkt.ok and res.reactions.sum() == pytest.approx(q * (1 - 0.25 * 0.25), rel=1e-10)
+    assert res.deflection(0.1, 0.9) == pytest.approx(q / k, rel=1e-7)
+    n = res.model.grid.nodes
+    assert not np.any((n[:, 0] > 0.3 + 1e-9) & (n[:, 0] < 0.55 - 1e-9) & (n[:, 1] > 0.35 + 1e-9) & (n[:, 1] < 0.6 - 1e-9))
+
+
+@pytest.mark.parametrize("mesh", ["grid", "triangles"])
+def test_a_point_load_in_an_opening_is_refused(mesh):
+    load, opening = pq.PointLoad(1.0, 0.4, 0.5), (0.3, 0.55, 0.35, 0.6)
+    with pytest.raises(pq.SceneError, match="no plate there|off the plate"):
+        if mesh == "grid":
+            rect("acm", 8, [load], openings=[pq.Opening(*opening)])
+        else:
+            square_with_an_opening(opening, [load])
+
+
+@pytest.mark.parametrize("opening, words", [
+    ((0.8, 1.2, 0.3, 0.5), "openings.0: the hole is not inside the plate"),
+    ((0.1, 0.3, 0.1, 0.3), "openings.0: overlaps or touches holes.0"),
+])
+def test_bad_openings_on_triangles(opening, words):
+    with pytest.raises(pq.SceneError, match=words):
+        square_with_an_opening(opening, [pq.UniformLoad(2.0)], holes=[{"circle": [0.25, 0.25, 0.1]}])
+
+
+@pytest.mark.parametrize("mesh, fine, coarse", [("grid", pq.MeshSpec(1000, 1000, "acm"), pq.MeshSpec(2, 2, "acm")),
+                                                ("triangles", pq.MeshSpec(element="dkt", size=1e-3),
+                                                 pq.MeshSpec(element="dkt", size=0.5))], ids=["grid", "triangles"])
+def test_bed_scale_is_checked_at_the_element_size(mesh, fine, coarse):
+    """The bed's node spring is about k h² with h the element size (the grid's cell, the triangle
+    mesh's size): a bed flexible enough against a 1e-181 plate at h = 1e-3 passes, at h = 0.5 it
+    is named."""
+    plate = pq.Plate(a=1.0, b=1.0, h=1e-30, E=1e-90, nu=0.3) if mesh == "grid" else \
+        pq.Plate(shape={"polygon": SQ}, h=1e-30, E=1e-90, nu=0.3)
+
+    def bed(spec):
+        return pq.Scene(plate=plate, mesh=spec, loads=[pq.UniformLoad(1e-30)], foundation=pq.Foundation(k=1e22))
+    bed(fine)
+    with pytest.raises(pq.SceneError, match="foundation.k"):
+        bed(coarse)
 
 
 def test_shapes_given_in_python_keep_their_scene_form():

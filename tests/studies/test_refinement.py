@@ -1,8 +1,13 @@
 """Mesh refinement (plateqp.studies.refinement): the convergence table against Timoshenko, and
-discretisation error against solver error: ``accuracy="auto"`` and ``solve_to_target``.
+discretisation error against solver error: ``accuracy="auto"`` and ``solve_to_target``, on the
+rectangle grid (ACM, BFS) and on triangles (DKT), where a mesh of n "cells a side" has element
+size h = L / n (L: the bounding box's side).
 
-External reference: Navier's double series for a simply supported square plate, under a
-uniform load and under a central point load; by superposition the reaction of a rigid
+External references: Navier's double series for a simply supported square plate, under a
+uniform load and under a central point load; the simply supported and the clamped circular
+plate of radius R (Timoshenko & Woinowsky-Krieger, Theory of plates and shells, §§ 15-19):
+clamped w0 = q R⁴ / 64 D, simply supported w0 = (5 + ν) q R⁴ / (64 (1 + ν) D), under a central
+point load P, w0 = (3 + ν) P R² / (16 π (1 + ν) D). By superposition the reaction of a rigid
 one-sided support at the centre, set at a gap g0 below the plate, is
 R = (w_q − g0) / α with w_q the centre deflection under the load and α that under a unit
 point load (while w_q > g0).
@@ -10,6 +15,7 @@ point load (while w_q > g0).
 
 from __future__ import annotations
 
+import json
 import math
 import warnings
 
@@ -59,22 +65,65 @@ def centre_scene(n=8, element="acm", support=True):
                     supports=[pq.Support(0.5, 0.5, gap=G0)] if support else [])
 
 
+# the same central support on triangles: a simply supported disc (a shape the grid cannot mesh)
+R, DISC_Q = 1.0, 1.0
+
+
+def disc(edge="simple", size=R / 8, **kw) -> pq.Scene:
+    return pq.Scene(name="disc", plate=pq.Plate(shape={"circle": [0.0, 0.0, R]}, h=0.01, E=1.0e7, nu=NU),
+                    mesh=pq.MeshSpec(element="dkt", size=size), edges={"all": pq.Edge(edge)},
+                    loads=[pq.UniformLoad(DISC_Q)], **kw)
+
+
+DISC_D = disc().plate.D
+DISC_CLAMPED = DISC_Q * R**4 / (64 * DISC_D)
+DISC_SIMPLE = (5 + NU) * DISC_Q * R**4 / (64 * (1 + NU) * DISC_D)
+DISC_ALPHA = (3 + NU) * R**2 / (16 * math.pi * (1 + NU) * DISC_D)
+DISC_G0 = 0.5 * DISC_SIMPLE
+DISC_R_EXACT = (DISC_SIMPLE - DISC_G0) / DISC_ALPHA
+
+
+def disc_centre_support(size=R / 8) -> pq.Scene:
+    return disc("simple", size, supports=[pq.Support(0.0, 0.0, gap=DISC_G0)])
+
+
+# the central support on each mesh: (scene, its reaction's closed form)
+CENTRE = {"acm": (lambda: centre_scene(element="acm"), R_EXACT),
+          "bfs": (lambda: centre_scene(element="bfs"), R_EXACT),
+          "triangles": (disc_centre_support, DISC_R_EXACT)}
+
+
+def centre_case(mesh):
+    if mesh == "triangles":
+        pytest.importorskip("gmsh")
+    scene, exact = CENTRE[mesh]
+    return scene(), exact
+
+
 def test_references():
     """The series against Timoshenko's table: 0.00406 q a⁴/D and 0.01160 P a²/D."""
     assert W_Q * D / (Q * A**4) == pytest.approx(0.0040624, rel=2e-5)
     assert ALPHA * D / A**2 == pytest.approx(0.0116008, rel=2e-5)
 
 
-@pytest.mark.parametrize("element", ["acm", "bfs"])
-@pytest.mark.parametrize("target", [1e-2, 1e-3])
-def test_target_is_met(element, target):
+@pytest.mark.parametrize("mesh, target", [("acm", 1e-2), ("acm", 1e-3), ("bfs", 1e-2), ("bfs", 1e-3),
+                                          ("triangles", 1e-2)])
+def test_target_is_met(mesh, target):
+    """The reaction of the central support within the target of its closed form; on triangles
+    the mesh is chosen by halving the element size h."""
+    sc, exact = centre_case(mesh)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pq.PlateQPWarning)
-        out = solve_to_target(centre_scene(element=element), target)
+        out = solve_to_target(sc, target)
     assert out.reached and out.result.ok
-    assert abs(out.result.reactions[0] / R_EXACT - 1) <= target
+    assert abs(out.result.reactions[0] / exact - 1) <= target
     assert out.tolerance == pytest.approx(target / 10)
     assert out.result.accuracy == pytest.approx(target / 10)
+    if mesh == "triangles":
+        sizes = [r["mesh"][0] for r in out.rows]
+        assert sizes == [4 * 2**k for k in range(len(sizes))]
+        assert out.result.scene.mesh.size == pytest.approx(2 * R / sizes[-1])
+        assert "element size" in str(out)
 
 
 @pytest.mark.parametrize("element", ["acm", "bfs"])
@@ -132,8 +181,6 @@ def test_auto_on_a_coarse_mesh_is_low():
 def test_cli_target_and_accuracy(tmp_path, capsys):
     """``plateqp solve --target`` reports the mesh it chose and the estimate; numbers and "auto"
     are accepted by --accuracy; bad values are exit code 2 with a message."""
-    import json
-
     from plateqp.cli import main
 
     path = tmp_path / "centre.toml"
@@ -153,6 +200,40 @@ def test_cli_target_and_accuracy(tmp_path, capsys):
         assert exc.value.code == 2
     assert main(["solve", str(path), "--target", "1e-3", "--accuracy", "high"]) == 2
     assert "drop --accuracy" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("mesh", ["bfs", "triangles"])
+def test_cli_target_in_every_formulation(tmp_path, capsys, mesh):
+    """``plateqp solve SCENE.toml --target`` from the command line, every formulation: the
+    reaction within the target of its closed form (the square's on the grid, the disc's on
+    triangles), the mesh it reports the last one it tried."""
+    from plateqp.cli import main
+
+    sc, exact = centre_case(mesh)
+    path = tmp_path / "centre.toml"
+    sc.to_toml(path)
+    for form in ("primal", "condensed", "dual"):
+        assert main(["solve", str(path), "--target", "1e-2", "--formulation", form, "--json"]) == 0
+        d = json.loads(capsys.readouterr().out)
+        assert d["target"]["reached"] and abs(d["reactions"][0] / exact - 1) <= 1e-2
+        assert d["target"]["mesh"] == d["target"]["meshes"][-1]["mesh"]
+
+
+def test_auto_accuracy_on_a_disc_errs_on_the_safe_side():
+    """``accuracy="auto"`` on triangles: the error estimated from the meshes 4h and 2h is at least
+    the true error of the reaction on h (against the closed form), and the solver's tolerance
+    is a tenth of it."""
+    pytest.importorskip("gmsh")
+    sc = disc_centre_support(R / 16)
+    tol, est = auto_tolerance(sc)
+    assert est is not None and est.mesh == (32, 32) and est.from_meshes == ((8, 8), (16, 16))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        res = pq.solve(sc, accuracy="auto")
+    assert res.accuracy == pytest.approx(tol) == pytest.approx(0.1 * est.worst)
+    true_err = abs(res.reactions[0] / DISC_R_EXACT - 1)
+    assert true_err <= res.extras["discretisation_error"]["reactions"]
+    assert res.extras["discretisation_error"]["trusted"] is True
 
 
 # -- convergence by mesh halving ----------------------------------------------------------------
@@ -186,3 +267,34 @@ def test_convergence_reactions_on_a_contact_scene():
     assert tab.converged_at["reactions.12"] == (4, 4)
     # a lifted support's reaction is zero up to rounding: compared with the largest reaction, not with noise
     assert tab.converged_at["reactions.0"] == (4, 4)
+
+
+@pytest.mark.parametrize("edge, ref, meshes", [("clamped", DISC_CLAMPED, (16, 32, 64)),
+                                               ("simple", DISC_SIMPLE, (8, 16, 32, 64))])
+def test_convergence_on_a_disc_is_second_order(edge, ref, meshes):
+    """Triangles: the convergence table on meshes of h = 2R/n against the closed forms: w at the
+    centre within 0.1 % on the finest mesh, the error's fitted order in h ≈ 2 (DKT), the changes
+    shrinking (clamped: from 16 on; at h = R/4 the clamped error passes through a sign change)."""
+    pytest.importorskip("gmsh")
+    tab = convergence(disc(edge), meshes=meshes, quantities=("w:0,0",), target=0.01)
+    assert [m for m in tab.meshes] == [(n, n) for n in meshes] and all(e is None for e in tab.errors)
+    w = tab.values["w:0,0"]
+    err = np.abs(w / ref - 1)
+    assert err[-1] < 1e-3
+    h = 2 * R / np.array(meshes)
+    order = np.polyfit(np.log(h), np.log(err), 1)[0]
+    assert 1.7 < order < 2.3, (err, order)
+    assert np.all(np.diff(tab.diff["w:0,0"][:-1]) < 0)
+
+
+def _mean_edge(res) -> float:
+    g = res.model.grid
+    p = g.nodes[g.triangles]
+    return float(np.mean(np.hypot(*(p - np.roll(p, 1, axis=1)).transpose(2, 0, 1))))
+
+
+def test_triangle_meshes_halve_the_element_size():
+    """A mesh of n cells a side is the gmsh mesh of size h = L / n: its mean edge is h (within 15 %: gmsh makes the coarsest a little finer)."""
+    pytest.importorskip("gmsh")
+    tab = convergence(disc(), meshes=(8, 16, 32), quantities=(("edge", _mean_edge),))
+    assert tab.values["edge"] == pytest.approx(2 * R / np.array([8, 16, 32]), rel=0.15)
