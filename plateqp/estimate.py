@@ -72,8 +72,10 @@ class Quantities:
         if np.asarray(res.reactions).size:
             src = res.model.contacts.source
             R = np.asarray(res.reactions, dtype=float)[src == "support"]
-            if sc.foundation is not None:  # pressure = k × compression of the bed
-                p = float(sc.foundation.k * np.asarray(res.compressions)[src == "bed"].max(initial=0.0))
+            if sc.foundation is not None:  # the bed's pressure: its force over the node's area (k × compression on Winkler's)
+                bed = src == "bed"
+                area = res.model.bed_areas()[res.model.contacts.index[bed]]
+                p = float((np.asarray(res.reactions, dtype=float)[bed] / area).max(initial=0.0))
         w, mesh = res.w_nodes(), res.model.grid
         return cls(mesh_cells(sc), float(np.max(np.abs(w))), R, p,
                    mesh.grid_view(w))

@@ -122,7 +122,8 @@ def solve(scene: Scene, backend: str = "auto", formulation: str = "auto", accura
     if not auto:
         accuracy = Accuracy.parse(accuracy)  # a bad accuracy fails before any work
     t0 = time.perf_counter()
-    model = model or build_model(scene)
+    # backend "mprgp" solves a half-space on the grid matrix-free at any size (plateqp.contact.pressures)
+    model = model or build_model(scene, soil_operator=True if backend == "mprgp" else None)
     t_build = time.perf_counter() - t0
     if not scene.one_sided:
         t1 = time.perf_counter()

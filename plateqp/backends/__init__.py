@@ -16,13 +16,13 @@ from .base import ACCURACIES, LCP, PRESET_TOL, QP, Backend, RawSolution, Status,
 
 # module name -> the backends it provides (a family such as qpsolvers provides many), in the
 # order they are imported and listed: plateqp's own first
-_MODULES = ("lemke", "bpp", "pgs", "pdas", "toggle", "osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
+_MODULES = ("lemke", "bpp", "pgs", "pdas", "toggle", "mprgp", "osqp_", "clarabel_", "cvxpy_", "qpsolvers_")
 #: plateqp's own backends (the first modules of ``_MODULES``): their modules import no
 #: third-party solver. Every backend declared ``exact`` is among them (tests/backends/test_backends.py
 #: checks), so ``backend="auto"`` chooses from these alone and a solve with one of them never
 #: imports cvxpy, qpsolvers, OSQP or Clarabel (cvxpy's import alone took 0.3-0.5 s of a fresh
 #: process's first solve).
-IN_HOUSE = _MODULES[:5]
+IN_HOUSE = _MODULES[:6]
 # the other modules by the family a backend's name starts with ("cvxpy:SCS" -> cvxpy_)
 _FAMILY = {"osqp": "osqp_", "clarabel": "clarabel_", "cvxpy": "cvxpy_", "qpsolvers": "qpsolvers_"}
 

@@ -109,7 +109,7 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
     return KKTReport(
         floor=float(floor),
         stationarity=float(st),
-        spring=float(np.abs(s - data.rho * R).max(initial=0.0) / delta),
+        spring=float(np.abs(s - compressions(data, R)).max(initial=0.0) / delta),
         primal=float(max(0.0, -gap.min(initial=0.0)) / delta),
         dual=float(max(0.0, -R.min(initial=0.0)) / rscale),
         # divided in turn: rscale · delta underflows to 0 (0/0) when there is no load and no gap
@@ -118,6 +118,12 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
         tol=tol,
         scale=delta * data.W,
     )
+
+
+def compressions(data: Scaled, R: np.ndarray) -> np.ndarray:
+    """The supports' compressions the reactions R cause: ρ R, or with a half-space held
+    matrix-free its operator's settlements under the bed's rows (:attr:`Scaled.compliance`)."""
+    return data.rho * R if data.compliance is None else data.compliance(R)
 
 
 def abs_K_times(data: Scaled, x: np.ndarray) -> np.ndarray:
@@ -222,7 +228,9 @@ def close_pairs_error(data: Scaled, R, gap, rscale: float, delta: float, tol: fl
     """Where two close contact points both act: max |R − R*| / ρ_R, with R* the reactions of an
     exact solve (sparse LU of the saddle-point system, refined) holding the same contact set.
     0 where there is no such pair, or where that contact set does not hold the plate."""
-    if data.m < 2:
+    if data.m < 2 or data.compliance is not None:
+        # (a matrix-free soil's rows are distinct nodes; its compliance is no diagonal ρ to hold
+        # a contact set with: there the natural residual is the check)
         return 0.0
     memo = data.memo if data.memo is not None else {}
     if "rows_gram" not in memo:  # K and B alone: once per sweep

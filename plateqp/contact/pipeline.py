@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..accuracy import NO_WORK, Accuracy, Status
+from ..accuracy import Accuracy, Status
 from ..model.assembly import Model
 from ..backends import get_backend
 from ..backends.base import RawSolution
@@ -21,12 +21,13 @@ from ..errors import MechanismError, NoEquilibriumError, PlateQPWarning, Problem
 from ..linalg import solve_saddle
 from ..linalg.keep import keeping, shared
 from ..results import Result
+from .answer import to_result
 from .formulations import ContactSolution, Formulation, formulate
-from .kkt import defect_residual, heave_bound, heave_force, kkt_report, reaction_scale
+from .kkt import defect_residual, kkt_report
 from .predict import check_predict, predicted_set, wanted
 from .routing import choose, fallback_routes, formulations_for
 from .scaling import Scaled
-from .statics import NO_EQUILIBRIUM, settle, supports_reach
+from .statics import NO_EQUILIBRIUM, supports_reach
 
 log = logging.getLogger(__name__)
 
@@ -48,6 +49,10 @@ def solve_contact(model: Model, backend: str = "auto", formulation: str = "auto"
     (:func:`plateqp.contact.routing.fallback_routes`); ``extras["route"]`` says which route
     answered and why each one before it stopped. The first route runs exactly as without it.
     """
+    if model.soil_flexibility is not None:  # a half-space held matrix-free: solved in the contact forces
+        from .pressures import solve_pressures
+
+        return solve_pressures(model, backend, formulation, accuracy, options, check_statics)
     acc = Accuracy.parse(accuracy)  # ProblemError for a bad one, before any work
     options = dict(options or {})
     predict = options.pop("predict", "auto")  # the pipeline's own option, never the backend's
@@ -303,54 +308,16 @@ def finish(model: Model, form: Formulation, raw: RawSolution, accuracy: str | fl
     return res
 
 
-def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, backend: str, formulation: str,
-              accuracy: str | float | Accuracy) -> Result:
-    """A contact solution of the scaled problem back in the user's units, as a :class:`Result`.
-
-    A solved answer whose deflection is not unique (a rigid motion of a floating plate left free
-    by the supports that carry load) is replaced by the canonical one, the same whatever the
-    backend, and flagged ``deflection_unique = False`` (:func:`plateqp.contact.statics.settle`;
-    the reactions and the KKT report are those of the backend's answer).
-    """
-    acc = Accuracy.parse(accuracy)
-    tol = max(acc.tol, 1e-9)
-    u_s, unique = c.u, True
-    if status.solved and formulation != "bilateral" and np.all(np.isfinite(c.u)) and np.all(np.isfinite(c.R)):
-        u_s, unique = settle(data, c.u, c.R, c.s, tol)
-    u = data.dof_scale * u_s
-    R = data.F0 * c.R
-    s = data.W * c.s
-    w = model.contacts.B @ u
-    if model.n_soil:  # the soil's settlement v under a bed node: its compression; w the plate's (B u = w − v)
-        v = np.zeros(R.shape)
-        v[model.contacts.source == "bed"] = u[model.n_free:]
-        s, w = s + v, w + v
-    gaps = model.contacts.g0 + s - w
-    stat = model.K @ u - model.f + model.contacts.B.T @ R
-    res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))
-    # in contact: the reaction carries load, or the support touches (gap ≈ 0), both judged at
-    # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports).
-    # The gap is judged at each support's own deflection scale (the load's, its own initial gap, its
-    # deflection and compression), not at W: for a floating plate W counts every gap, and one support
-    # settled by 1000 would call every support within tol · 1000 of touching in contact
-    local = np.maximum.reduce([np.full(R.shape, data.w_load * data.W), np.abs(model.contacts.g0), np.abs(w),
-                               np.abs(s)]) if R.size else np.zeros(0)
-    # (reactions all below tol of the load are zero to the asked accuracy: kkt.reaction_scale)
-    # the heaves' force counts only where the load does no work beside it (accuracy.NO_WORK): its
-    # Rayleigh quotients are not computed where a cheap bound says the load does
-    heave = heave_force(data) if np.abs(data.f).sum() <= NO_WORK * heave_bound(data) else 0.0
-    active = (c.R > tol * reaction_scale(c.R, data.f, tol, heave)) | (np.abs(gaps) <= tol * np.maximum(local, 1e-300))
-    return Result(model.scene, model, model.expand(u), status=status, backend=backend, formulation=formulation,
-                  accuracy=acc.asked, reactions=R, gaps=gaps, compressions=s, active=active, residual=res,
-                  deflection_unique=unique)
-
-
 def solve_bilateral(model: Model) -> Result:
     """Every one-sided support made two-sided: B u − ρ R = g0 exactly, R of either sign.
 
     Solves the sparse saddle-point system [K Bᵀ; B −ρ] (u, R) = (f, g0), which works for a
     floating plate too (as long as the supports hold it).
     """
+    if model.soil_flexibility is not None:  # a half-space held matrix-free: the same system by CG
+        from .pressures import solve_bonded
+
+        return solve_bonded(model)
     t0 = time.perf_counter()
     data = Scaled.from_model(model)
     try:

@@ -60,6 +60,11 @@ class Scaled:
     spacing: np.ndarray | None = field(default=None, repr=False, compare=False)
     #: the soil whose surface has unknowns of its own among K's ("pasternak", "halfspace"), or None
     soil: str | None = None
+    #: a half-space held matrix-free (``Model.soil_flexibility``): s̃ = compliance(R̃), the
+    #: compressions of every row (the posts' ρ̃ R̃ and the soil's settlement under the bed's rows);
+    #: ``rho`` then holds on the bed's rows the soil's own point flexibility (the operator's
+    #: diagonal), the series spring of the KKT check's local stiffness. None otherwise
+    compliance: object = field(default=None, repr=False, compare=False)
 
     # inside plateqp.linalg.keep.sharing (a sweep): what this data derive from K, B and the contact
     # points' places alone (not from gaps, springs, loads nor W), kept in the model's list for the
@@ -67,11 +72,23 @@ class Scaled:
     memo: dict | None = field(default=None, repr=False, compare=False)
 
     @classmethod
-    def from_model(cls, model: Model) -> Scaled:
+    def from_model(cls, model: Model, operator: bool = False) -> Scaled:
+        """The scaled data of ``model``. A model whose half-space is held matrix-free
+        (``Model.soil_flexibility``) is scaled only for the route that takes the soil as an
+        operator (``operator=True``, :mod:`plateqp.contact.pressures`); any other use is a
+        ProblemError: its bed's rows alone would be a rigid bed."""
         c = model.contacts
         if c is None:
             raise ProblemError("the scene has no one-sided supports: nothing to formulate")
-        memo = structure(model)
+        if model.soil_flexibility is not None:
+            if not operator:
+                raise ProblemError(matrix_free_refusal(model))
+            return with_compliance(cls._scale(model, None), model)
+        return cls._scale(model, structure(model))
+
+    @classmethod
+    def _scale(cls, model: Model, memo: dict | None) -> Scaled:
+        c = model.contacts
         if memo is not None and "K" in memo:
             return cls._again(model, memo)
         p = model.scene.plate
@@ -154,6 +171,35 @@ def structure(model: Model) -> dict | None:
     value: dict = {}
     model.derived.append((K, B, "structure", value))
     return value
+
+
+def matrix_free_refusal(model: Model, what: str = "this") -> str:
+    """The one line that says a matrix-free half-space takes only its own route."""
+    from ..model.soil import HALFSPACE_OPERATOR_FROM
+
+    return (f"a half-space under {model.soil_rows.size} bed nodes (above {HALFSPACE_OPERATOR_FROM}) is held "
+            f"matrix-free, solved in the contact forces by backend 'auto' or 'mprgp'; {what} needs the soil as "
+            f"unknowns of K: use a coarser mesh or a smaller bed region")
+
+
+def with_compliance(data: Scaled, model: Model) -> Scaled:
+    """``data`` given the matrix-free soil's compliance (:attr:`Scaled.compliance`): s̃ = ρ̃ R̃ on
+    the posts, s̃ = (D/L²) H_F R̃ on the bed's rows (F0/W = D/L²: ρ̃'s own scaling)."""
+    p = model.scene.plate
+    factor = p.D / max(p.a, p.b) ** 2
+    H, rows = model.soil_flexibility, model.soil_rows
+    posts = data.rho.copy()  # the posts' springs, 0 on the bed's rows
+    rho = posts.copy()
+    rho[rows] = factor * H.diagonal()
+
+    def compliance(R: np.ndarray) -> np.ndarray:
+        s = posts * R
+        s[rows] += factor * (H @ R[rows])
+        return s
+
+    data.compliance = compliance
+    data.rho = rho
+    return data
 
 
 def soil_of(model: Model) -> str | None:

@@ -20,6 +20,7 @@ module                     job
 :mod:`.assembly`           :func:`~.assembly.build_model`: mesh, stiffness, load, contact operator
 :mod:`.soil`               soils whose surface has unknowns of its own (Pasternak, half-space)
 :mod:`.halfspace`          Boussinesq's surface flexibility: polygons exactly, a grid's by FFT
+:mod:`.halfspace_grid`     a half-space bed's force flexibility on a grid, matrix-free (FFT)
 :mod:`.variation`          a scene with one value changed, checked where it changed (sweeps)
 :mod:`.recovery`           moments and stresses from the curvatures, nodal averages
 =========================  =======================================================================

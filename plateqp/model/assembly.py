@@ -29,7 +29,7 @@ from ..errors import SceneError
 from .generators import mesh_generator
 from .memory import check_memory
 from .scene import PatchLoad, PointLoad, Scene, UniformLoad
-from .soil import attach, couples, halfspace_areas
+from .soil import attach, attach_operator, couples, halfspace_areas, halfspace_operator
 
 if TYPE_CHECKING:  # pragma: no cover
     from .elements import DKT
@@ -115,6 +115,11 @@ class Model:
     #: bed's contact rows in order); 0 and None for Winkler's springs or no bed
     n_soil: int = 0
     soil_nodes: np.ndarray | None = field(default=None, repr=False)
+    #: a half-space held matrix-free (:func:`plateqp.model.soil.attach_operator`): the soil's
+    #: force flexibility H_F on the bed's rows ``soil_rows`` (a LinearOperator, the user's units:
+    #: settlement = H_F @ forces), K without soil unknowns; None otherwise
+    soil_flexibility: object = field(default=None, repr=False, compare=False)
+    soil_rows: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def K_full(self) -> sp.csr_matrix:
@@ -222,11 +227,13 @@ def load_vector(scene: Scene, mesh, element, cell_dofs: np.ndarray, n_full: int)
     return f
 
 
-def build_model(scene: Scene) -> Model:
+def build_model(scene: Scene, soil_operator: bool | None = None) -> Model:
     """Mesh a scene (after :func:`check_memory`: a mesh too large for the machine is refused
     before any allocation) and assemble its stiffness on the free dofs (``mesh.assemble``), its
     loads (:func:`load_vector`), its two-sided supports (:func:`plateqp.model.constraints.prescribed`)
-    and its contact operator; the same steps on every mesh."""
+    and its contact operator; the same steps on every mesh. ``soil_operator``: a half-space bed
+    held matrix-free (True: wherever the mesh offers the operator; False: never; None: above
+    :data:`plateqp.model.soil.HALFSPACE_OPERATOR_FROM` bed nodes)."""
     check_memory(scene)
     mesh = mesh_generator(scene).from_scene(scene)
     el = ELEMENTS[scene.mesh.element]()
@@ -259,7 +266,11 @@ def build_model(scene: Scene) -> Model:
     if couples(scene.foundation):
         c = model.contacts
         rows = np.flatnonzero(c.source == "bed")
-        attach(model, rows, c.index[rows], model.bed_areas()[c.index[rows]])
+        H = halfspace_operator(model, c.index[rows], soil_operator)
+        if H is not None:
+            attach_operator(model, rows, c.index[rows], H)
+        else:
+            attach(model, rows, c.index[rows], model.bed_areas()[c.index[rows]])
     return model
 
 

@@ -154,6 +154,15 @@ class Grid:
         np.add.at(area, self.cell_nodes()[cells[hit]].ravel(), weights.ravel())
         return area
 
+    def halfspace_flexibility_operator(self, region, E: float, nu: float, nodes):
+        """The force flexibility of a half-space bed on ``region`` at its ``nodes`` (the contact
+        rows' order), matrix-free: an (m, m) symmetric LinearOperator equal to
+        :func:`plateqp.model.soil.halfspace_flexibility`'s matrix to rounding, applied by FFT
+        (:func:`plateqp.model.halfspace_grid.bed_flexibility`)."""
+        from .halfspace_grid import bed_flexibility
+
+        return bed_flexibility(self, region, E, nu, nodes)
+
     def boundary_edges(self):
         """The plate's boundary as every mesh gives it: (edges (ne, 2) node pairs, outward unit
         normals (ne, 2), boundary (ne,) 0 outer or K + 1 for cut-out K, segment (ne,) of that

@@ -39,6 +39,15 @@ Zhemochkin's method). The flexibility in forces, H_F (settlement at node i per u
 node j's cell), is dense; K_s = H_F⁻¹ (symmetrised: on unequal cells collocation is not
 exactly reciprocal). The dense block limits this route to a few thousand bed nodes
 (:data:`HALFSPACE_DENSE_MAX`).
+
+**The half-space held matrix-free** (a mesh that offers the operator: the rectangle grid, whose
+pressure cells are a regular sub-grid, so H_F is a convolution applied by FFT). Above
+:data:`HALFSPACE_OPERATOR_FROM` bed nodes the model keeps no soil unknowns: its bed's rows read
+the plate's w alone, and ``Model.soil_flexibility`` holds H_F as an operator
+(:func:`attach_operator`). Eliminating v = H_F R, the soil is a compliance on the contact rows,
+as an elastic support's 1/c is, but a full one: gap = g0 + H_F R − w. The contact problem is
+then solved in the contact forces (:mod:`plateqp.contact.pressures`), where the soil never
+needs a matrix.
 """
 
 from __future__ import annotations
@@ -51,6 +60,10 @@ from ..errors import ProblemError
 #: the most bed nodes a half-space's dense stiffness is built for (m² doubles: 4000 → 128 MB,
 #: with its flexibility and inverse alive at once about three times that)
 HALFSPACE_DENSE_MAX = 4000
+#: more bed nodes than this on a mesh that offers the half-space's operator (the grid) are held
+#: matrix-free (:func:`attach_operator`); up to it the soil's unknowns join K, and every backend
+#: and formulation takes the problem
+HALFSPACE_OPERATOR_FROM = 1000
 
 
 def couples(foundation) -> bool:
@@ -115,20 +128,26 @@ def _bed_cells(model, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return cells[keep], corners[keep]
 
 
-def pasternak_stiffness(model, nodes: np.ndarray, area: np.ndarray) -> sp.csr_matrix:
-    """K_s = k diag(area) + c2 L over the soil's unknowns at ``nodes`` (mesh node numbers, the
-    bed's contact order) with tributary ``area``; L the shear layer's Laplacian (the module's
-    text). Exactly symmetric."""
-    fnd = model.scene.foundation
+def shear_laplacian(model, nodes: np.ndarray) -> sp.csr_matrix:
+    """L, the Laplacian's stiffness ∫∇v·∇v dA over the bed's cells (the module's text) on the
+    soil's points ``nodes``, exactly symmetric."""
     mesh = model.grid
     cells, corners = _bed_cells(model, nodes)
-    Ke = fnd.shear * laplacian_cells(mesh.nodes[mesh.cells[cells]])
+    Ke = laplacian_cells(mesh.nodes[mesh.cells[cells]])
     k = corners.shape[1]
     rows = np.repeat(corners, k, axis=1).ravel()
     cols = np.tile(corners, (1, k)).ravel()
     m = nodes.size
     L = sp.csr_matrix((Ke.ravel(), (rows, cols)), shape=(m, m))
-    Ks = (L + L.T) * 0.5 + sp.diags(fnd.k * area)
+    return ((L + L.T) * 0.5).tocsr()
+
+
+def pasternak_stiffness(model, nodes: np.ndarray, area: np.ndarray) -> sp.csr_matrix:
+    """K_s = k diag(area) + c2 L over the soil's unknowns at ``nodes`` (mesh node numbers, the
+    bed's contact order) with tributary ``area``; L the shear layer's Laplacian (the module's
+    text). Exactly symmetric."""
+    fnd = model.scene.foundation
+    Ks = fnd.shear * shear_laplacian(model, nodes) + sp.diags(fnd.k * area)
     Ks = Ks.tocsr()
     Ks.sum_duplicates()
     Ks.sort_indices()
@@ -218,4 +237,24 @@ def attach(model, bed_rows: np.ndarray, nodes: np.ndarray, area: np.ndarray) -> 
     E = sp.csr_matrix((-np.ones(m), (bed_rows, np.arange(m))), shape=(c.m, m))
     c.B = sp.hstack([c.B, E], format="csr")
     model.n_soil = m
+    model.soil_nodes = nodes
+
+
+def halfspace_operator(model, nodes: np.ndarray, wanted: bool | None = None):
+    """H_F of the bed ``nodes`` as an operator (the mesh's own matrix-free route:
+    ``mesh.halfspace_flexibility_operator``), or None where the mesh offers none, where not
+    ``wanted``, or (``wanted`` None) where the bed is small enough for the soil's unknowns
+    (:data:`HALFSPACE_OPERATOR_FROM`)."""
+    fnd = model.scene.foundation
+    if fnd.model != "halfspace" or wanted is False or (wanted is None and nodes.size <= HALFSPACE_OPERATOR_FROM):
+        return None
+    return model.grid.halfspace_flexibility_operator(fnd.region, fnd.E, fnd.nu, nodes)
+
+
+def attach_operator(model, bed_rows: np.ndarray, nodes: np.ndarray, H) -> None:
+    """Hold the half-space matrix-free: ``model.soil_flexibility`` = H_F (forces on the bed's
+    rows ``bed_rows`` to the soil's settlements there), no soil unknowns in K, the bed's rows
+    reading the plate's w (their spring stays 0: the soil is the operator's)."""
+    model.soil_flexibility = H
+    model.soil_rows = bed_rows
     model.soil_nodes = nodes

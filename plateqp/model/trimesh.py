@@ -198,6 +198,10 @@ class TriMesh:
             raise SceneError(f"foundation.region: {region} does not overlap the plate's mesh")
         return area
 
+    def halfspace_flexibility_operator(self, region, E: float, nu: float, nodes) -> None:
+        """None: a triangle mesh has no matrix-free half-space flexibility (the dense route,
+        :func:`plateqp.model.soil.halfspace_flexibility`, holds it)."""
+
     # -- the names the contact code reads from a grid ------------------------------------
     @property
     def n_nodes(self) -> int:

@@ -1,0 +1,173 @@
+r"""A primal–dual active set method with preconditioned conjugate gradients inside, matrix-free,
+for the convex QP with bounds and a few equalities
+
+.. math::
+    \min_x \tfrac12 x^T M x + q^T x \quad\text{s.t.}\quad x \ge 0,\quad G^T x = b ,
+
+``M`` symmetric positive semidefinite (positive definite on the null space of ``Gᵀ``), known
+through ``matvec``; ``G`` dense m × k, k small (``None``: no equality).
+
+Contract:
+
+- **Method.** The active set A = {i : x_i − c g_i > 0} (g = M x + q − G α the gradient, c > 0
+  a scale of M's inverse; the semismooth Newton step of the complementarity function
+  min(x, g): Hintermüller, Ito & Kunisch, SIAM J. Optim. 13, 2003); on A the equality-constrained
+  problem with x = 0 off A is solved by conjugate gradients projected onto the null space of
+  G_Aᵀ and preconditioned by the restriction of ``precond`` (any symmetric positive definite
+  approximation of M⁻¹), started from the last iterate. While A changes, the inner solves stop
+  at ``INNER_RTOL``; once it settles, at the asked tolerance, and A is checked once more.
+- **Answer.** x ≥ 0 (the components left negative by an inexact inner solve are never
+  returned: a set that does not settle ends ``"cycled"``), ``alpha`` the equalities'
+  multipliers (least squares on A), ``g``.
+- **Status.** ``"optimal"`` when A no longer changes and, with g from a fresh product,
+  ‖min(x, g)‖ ≤ tol · max(‖q‖, ‖M x‖, ‖G α‖) and ‖Gᵀx − b‖ ≤ tol · max(‖b‖, ‖G‖‖x‖) (the
+  scales of :mod:`plateqp.backends.mprgp`'s rule); ``"cycled"`` when A repeats or ``max_outer``
+  sets were tried (the method has no convergence guarantee for a matrix that is not an
+  M-matrix: a flexibility is not one), ``"max_iter"`` when the products run out, ``"singular"``
+  when G_A loses rank (the set does not hold the plate). The caller falls back to MPRGP,
+  which converges for every such problem, on any of these.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+#: the inner solves' relative tolerance while the active set still changes
+INNER_RTOL = 1e-6
+#: active sets tried at most
+MAX_OUTER = 40
+
+
+@dataclass(frozen=True)
+class ActiveSetResult:
+    """What :func:`active_set_pcg` found (the module's contract)."""
+
+    x: np.ndarray
+    alpha: np.ndarray
+    g: np.ndarray
+    iterations: int  # conjugate gradient steps, all sets
+    matvecs: int
+    sets: int
+    status: str
+    message: str
+
+
+def _pcg(apply, rhs, x, precond, project, rtol, budget, Ax=None):
+    """Projected preconditioned CG on the equations apply(x) = rhs (on the current set), from x
+    (feasible for the projection's equalities; ``Ax`` its product if known): x, steps. Stops when
+    the residual's preconditioned norm is ``rtol`` of the right-hand side's (estimated by the
+    start's residual and rhs's plain norms: no product spent on it)."""
+    r = project(rhs - (apply(x) if Ax is None else Ax))
+    z = project(precond(r))
+    p = z.copy()
+    rz = r @ z
+    nr = np.linalg.norm(r)
+    stop = rtol * max(np.sqrt(abs(rz)) * np.linalg.norm(project(rhs)) / max(nr, 1e-300), 1e-300)
+    steps = 0
+    while np.sqrt(abs(rz)) > stop and steps < budget:
+        Ap = apply(p)
+        pAp = p @ Ap
+        if pAp <= 0:
+            break
+        a = rz / pAp
+        x = x + a * p
+        r = r - a * project(Ap)
+        z = project(precond(r))
+        rz, rz_old = r @ z, rz
+        p = z + (rz / rz_old) * p
+        steps += 1
+    return x, steps
+
+
+def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=None, b=None, x0=None,
+                   active=None, c: float = 1.0, tol: float = 1e-8, maxiter: int = 20000,
+                   max_outer: int = MAX_OUTER, precise: Callable | None = None) -> ActiveSetResult:
+    """Solve the module's QP; ``active`` (bool, m) or ``x0`` start the set (default: where the
+    gradient at x0, or at 0, is negative); ``precise``: a more accurate (dearer) product for the
+    last solves, once the set has settled. See the module's contract."""
+    q = np.asarray(q, dtype=float)
+    m = q.size
+    k = 0 if G is None else G.shape[1]
+    Gm = np.zeros((m, 0)) if G is None else np.asarray(G, dtype=float)
+    b = np.zeros(0) if G is None else np.asarray(b, dtype=float)
+    count = [0]
+
+    product = [matvec]
+
+    def M(v):
+        count[0] += 1
+        return product[0](v)
+
+    P = precond or (lambda v: v)
+    x = np.zeros(m) if x0 is None else np.maximum(np.asarray(x0, dtype=float), 0.0)
+    alpha = np.zeros(k)
+    g = M(x) + q
+    if k:  # the equalities' multipliers that fit the start best where it presses (everywhere at 0)
+        on = x > 0 if np.any(x > 0) else np.ones(m, dtype=bool)
+        alpha = np.linalg.lstsq(Gm[on], g[on], rcond=None)[0]
+        g = g - Gm @ alpha
+    A = np.asarray(active, dtype=bool).copy() if active is not None else (x - c * g) > 0
+    seen, steps, final, status, message = set(), 0, False, "cycled", f"{max_outer} active sets tried"
+    Mx, moved = None, True
+    for sets in range(1, max_outer + 1):
+        idx = np.flatnonzero(A)
+        GA = Gm[idx]
+        if k and np.linalg.matrix_rank(GA) < k:
+            status, message = "singular", f"the {idx.size} rows in the set do not hold the equalities"
+            break
+        GtG = GA.T @ GA if k else None
+
+        def project(v):
+            return v - GA @ np.linalg.solve(GtG, GA.T @ v) if k else v
+
+        def apply(v):
+            z = np.zeros(m)
+            z[idx] = v
+            return M(z)[idx]
+
+        def pre(v):
+            z = np.zeros(m)
+            z[idx] = v
+            return P(z)[idx]
+
+        xa = x[idx]
+        if k:  # onto G_Aᵀ x = b
+            xa = xa + GA @ np.linalg.solve(GtG, b - GA.T @ xa)
+        # the last product is this start's where x is already zero off A (no equality moved it)
+        known = Mx[idx] if (Mx is not None and not moved and not k and not np.any(x[~A])) else None
+        xa, n = _pcg(apply, -q[idx], xa, pre, project, 0.1 * tol if final else INNER_RTOL, maxiter - count[0], known)
+        steps += n
+        x = np.zeros(m)
+        x[idx] = xa
+        Mx = M(x)
+        alpha = np.linalg.lstsq(GA, (Mx + q)[idx], rcond=None)[0] if k else alpha
+        g = Mx + q - Gm @ alpha
+        new = (x - c * g) > 0
+        if count[0] >= maxiter:
+            status, message = "max_iter", f"{count[0]} products"
+            break
+        moved = False
+        if np.array_equal(new, A):
+            if not final:  # settled: solve it again tightly (on the accurate product, if given)
+                final = True
+                if precise is not None:
+                    product[0], moved = precise, True
+                continue
+            scale = max(np.linalg.norm(q), np.linalg.norm(Mx), np.linalg.norm(Gm @ alpha), 1e-300)
+            natural = np.linalg.norm(np.minimum(x, g)) / scale
+            eq = np.linalg.norm(Gm.T @ x - b) / max(np.linalg.norm(b), np.linalg.norm(Gm, 2) * np.linalg.norm(x), 1e-300) if k else 0.0
+            if natural <= tol and eq <= tol:
+                status, message = "optimal", f"set settled after {sets} sets, natural residual {natural:.1e}"
+                break
+            status, message = "stalled", f"the settled set's natural residual {natural:.1e} stays above {tol:.0e}"
+            break
+        key = new.tobytes()
+        if key in seen:
+            status, message = "cycled", f"an active set came back after {sets} sets"
+            break
+        seen.add(key)
+        A = new
+    return ActiveSetResult(np.maximum(x, 0.0), alpha, g, steps, count[0], sets, status, message)
