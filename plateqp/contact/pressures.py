@@ -40,6 +40,7 @@ import scipy.sparse as sp
 from ..accuracy import Accuracy, Status
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError
 from ..linalg.factor import Factor
+from ..model import soil
 from ..results import Result
 from .answer import to_result
 from .formulations import ContactSolution
@@ -126,15 +127,13 @@ def soil_fit(model, data: Scaled) -> sp.csr_matrix:
     at the bed's lowest and highest wavenumbers (π over its size, π over a cell), so that the two
     differ by at most ½√(ξ₂/ξ₁) between; the posts' springs (a rigid one: :data:`RIGID` × the
     stiffest). For :func:`preconditioner`."""
-    from ..model.soil import shear_laplacian
-
     fnd, p = model.scene.foundation, model.scene.plate
     rows, nodes = model.soil_rows, model.soil_nodes
     area = model.bed_areas()[nodes]
     a = fnd.E / (1.0 - fnd.nu**2) / 2.0
     xi1, xi2 = np.pi / np.sqrt(area.sum()), np.pi / np.sqrt(np.median(area))
     c2, k = a / (xi1 + xi2), a * xi1 * xi2 / (xi1 + xi2)
-    Sb = (c2 * shear_laplacian(model, nodes) + sp.diags(k * area)).tocoo()
+    Sb = (c2 * soil.shear_laplacian(model, nodes) + sp.diags(k * area)).tocoo()
     to_scaled = max(p.a, p.b) ** 2 / p.D  # a stiffness: the inverse of ρ's scaling
     diag = np.zeros(data.m)
     others = np.setdiff1d(np.arange(data.m), rows)
@@ -203,7 +202,7 @@ def check_backend(backend: str, formulation: str) -> None:
     if backend not in BACKENDS:
         raise ProblemError(f"backend {backend!r}: a half-space held matrix-free is solved in the contact forces by "
                            f"{' or '.join(repr(b) for b in BACKENDS)} only (the soil has no matrix for the others; "
-                           "a bed of at most HALFSPACE_OPERATOR_FROM nodes gives every backend its unknowns)")
+                           f"a bed of at most {soil.HALFSPACE_OPERATOR_FROM} nodes gives every backend its unknowns)")
     if formulation not in ("auto", "condensed"):
         raise ProblemError(f"formulation {formulation!r}: a half-space held matrix-free is solved condensed onto "
                            "the contact forces only (formulation 'auto' or 'condensed')")
