@@ -115,7 +115,7 @@ def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=No
     for sets in range(1, max_outer + 1):
         idx = np.flatnonzero(A)
         GA = Gm[idx]
-        if k and np.linalg.matrix_rank(GA) < k:
+        if k and (idx.size < k or np.linalg.matrix_rank(GA) < k):
             status, message = "singular", f"the {idx.size} rows in the set do not hold the equalities"
             break
         GtG = GA.T @ GA if k else None

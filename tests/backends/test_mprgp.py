@@ -52,7 +52,10 @@ def clarabel_reference(M, q, lb, G=None, b=None):
     solver = clarabel.DefaultSolver(sp.triu(sp.csc_matrix(M), format="csc"), q, A,
                                     np.concatenate(rhs) if rhs else np.zeros(0), cones, settings)
     sol = solver.solve()
-    assert str(sol.status) in ("Solved", "AlmostSolved"), sol.status
+    # Clarabel 0.9 (the oldest the project allows) stops short of 1e-10 on some of these
+    # ("InsufficientProgress") with an answer whose active set is right: refined() solves the KKT
+    # system on that set exactly and checks it, so a wrong set cannot pass either way
+    assert str(sol.status) in ("Solved", "AlmostSolved", "InsufficientProgress"), sol.status
     x, z = np.array(sol.x), np.array(sol.z)[len(rhs[0]) if G is not None and G.shape[1] else 0:]
     slack = np.full(m, np.inf)
     dual = np.zeros(m)
