@@ -424,7 +424,38 @@ def grid_kernel(nx: int, ny: int, hx: float, hy: float, E: float, nu: float, *,
     return K
 
 
-class GridFlexibility(LinearOperator):
+class SymmetricOperator(LinearOperator):
+    """A symmetric LinearOperator (its own adjoint) whose products check their argument's shape
+    (a ProblemError in the subclass's words, :meth:`_shape_error`) and are computed by
+    ``_matmat`` alone (a vector as a one-column matrix)."""
+
+    def _shape_error(self, what: str, shape: tuple, n: int) -> str:
+        raise NotImplementedError
+
+    def _check(self, x, ndim: int):
+        x = np.asarray(x)
+        n = self.shape[1]
+        if not ((x.ndim == ndim or (ndim == 1 and x.shape == (n, 1))) and x.shape[0] == n):
+            raise ProblemError(self._shape_error("vector" if ndim == 1 else "matrix", x.shape, n))
+        return x
+
+    def matvec(self, x):
+        return super().matvec(self._check(x, 1))
+
+    def matmat(self, X):
+        return super().matmat(self._check(X, 2))
+
+    def _matvec(self, x):
+        return self._matmat(np.asarray(x, dtype=float).reshape(-1, 1)).reshape(np.shape(x))
+
+    def _rmatvec(self, x):
+        return self._matvec(x)
+
+    def _adjoint(self):
+        return self
+
+
+class GridFlexibility(SymmetricOperator):
     """The flexibility of a grid of equal rectangles, applied by FFT without forming the matrix.
 
     ``op @ p`` equals ``flexibility(centres, cells, E, nu, per=per) @ p`` over the cells of
@@ -490,23 +521,8 @@ class GridFlexibility(LinearOperator):
         """The matrix's diagonal: one value, the kernel's centre, for every kept cell."""
         return np.full(self.shape[0], self.kernel[self.ny - 1, self.nx - 1])
 
-    def _check(self, x, ndim: int):
-        x = np.asarray(x)
-        n = self.shape[1]
-        if not ((x.ndim == ndim or (ndim == 1 and x.shape == (n, 1))) and x.shape[0] == n):
-            what = "vector" if ndim == 1 else "matrix"
-            raise ProblemError(f"GridFlexibility: a {what} of shape {x.shape} for {n} cells; give one value "
-                               f"per kept cell ({n}), in grid order")
-        return x
-
-    def matvec(self, x):
-        return super().matvec(self._check(x, 1))
-
-    def matmat(self, X):
-        return super().matmat(self._check(X, 2))
-
-    def _matvec(self, x):
-        return self._matmat(np.asarray(x, dtype=float).reshape(-1, 1)).reshape(np.shape(x))
+    def _shape_error(self, what: str, shape: tuple, n: int) -> str:
+        return f"GridFlexibility: a {what} of shape {shape} for {n} cells; give one value per kept cell ({n}), in grid order"
 
     def _matmat(self, X):
         X = np.asarray(X, dtype=float)
@@ -521,9 +537,3 @@ class GridFlexibility(LinearOperator):
             w = scipy.fft.irfft2(spectrum, s=self.fft_shape)[:, :ny, :nx].reshape(-1, ny * nx)
             out[:, c0:c0 + cols] = w[:, self.kept].T
         return out
-
-    def _rmatvec(self, x):
-        return self._matvec(x)
-
-    def _adjoint(self):
-        return self

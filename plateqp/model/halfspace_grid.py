@@ -40,10 +40,9 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.fft
-from scipy.sparse.linalg import LinearOperator
 
 from ..errors import ProblemError
-from .halfspace import boussinesq_factor, polygon_potential
+from .halfspace import SymmetricOperator, boussinesq_factor, polygon_potential
 from .soil import region_cells
 
 #: The quarters of a cell, (a, b): the corner they touch along x and along y; in reverse order
@@ -84,7 +83,7 @@ def quarter_kernels(nx: int, ny: int, hx: float, hy: float, E: float, nu: float)
     return np.stack([g[np.ix_(index(ny, b), index(nx, a))] for a, b in QUARTERS])
 
 
-class BedFlexibility(LinearOperator):
+class BedFlexibility(SymmetricOperator):
     """½(H + Hᵀ), the force flexibility of a half-space bed's nodes on a grid (:func:`bed_flexibility`).
 
     ``op @ x``: the settlements at the bed's nodes (in ``nodes`` order) under the forces x on them
@@ -145,29 +144,8 @@ class BedFlexibility(LinearOperator):
         """(m,) the matrix's diagonal (H's own: symmetrising keeps it), exact."""
         return self._diagonal.copy()
 
-    def _check(self, x, ndim: int):
-        x = np.asarray(x)
-        n = self.shape[1]
-        if not ((x.ndim == ndim or (ndim == 1 and x.shape == (n, 1))) and x.shape[0] == n):
-            what = "vector" if ndim == 1 else "matrix"
-            raise ProblemError(f"x: a {what} of shape {x.shape} for {n} bed nodes; give one value per node, "
-                               "in the order of nodes")
-        return x
-
-    def matvec(self, x):
-        return super().matvec(self._check(x, 1))
-
-    def matmat(self, X):
-        return super().matmat(self._check(X, 2))
-
-    def _matvec(self, x):
-        return self._matmat(np.asarray(x, dtype=float).reshape(-1, 1)).reshape(np.shape(x))
-
-    def _rmatvec(self, x):
-        return self._matvec(x)
-
-    def _adjoint(self):
-        return self
+    def _shape_error(self, what: str, shape: tuple, n: int) -> str:
+        return f"x: a {what} of shape {shape} for {n} bed nodes; give one value per node, in the order of nodes"
 
     def settlements(self, forces) -> np.ndarray:
         """H @ ``forces``: the settlements at the nodes under the nodes' forces (m,) or (m, k),
