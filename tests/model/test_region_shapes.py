@@ -28,6 +28,8 @@ import plateqp as pq
 from plateqp.model.assembly import build_model
 from plateqp.model.paths import get_param, set_param
 
+from test_loads_every_mesh import load_resultant  # noqa: E402  (one definition of the loads' resultant)
+
 pytest.importorskip("gmsh")
 
 NU = 0.3
@@ -46,18 +48,6 @@ def reactions_total(res) -> float:
     m = res.model
     R = m.K_full @ res.u - m.f_full
     return -R[0::m.element.ndof_node].sum()
-
-
-def load_resultant(model):
-    """Total force and its centroid: the work of the loads in a rigid translation w = 1 and in
-    the rigid rotations w = x, w = y (nodal slopes 1 where the element carries them)."""
-    names = list(model.element.dof_names)
-    f = model.f_full.reshape(-1, len(names))
-    xy = model.grid.node_xy()
-    F = f[:, 0].sum()
-    mx = f[:, 0] @ xy[:, 0] + f[:, names.index("wx")].sum()
-    my = f[:, 0] @ xy[:, 1] + f[:, names.index("wy")].sum()
-    return F, np.array([mx, my]) / F
 
 
 MESHES = [("acm", 16), ("bfs", 16), ("dkt", 16)]
