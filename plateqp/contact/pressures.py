@@ -94,16 +94,19 @@ class PressureProblem:
         u[self.keep] = self.fac.solve(F[self.keep], refine=refine)
         return u
 
-    def matvec(self, R: np.ndarray) -> np.ndarray:
-        """(B K_p⁻¹ Bᵀ + C) R."""
+    def product(self, R: np.ndarray, refine: int) -> np.ndarray:
+        """(B K_p⁻¹ Bᵀ + C) R, the solve refined ``refine`` times (counted in ``matvecs``)."""
         self.matvecs += 1
-        return self.data.B @ self.solve_K(self.BT @ R, refine=self.refine) + self.data.compliance(R)
+        return self.data.B @ self.solve_K(self.BT @ R, refine=refine) + self.data.compliance(R)
+
+    def matvec(self, R: np.ndarray) -> np.ndarray:
+        """:meth:`product` as the rounds ask (:attr:`refine`)."""
+        return self.product(R, self.refine)
 
     def precise(self, R: np.ndarray) -> np.ndarray:
-        """:meth:`matvec` with its solve refined once (about twice the work; the error of a plain
+        """:meth:`product` with its solve refined once (about twice the work; the error of a plain
         solve, cond(K)·ε, squared)."""
-        self.matvecs += 1
-        return self.data.B @ self.solve_K(self.BT @ R, refine=1) + self.data.compliance(R)
+        return self.product(R, 1)
 
     def recover(self, R: np.ndarray, alpha: np.ndarray | None, closed: np.ndarray | None = None) -> ContactSolution:
         """The plate's dofs and the rows' compressions of the forces R (refined solves); the rigid
