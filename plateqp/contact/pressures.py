@@ -249,9 +249,9 @@ def solve_pressures(model, backend: str = "auto", formulation: str = "auto",
         rep = kkt_report(data, c, acc)
         if rep.ok or out.status != "optimal":
             break
-        # the solver met its tolerance on products accurate to cond(K)·ε: again from its answer,
-        # each product's solve refined, and tighter
-        start, tol, pr.refine = out.x, tol * 0.1, 2
+        # again from the answer, tighter; MPRGP met its tolerance on products accurate to
+        # cond(K)·ε, so its products' solves are refined (the active-set PCG's residuals are)
+        start, tol, pr.refine = out.x, tol * 0.1, 2 if method == "mprgp" else 0
     t2 = time.perf_counter()
     status = (Status.OPTIMAL if rep.ok else Status.INACCURATE) if out.status == "optimal" else (
         Status.MAX_ITER if out.status == "max_iter" else Status.INACCURATE)
