@@ -69,12 +69,15 @@ class ActiveSetResult:
     message: str
 
 
-def _pcg(apply, rhs, x, precond, project, rtol, budget, Ax=None):
-    """Projected preconditioned CG on the equations apply(x) = rhs (on the current set), from x
-    (feasible for the projection's equalities; ``Ax`` its product if known): x, steps. Stops when
-    the residual's preconditioned norm is ``rtol`` of the right-hand side's (estimated by the
-    start's residual and rhs's plain norms: no product spent on it)."""
-    r = project(rhs - (apply(x) if Ax is None else Ax))
+def _pcg(apply, idx, rhs, x, precond, project, rtol, budget, Ax=None):
+    """Projected preconditioned CG on the equations apply(x)[idx] = rhs (on the current set),
+    from x (feasible for the projection's equalities; ``Ax`` its product if known): x, steps and
+    the product of x on every row (``apply`` gives them all: carried along the steps, so the
+    gradient off the set costs no product). Stops when the residual's preconditioned norm is
+    ``rtol`` of the right-hand side's (estimated by the start's residual and rhs's plain norms:
+    no product spent on it)."""
+    Ax = apply(x) if Ax is None else Ax.copy()
+    r = project(rhs - Ax[idx])
     z = project(precond(r))
     p = z.copy()
     rz = r @ z
@@ -83,17 +86,18 @@ def _pcg(apply, rhs, x, precond, project, rtol, budget, Ax=None):
     steps = 0
     while np.sqrt(abs(rz)) > stop and steps < budget:
         Ap = apply(p)
-        pAp = p @ Ap
+        pAp = p @ Ap[idx]
         if pAp <= 0:
             break
         a = rz / pAp
         x = x + a * p
-        r = r - a * project(Ap)
+        Ax += a * Ap
+        r = r - a * project(Ap[idx])
         z = project(precond(r))
         rz, rz_old = r @ z, rz
         p = z + (rz / rz_old) * p
         steps += 1
-    return x, steps
+    return x, steps, Ax
 
 
 def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=None, b=None, x0=None,
@@ -141,7 +145,7 @@ def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=No
         def apply(v):
             z = np.zeros(m)
             z[idx] = v
-            return M(z)[idx]
+            return M(z)
 
         def pre(v):
             z = np.zeros(m)
@@ -154,8 +158,8 @@ def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=No
         # the last product is still this start's where x is zero off A and no equality moved it
         known = fresh and not np.any(x[~A]) and (not k or np.array_equal(xa, x[idx]))
         if not final:
-            xa, n = _pcg(apply, -q[idx], xa, pre, project, INNER_RTOL, maxiter - count[0],
-                         Mx[idx] if known else None)
+            xa, n, Mx = _pcg(apply, idx, -q[idx], xa, pre, project, INNER_RTOL, maxiter - count[0],
+                             Mx if known else None)
         else:  # refinement: the accurate product's residual, corrected by CG on the plain one
             if not known:
                 x = np.zeros(m)
@@ -164,13 +168,14 @@ def active_set_pcg(matvec: Callable, q, *, precond: Callable | None = None, G=No
             r = -(Mx + q)[idx]
             scale = max(np.linalg.norm(q), np.linalg.norm(Mx), 1e-300)
             rtol = min(max(REFINE_AIM * tol * scale / max(np.linalg.norm(project(r)), 1e-300), REFINE_RTOL), 0.5)
-            d, n = _pcg(apply, r, np.zeros(idx.size), pre, project, rtol, maxiter - count[0], np.zeros(idx.size))
+            d, n, _ = _pcg(apply, idx, r, np.zeros(idx.size), pre, project, rtol, maxiter - count[0], np.zeros(m))
             xa = xa + d
             rounds += 1
         steps += n
         x = np.zeros(m)
         x[idx] = xa
-        Mx = M(x, dear=final)
+        if final:  # the correction's product is the plain one's: the residual anew, accurate
+            Mx = M(x, dear=True)
         alpha = np.linalg.lstsq(GA, (Mx + q)[idx], rcond=None)[0] if k else alpha
         g = Mx + q - Gm @ alpha
         fresh = True
