@@ -60,6 +60,9 @@ RETRIES = 2
 START_MIN = 2000
 #: the accuracy the start's coarser solve is asked (it is only a start)
 START_TOL = 1e-4
+#: the products the start's coarser solve may take (a start that does not come cheaply is not
+#: worth having: the solve goes on cold)
+START_PRODUCTS = 1000
 #: a rigid post's spring in the preconditioner's sparse soil: this many times its stiffest
 RIGID = 100.0
 
@@ -165,8 +168,9 @@ def preconditioner(model, data: Scaled):
 
 def coarse_start(model, accuracy) -> np.ndarray | None:
     """The contact forces of the mesh with half the cells a side (solved matrix-free, itself
-    started so while it is large enough), as pressures interpolated linearly to this model's
-    rows × their areas; None where that mesh cannot be built or solved."""
+    started so while it is large enough, to :data:`START_TOL` and no further: no refinement of
+    the settled set, no KKT check, no result), as pressures interpolated linearly to this
+    model's rows × their areas; None where that mesh cannot be built or solved."""
     from scipy.interpolate import LinearNDInterpolator
 
     from ..estimate import COARSE_FAILURES, with_mesh
@@ -176,18 +180,35 @@ def coarse_start(model, accuracy) -> np.ndarray | None:
     nx, ny = mesh_cells(model.scene)
     try:
         coarse_model = build_model(with_mesh(model.scene, max(1, nx // 2), max(1, ny // 2)), soil_operator=True)
+        if coarse_model.soil_flexibility is None:
+            return None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", PlateQPWarning)
-            coarse = solve_pressures(coarse_model, accuracy=max(Accuracy.parse(accuracy).tol, START_TOL))
+            R = _start_forces(coarse_model, max(Accuracy.parse(accuracy).tol, START_TOL))
     except (*COARSE_FAILURES, NoEquilibriumError):
         return None
-    if not coarse.status.solved or coarse_model.soil_flexibility is None:
+    if R is None:
         return None
     cc = coarse_model.contacts
-    p = coarse.reactions / coarse_model.bed_areas()[cc.index]
+    p = R / coarse_model.bed_areas()[cc.index]
     c = model.contacts
     at = LinearNDInterpolator(cc.xy, np.maximum(p, 0.0), fill_value=0.0)(c.xy)
     return np.nan_to_num(at) * model.bed_areas()[c.index] * (c.source == "bed")
+
+
+def _start_forces(model, tol: float) -> np.ndarray | None:
+    """The contact forces (user units) of :func:`solve_pressures`'s solver on ``model`` with the
+    solver's tolerance ``tol`` and no accurate product: a start, not an answer (None where the
+    solver does not converge or statics rule an equilibrium out)."""
+    data = Scaled.from_model(model, operator=True)
+    reach = supports_reach(data, band=tol)
+    if not reach.possible and not reach.marginal:
+        return None
+    pr = PressureProblem(data)
+    x0 = coarse_start(model, tol) if data.m >= START_MIN else None
+    start = None if x0 is None else np.maximum(x0 / data.F0, 0.0)
+    _, out = _Solver(model, data, pr, START_PRODUCTS).run("pdas-pcg", start, tol, [], precise=False)
+    return data.F0 * out.x if out.status == "optimal" else None
 
 
 def _pins(data: Scaled) -> np.ndarray:
@@ -277,7 +298,7 @@ class _Solver:
         self.precond = None
         self.iterations = 0
 
-    def run(self, method: str, start, tol: float, said: list):
+    def run(self, method: str, start, tol: float, said: list, precise: bool = True):
         from ..backends.active_pcg import active_set_pcg
         from ..backends.mprgp import solve_bound_qp
 
@@ -289,7 +310,7 @@ class _Solver:
             # a floating plate without a start: every row in contact (the bonded soil holds it)
             every = np.ones(d.m, dtype=bool) if start is None and pr.G is not None else None
             out = active_set_pcg(pr.matvec, pr.q, precond=self.precond, G=pr.G, b=pr.b, x0=start, active=every, c=c,
-                                 tol=tol, maxiter=self.maxiter - pr.matvecs, precise=pr.precise)
+                                 tol=tol, maxiter=self.maxiter - pr.matvecs, precise=pr.precise if precise else None)
             self.iterations += out.iterations
             said.append({"method": method, "status": out.status, "why": out.message})
             if out.status == "optimal":
