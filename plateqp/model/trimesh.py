@@ -25,7 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SceneError
-from .blocks import assemble_blocks
+from .blocks import block_pattern
 from .geometry import Domain, inner_segments
 from .gmsh_mesh import REFINE  # noqa: F401 - the refinement around embedded points, read by tests and docs
 from .gmsh_mesh import mesh_domain as _gmsh_mesh_domain
@@ -68,6 +68,8 @@ class TriMesh:
     size: float
     domain: Domain
     _tree: object = field(default=None, repr=False, compare=False)
+    #: the assembly's scatter patterns, [(pos, pattern)] (:meth:`assemble`): the last two kept
+    _patterns: list = field(default_factory=list, repr=False, compare=False)
 
     # -- the mesh as every generator gives it (plateqp.model.grid.Grid has the same names) ---------
     cell_type = "triangle"
@@ -178,10 +180,15 @@ class TriMesh:
     def assemble(self, element, D: float, nu: float, pos: np.ndarray, ncol: int) -> sp.csr_matrix:
         """The stiffness on the dofs with ``pos`` ≥ 0 (``pos``: each dof's new index, increasing;
         ``ncol`` of them), in canonical CSR, exactly symmetric: the element matrices of every
-        triangle (``element.cell_stiffness``, batched) summed by node blocks
-        (:func:`plateqp.model.blocks.assemble_blocks`)."""
+        triangle (``element.cell_stiffness``, batched) summed by node blocks through the mesh's
+        scatter pattern for ``pos`` (:func:`plateqp.model.blocks.block_pattern`, worked out on
+        the first assembly and kept with the mesh for the next)."""
         Ke = element.cell_stiffness(self.nodes[self.triangles], D, nu)
-        return assemble_blocks(Ke, self.triangles, len(self.nodes), pos, ncol)
+        pattern = next((pat for p, pat in self._patterns if p.shape == pos.shape and np.array_equal(p, pos)), None)
+        if pattern is None or pattern.n != ncol:
+            pattern = block_pattern(self.triangles, len(self.nodes), Ke.shape[1] // 3, pos, ncol)
+            self._patterns[:] = [*self._patterns[-1:], (pos.copy(), pattern)]
+        return pattern.assemble(Ke)
 
     def tributary_areas(self, region) -> np.ndarray:
         """(n_nodes,) each node's tributary area of a bed on ``region`` (a box [x0, x1, y0, y1], a
