@@ -27,13 +27,10 @@ import scipy.sparse as sp
 from ..errors import SceneError
 from .blocks import block_pattern
 from .geometry import Domain, inner_segments
-from .gmsh_mesh import REFINE  # noqa: F401 - the refinement around embedded points, read by tests and docs
+from .gmsh_mesh import NODES_PER_AREA, REFINE  # noqa: F401 - REFINE: the refinement around embedded points, read by tests and docs
 from .gmsh_mesh import mesh_domain as _gmsh_mesh_domain
 from .regions import lumped_region, region_outline
 from .symmetry import mirror_lines
-
-#: nodes of a mesh per area / h², about (measured: 1.09 on the unit disc at h = 1/16)
-NODES_PER_AREA = 1.2
 
 
 def estimate_nodes(scene) -> float:
