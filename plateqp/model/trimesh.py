@@ -28,7 +28,9 @@ from ..errors import SceneError
 from .blocks import block_pattern
 from .geometry import Domain, inner_segments
 from .gmsh_mesh import NODES_PER_AREA, REFINE  # noqa: F401 - REFINE: the refinement around embedded points, read by tests and docs
+from .gmsh_mesh import gmsh_options
 from .gmsh_mesh import mesh_domain as _gmsh_mesh_domain
+from .mesh_cache import MeshCache, mesh_key
 from .regions import lumped_region, region_outline
 from .symmetry import mirror_lines
 
@@ -330,8 +332,14 @@ def _barycentric(p, x, y):
     return np.column_stack([1.0 - l2 - l3, l2, l3])
 
 
+#: the meshes of the last few geometries (:mod:`plateqp.model.mesh_cache`): a sweep or a study that
+#: solves one plate again meshes it once; ``MESHES.clear()`` empties it, ``MESHES.size = 0`` turns it off
+MESHES = MeshCache(3)
+
+
 def mesh_domain(domain: Domain, size: float, points=(), lines=(), mirrors=()) -> TriMesh:
     """Mesh ``domain`` with gmsh at target size ``size`` (:func:`plateqp.model.gmsh_mesh.mesh_domain`:
-    ``points`` become nodes, ``lines`` run along element edges, ``mirrors`` make it symmetric)."""
-    return TriMesh(*_gmsh_mesh_domain(domain, size, points, lines, mirrors))
-
+    ``points`` become nodes, ``lines`` run along element edges, ``mirrors`` make it symmetric), or
+    the mesh of the same exact geometry made before (:data:`MESHES`)."""
+    key = mesh_key(domain, size, points, lines, mirrors, gmsh_options())
+    return MESHES.get(key, lambda: TriMesh(*_gmsh_mesh_domain(domain, size, points, lines, mirrors)))
