@@ -13,6 +13,7 @@ import threading
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..errors import SceneError
 from .geometry import Domain, Polygon, _point_segment
@@ -112,7 +113,7 @@ def _mesh(gmsh, domain: Domain, h: float, points, lines=()) -> MeshArrays:
     """The steps of :func:`mesh_domain` inside one gmsh model: the boundary curves, the embedded
     points and lines, the size field, the mesh, and the mesh read back."""
     tol = 1e-9 * domain.size
-    curves = _boundary_curves(gmsh.model.geo, domain, lines, tol)
+    curves = _boundary_curves(gmsh.model.geo, domain, lines, tol, points)
     surf = gmsh.model.geo.addPlaneSurface(curves.loops)
     gmsh.model.geo.synchronize()
     embedded = _embed(gmsh, surf, domain, curves, points, lines, tol)
@@ -147,14 +148,15 @@ class _Curves:
     loops: list
 
 
-def _boundary_curves(geo, domain: Domain, lines, tol: float) -> _Curves:
-    """One gmsh curve per polygon segment (split where a line of ``lines`` ends on it: a line must
-    end at a point of the boundary's own curves to be meshed conformingly), a circle as arcs (split
-    at the quarter points and where a line ends on it)."""
+def _boundary_curves(geo, domain: Domain, lines, tol: float, points=()) -> _Curves:
+    """One gmsh curve per polygon segment (split where a line of ``lines`` ends on it or a point of
+    ``points`` lies on it: a line must end at a point of the boundary's own curves to be meshed
+    conformingly, and a point embedded in a curve is not made a node), a circle as arcs (split at
+    the quarter points and there)."""
     c = _Curves({}, {}, [], [], [])
-    ends = [e for seg in lines for e in seg]
+    ends = np.array([e for seg in lines for e in seg] + list(points), dtype=float).reshape(-1, 2)
     for k, shape in enumerate((domain.outer, *domain.holes)):
-        on = [e for e in ends if shape.distance(*e)[0] <= tol]
+        on = [tuple(e) for e in ends[shape.distance(ends[:, 0], ends[:, 1]) <= tol].tolist()]
         tags = []
         if isinstance(shape, Polygon):
             verts = []
@@ -194,17 +196,22 @@ def _embed(gmsh, surf: int, domain: Domain, curves: _Curves, points, lines, tol:
     vertex or a line's end) in the curve it lies on, a line, or the surface. Returns the embedded
     points [(tag, curve or None)]."""
     geo = gmsh.model.geo
-    embedded, seen = [], []
     line_tags, line_ends = _lines(geo, curves.vertices, lines, tol)
-    for x, y in points:
-        if any(math.hypot(x - u, y - v) <= tol for u, v in seen):
-            continue
-        seen.append((x, y))
-        if any(math.hypot(x - u, y - v) <= tol for u, v, _ in curves.vertices + line_ends):
-            continue
-        on = _curve_at(domain, curves.of, curves.geom, x, y, tol)
-        if on is None:  # on an embedded line: a point of that line
-            on = next((c for c, (p, q) in line_tags if float(_point_segment(x, y, (p, q))) <= tol), None)
+    pts = _distinct(np.asarray(list(points), dtype=float).reshape(-1, 2), tol)
+    taken = np.array([(u, v) for u, v, _ in curves.vertices + line_ends], dtype=float).reshape(-1, 2)
+    if len(pts) and len(taken):  # a boundary vertex or a line's end is a point already
+        pts = pts[cKDTree(taken).query(pts)[0] > tol]
+    boundary = np.zeros(len(pts), dtype=bool)
+    for shape in (domain.outer, *domain.holes):
+        boundary |= shape.distance(pts[:, 0], pts[:, 1]) <= tol
+    line_of = np.full(len(pts), -1)  # the first line each point lies on
+    for k, (_, seg) in reversed(list(enumerate(line_tags))):
+        line_of[_point_segment(pts[:, 0], pts[:, 1], seg) <= tol] = k
+    embedded = []
+    for (x, y), on_boundary, k in zip(pts.tolist(), boundary, line_of):
+        on = _curve_at(domain, curves.of, curves.geom, x, y, tol) if on_boundary else None
+        if on is None and k >= 0:  # on an embedded line: a point of that line
+            on = line_tags[k][0]
         # built-in kernel: new points after synchronize need another synchronize before embedding
         t = geo.addPoint(x, y, 0.0)
         embedded.append((t, on))
@@ -217,6 +224,18 @@ def _embed(gmsh, surf: int, domain: Domain, curves: _Curves, points, lines, tol:
         else:
             gmsh.model.mesh.embed(0, [t], 1, on)
     return embedded
+
+
+def _distinct(pts: np.ndarray, tol: float) -> np.ndarray:
+    """The points ``pts`` (n, 2) less each one within ``tol`` of an earlier point kept."""
+    if len(pts) < 2:
+        return pts
+    keep = np.ones(len(pts), dtype=bool)
+    pairs = cKDTree(pts).query_pairs(tol, output_type="ndarray")  # (i, j), i < j
+    for i, j in pairs[np.argsort(pairs[:, 1], kind="stable")] if len(pairs) else ():
+        if keep[i]:
+            keep[j] = False
+    return pts[keep]
 
 
 def _splits(domain: Domain, h: float) -> int:
