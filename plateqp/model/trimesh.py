@@ -5,7 +5,10 @@
 nodes lie on the circle), given points (supports, point loads, pins) embedded as mesh nodes with
 the mesh refined around them (size h/4 at the point, growing to h at 2h away), and given line
 segments (a bed region's outline) followed by element edges: the boundary curves are split where
-such a line ends on them, so that the line's end is a point of the boundary.
+such a line ends on them, so that the line's end is a point of the boundary. A mesh of
+:data:`~plateqp.model.gmsh_mesh.SPLIT_FROM` nodes or more is the mesh at 2h with every triangle
+split in four (:data:`~plateqp.model.gmsh_mesh.SPLITS`); the meshes of the last few geometries are
+kept (:data:`MESHES`, :mod:`plateqp.model.mesh_cache`).
 
 The mesh is deterministic: gmsh runs on one thread with fixed options (Frontal-Delaunay without
 Laplacian smoothing, no random factor changes, no configuration files read), so the same scene gives the same mesh. gmsh
