@@ -154,7 +154,7 @@ def _boundary_curves(geo, domain: Domain, lines, tol: float, points=()) -> _Curv
     conformingly, and a point embedded in a curve is not made a node), a circle as arcs (split at
     the quarter points and there)."""
     c = _Curves({}, {}, [], [], [])
-    ends = np.array([e for seg in lines for e in seg] + list(points), dtype=float).reshape(-1, 2)
+    ends = _distinct(np.array([e for seg in lines for e in seg] + list(points), dtype=float).reshape(-1, 2), tol)
     for k, shape in enumerate((domain.outer, *domain.holes)):
         on = [tuple(e) for e in ends[shape.distance(ends[:, 0], ends[:, 1]) <= tol].tolist()]
         tags = []

@@ -50,3 +50,11 @@ def test_points_on_a_circle_are_nodes_on_the_circle():
     m = trimesh.mesh_domain(disc, 1 / 12, pts)
     for x, y in pts:
         assert np.hypot(*(m.nodes[np.unique(m.edges)] - (x, y)).T).min() <= 1e-15
+
+
+def test_two_points_within_the_tolerance_on_the_boundary_are_one_node():
+    m = trimesh.mesh_domain(SQUARE, 1 / 16, [(0.3, 0.0), (0.3 + 1e-13, 0.0), (1.0, 0.4)])
+    plain = trimesh.mesh_domain(SQUARE, 1 / 16, [(0.3, 0.0), (1.0, 0.4)])
+    assert np.array_equal(m.nodes, plain.nodes) and np.array_equal(m.triangles, plain.triangles)
+    lengths = np.hypot(*(m.nodes[m.edges[:, 1]] - m.nodes[m.edges[:, 0]]).T)
+    assert lengths.min() > 0.1 / 16
