@@ -73,7 +73,8 @@ def block_pattern(cells: np.ndarray, n_nodes: int, nd: int, pos: np.ndarray, nco
     per_row = np.add.reduceat(m.astype(np.int64), full.indptr[:-1])[row_kept]  # every row has its diagonal block
     out_ptr = np.zeros(ncol + 1, dtype=np.int64)
     np.cumsum(per_row, out=out_ptr[1:])
-    return BlockPattern(sums, full.data[m].astype(np.int64), cols[m], out_ptr, ncol, nd)
+    small = np.int32 if nb * nd * nd < 2**31 else np.int64  # kept with the mesh: the smaller type that holds them
+    return BlockPattern(sums, full.data[m].astype(small), cols[m].astype(small), out_ptr, ncol, nd)
 
 
 def assemble_blocks(Ke: np.ndarray, cells: np.ndarray, n_nodes: int, pos: np.ndarray, ncol: int) -> sp.csr_matrix:
