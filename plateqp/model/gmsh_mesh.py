@@ -13,6 +13,7 @@ import threading
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..errors import SceneError
 from .geometry import Domain, Polygon, _point_segment
@@ -25,11 +26,25 @@ REFINE = 0.25
 #: (MeshAdapt), smoothing and Shewchuk's Triangle (docs/guide/shapes.md, "Which mesher"): Delaunay
 #: meshes a third faster but its clamped annulus' error is 23 % larger.
 ALGORITHM = 6
+#: A large mesh (about :data:`SPLIT_FROM` nodes or more) is made at 2^SPLITS times the size asked
+#: and each triangle then split in four (its edges halved, the midpoints of boundary edges put on
+#: the true curve) SPLITS times by gmsh's ``refine``: a quarter of the time of meshing at the size
+#: asked, the same smallest angle, the same accuracy (docs/guide/shapes.md, "Which mesher").
+SPLITS = 1
+SPLIT_FROM = 3_000
+#: nodes of a mesh per area / h², about (measured: 1.09 on the unit disc at h = 1/16)
+NODES_PER_AREA = 1.2
 _model_names = itertools.count()
 #: What a mesh is made of: nodes (n, 2), counter-clockwise triangles (nt, 3), boundary edges
 #: (ne, 2) with their outward normals (ne, 2), boundary (ne,) and segment (ne,) of each edge, the
 #: target size h and the meshed domain: :class:`plateqp.model.trimesh.TriMesh`'s fields, in order.
 MeshArrays = tuple
+
+
+def gmsh_options() -> tuple:
+    """The settings of this module that shape a mesh (part of a kept mesh's key:
+    :mod:`plateqp.model.mesh_cache`)."""
+    return ("gmsh", ALGORITHM, SPLITS, SPLIT_FROM, REFINE, NODES_PER_AREA)
 
 
 def import_gmsh():
@@ -98,12 +113,13 @@ def _mesh(gmsh, domain: Domain, h: float, points, lines=()) -> MeshArrays:
     """The steps of :func:`mesh_domain` inside one gmsh model: the boundary curves, the embedded
     points and lines, the size field, the mesh, and the mesh read back."""
     tol = 1e-9 * domain.size
-    curves = _boundary_curves(gmsh.model.geo, domain, lines, tol)
+    curves = _boundary_curves(gmsh.model.geo, domain, lines, tol, points)
     surf = gmsh.model.geo.addPlaneSurface(curves.loops)
     gmsh.model.geo.synchronize()
     embedded = _embed(gmsh, surf, domain, curves, points, lines, tol)
-    _size_field(gmsh, h, [t for t, _ in embedded])
-    gmsh.model.mesh.generate(2)
+    splits = _splits(domain, h)
+    _size_field(gmsh, h, [t for t, _ in embedded], splits)
+    _generate(gmsh, splits)
     return _read_mesh(gmsh, surf, curves.owner, h, domain)
 
 
@@ -112,8 +128,9 @@ def _mesh_mirrored(gmsh, domain: Domain, h: float, points, lines, mirrors) -> Me
     refinement of the whole, read back and mirrored in each line (:mod:`plateqp.model.symmetry`)."""
     tol = SYMMETRY_TOL * domain.size
     refined = build_part(gmsh, domain, points, lines, mirrors, tol)
-    _size_field(gmsh, h, refined)
-    gmsh.model.mesh.generate(2)
+    splits = _splits(domain, h)
+    _size_field(gmsh, h, refined, splits)
+    _generate(gmsh, splits)
     nodes, tris = unfold(*read_triangles(gmsh), mirrors, tol)
     return (nodes, tris, *boundary_of(nodes, tris, domain, h), h, domain)
 
@@ -131,14 +148,15 @@ class _Curves:
     loops: list
 
 
-def _boundary_curves(geo, domain: Domain, lines, tol: float) -> _Curves:
-    """One gmsh curve per polygon segment (split where a line of ``lines`` ends on it: a line must
-    end at a point of the boundary's own curves to be meshed conformingly), a circle as arcs (split
-    at the quarter points and where a line ends on it)."""
+def _boundary_curves(geo, domain: Domain, lines, tol: float, points=()) -> _Curves:
+    """One gmsh curve per polygon segment (split where a line of ``lines`` ends on it or a point of
+    ``points`` lies on it: a line must end at a point of the boundary's own curves to be meshed
+    conformingly, and a point embedded in a curve is not made a node), a circle as arcs (split at
+    the quarter points and there)."""
     c = _Curves({}, {}, [], [], [])
-    ends = [e for seg in lines for e in seg]
+    ends = _distinct(np.array([e for seg in lines for e in seg] + list(points), dtype=float).reshape(-1, 2), tol)
     for k, shape in enumerate((domain.outer, *domain.holes)):
-        on = [e for e in ends if shape.distance(*e)[0] <= tol]
+        on = [tuple(e) for e in ends[shape.distance(ends[:, 0], ends[:, 1]) <= tol].tolist()]
         tags = []
         if isinstance(shape, Polygon):
             verts = []
@@ -178,17 +196,22 @@ def _embed(gmsh, surf: int, domain: Domain, curves: _Curves, points, lines, tol:
     vertex or a line's end) in the curve it lies on, a line, or the surface. Returns the embedded
     points [(tag, curve or None)]."""
     geo = gmsh.model.geo
-    embedded, seen = [], []
     line_tags, line_ends = _lines(geo, curves.vertices, lines, tol)
-    for x, y in points:
-        if any(math.hypot(x - u, y - v) <= tol for u, v in seen):
-            continue
-        seen.append((x, y))
-        if any(math.hypot(x - u, y - v) <= tol for u, v, _ in curves.vertices + line_ends):
-            continue
-        on = _curve_at(domain, curves.of, curves.geom, x, y, tol)
-        if on is None:  # on an embedded line: a point of that line
-            on = next((c for c, (p, q) in line_tags if float(_point_segment(x, y, (p, q))) <= tol), None)
+    pts = _distinct(np.asarray(list(points), dtype=float).reshape(-1, 2), tol)
+    taken = np.array([(u, v) for u, v, _ in curves.vertices + line_ends], dtype=float).reshape(-1, 2)
+    if len(pts) and len(taken):  # a boundary vertex or a line's end is a point already
+        pts = pts[cKDTree(taken).query(pts)[0] > tol]
+    boundary = np.zeros(len(pts), dtype=bool)
+    for shape in (domain.outer, *domain.holes):
+        boundary |= shape.distance(pts[:, 0], pts[:, 1]) <= tol
+    line_of = np.full(len(pts), -1)  # the first line each point lies on
+    for k, (_, seg) in reversed(list(enumerate(line_tags))):
+        line_of[_point_segment(pts[:, 0], pts[:, 1], seg) <= tol] = k
+    embedded = []
+    for (x, y), on_boundary, k in zip(pts.tolist(), boundary, line_of):
+        on = _curve_at(domain, curves.of, curves.geom, x, y, tol) if on_boundary else None
+        if on is None and k >= 0:  # on an embedded line: a point of that line
+            on = line_tags[k][0]
         # built-in kernel: new points after synchronize need another synchronize before embedding
         t = geo.addPoint(x, y, 0.0)
         embedded.append((t, on))
@@ -203,22 +226,49 @@ def _embed(gmsh, surf: int, domain: Domain, curves: _Curves, points, lines, tol:
     return embedded
 
 
-def _size_field(gmsh, h: float, refined: list) -> None:
-    """The mesh size: h everywhere, :data:`REFINE` · h at the points ``refined`` (tags), growing
-    to h at 2h away."""
+def _distinct(pts: np.ndarray, tol: float) -> np.ndarray:
+    """The points ``pts`` (n, 2) less each one within ``tol`` of an earlier point kept."""
+    if len(pts) < 2:
+        return pts
+    keep = np.ones(len(pts), dtype=bool)
+    pairs = cKDTree(pts).query_pairs(tol, output_type="ndarray")  # (i, j), i < j
+    for i, j in pairs[np.argsort(pairs[:, 1], kind="stable")] if len(pairs) else ():
+        if keep[i]:
+            keep[j] = False
+    return pts[keep]
+
+
+def _splits(domain: Domain, h: float) -> int:
+    """How many times the mesh of ``domain`` at size ``h`` is split: :data:`SPLITS` from about
+    :data:`SPLIT_FROM` nodes, else none."""
+    return SPLITS if NODES_PER_AREA * domain.area / h**2 >= SPLIT_FROM else 0
+
+
+def _generate(gmsh, splits: int) -> None:
+    """The 2-D mesh at the coarse size :func:`_size_field` set, split ``splits`` times."""
+    gmsh.model.mesh.generate(2)
+    for _ in range(splits):
+        gmsh.model.mesh.refine()
+
+
+def _size_field(gmsh, h: float, refined: list, splits: int = 0) -> None:
+    """The mesh size: h everywhere, :data:`REFINE` · h at the points ``refined`` (tags), growing to h
+    at 2h away; to be split ``splits`` times, the mesh of size H = 2^splits · h (REFINE · H at the
+    points, growing to H at 2H away), so the split mesh is the coarse mesh's own, split."""
     field = gmsh.model.mesh.field
+    scale = 2.0 ** splits
     f_const = field.add("MathEval")
-    field.setString(f_const, "F", repr(h))
+    field.setString(f_const, "F", repr(scale * h))
     fields = [f_const]
     if refined:
         f_dist = field.add("Distance")
         field.setNumbers(f_dist, "PointsList", refined)
         f_thr = field.add("Threshold")
         field.setNumber(f_thr, "InField", f_dist)
-        field.setNumber(f_thr, "SizeMin", REFINE * h)
-        field.setNumber(f_thr, "SizeMax", h)
+        field.setNumber(f_thr, "SizeMin", scale * REFINE * h)
+        field.setNumber(f_thr, "SizeMax", scale * h)
         field.setNumber(f_thr, "DistMin", 0.0)
-        field.setNumber(f_thr, "DistMax", 2.0 * h)
+        field.setNumber(f_thr, "DistMax", 2.0 * scale * h)
         fields.append(f_thr)
     f_min = field.add("Min")
     field.setNumbers(f_min, "FieldsList", fields)

@@ -5,7 +5,10 @@
 nodes lie on the circle), given points (supports, point loads, pins) embedded as mesh nodes with
 the mesh refined around them (size h/4 at the point, growing to h at 2h away), and given line
 segments (a bed region's outline) followed by element edges: the boundary curves are split where
-such a line ends on them, so that the line's end is a point of the boundary.
+such a line ends on them, so that the line's end is a point of the boundary. A mesh of
+:data:`~plateqp.model.gmsh_mesh.SPLIT_FROM` nodes or more is the mesh at 2h with every triangle
+split in four (:data:`~plateqp.model.gmsh_mesh.SPLITS`); the meshes of the last few geometries are
+kept (:data:`MESHES`, :mod:`plateqp.model.mesh_cache`).
 
 The mesh is deterministic: gmsh runs on one thread with fixed options (Frontal-Delaunay without
 Laplacian smoothing, no random factor changes, no configuration files read), so the same scene gives the same mesh. gmsh
@@ -25,15 +28,14 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SceneError
-from .blocks import assemble_blocks
+from .blocks import block_pattern
 from .geometry import Domain, inner_segments
-from .gmsh_mesh import REFINE  # noqa: F401 - the refinement around embedded points, read by tests and docs
+from .gmsh_mesh import NODES_PER_AREA, REFINE  # noqa: F401 - REFINE: the refinement around embedded points, read by tests and docs
+from .gmsh_mesh import gmsh_options
 from .gmsh_mesh import mesh_domain as _gmsh_mesh_domain
+from .mesh_cache import MeshCache, mesh_key
 from .regions import lumped_region, region_outline
 from .symmetry import mirror_lines
-
-#: nodes of a mesh per area / h², about (measured: 1.09 on the unit disc at h = 1/16)
-NODES_PER_AREA = 1.2
 
 
 def estimate_nodes(scene) -> float:
@@ -68,6 +70,8 @@ class TriMesh:
     size: float
     domain: Domain
     _tree: object = field(default=None, repr=False, compare=False)
+    #: the assembly's scatter patterns, [(pos, pattern)] (:meth:`assemble`): the last two kept
+    _patterns: list = field(default_factory=list, repr=False, compare=False)
 
     # -- the mesh as every generator gives it (plateqp.model.grid.Grid has the same names) ---------
     cell_type = "triangle"
@@ -178,10 +182,15 @@ class TriMesh:
     def assemble(self, element, D: float, nu: float, pos: np.ndarray, ncol: int) -> sp.csr_matrix:
         """The stiffness on the dofs with ``pos`` ≥ 0 (``pos``: each dof's new index, increasing;
         ``ncol`` of them), in canonical CSR, exactly symmetric: the element matrices of every
-        triangle (``element.cell_stiffness``, batched) summed by node blocks
-        (:func:`plateqp.model.blocks.assemble_blocks`)."""
+        triangle (``element.cell_stiffness``, batched) summed by node blocks through the mesh's
+        scatter pattern for ``pos`` (:func:`plateqp.model.blocks.block_pattern`, worked out on
+        the first assembly and kept with the mesh for the next)."""
         Ke = element.cell_stiffness(self.nodes[self.triangles], D, nu)
-        return assemble_blocks(Ke, self.triangles, len(self.nodes), pos, ncol)
+        pattern = next((pat for p, pat in self._patterns if p.shape == pos.shape and np.array_equal(p, pos)), None)
+        if pattern is None or pattern.n != ncol:
+            pattern = block_pattern(self.triangles, len(self.nodes), Ke.shape[1] // 3, pos, ncol)
+            self._patterns[:] = [*self._patterns[-1:], (pos.copy(), pattern)]
+        return pattern.assemble(Ke)
 
     def tributary_areas(self, region) -> np.ndarray:
         """(n_nodes,) each node's tributary area of a bed on ``region`` (a box [x0, x1, y0, y1], a
@@ -326,8 +335,14 @@ def _barycentric(p, x, y):
     return np.column_stack([1.0 - l2 - l3, l2, l3])
 
 
+#: the meshes of the last few geometries (:mod:`plateqp.model.mesh_cache`): a sweep or a study that
+#: solves one plate again meshes it once; ``MESHES.clear()`` empties it, ``MESHES.size = 0`` turns it off
+MESHES = MeshCache(3)
+
+
 def mesh_domain(domain: Domain, size: float, points=(), lines=(), mirrors=()) -> TriMesh:
     """Mesh ``domain`` with gmsh at target size ``size`` (:func:`plateqp.model.gmsh_mesh.mesh_domain`:
-    ``points`` become nodes, ``lines`` run along element edges, ``mirrors`` make it symmetric)."""
-    return TriMesh(*_gmsh_mesh_domain(domain, size, points, lines, mirrors))
-
+    ``points`` become nodes, ``lines`` run along element edges, ``mirrors`` make it symmetric), or
+    the mesh of the same exact geometry made before (:data:`MESHES`)."""
+    key = mesh_key(domain, size, points, lines, mirrors, gmsh_options())
+    return MESHES.get(key, lambda: TriMesh(*_gmsh_mesh_domain(domain, size, points, lines, mirrors)))

@@ -31,6 +31,8 @@ from .base import bending_matrix
 MID_POINTS = np.array([[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]])
 MID_WEIGHTS = np.full(3, 1.0 / 3.0)
 EDGES = ((0, 1), (1, 2), (2, 0))  # midside node 3 + e on edge e
+#: triangles a chunk of :meth:`DKT.stiffness` (its temporaries about a megabyte each)
+CHUNK = 2048
 _CUBIC = [(i, j) for n in range(4) for i in range(n, -1, -1) for j in (n - i,)]  # 10 monomials x^i y^j
 
 
@@ -151,17 +153,29 @@ class DKT:
 
     # -- element matrices -------------------------------------------------------------------
     def stiffness(self, xy, D: float, nu: float) -> np.ndarray:
-        """(nt, 9, 9) element stiffness ∫ Bᵀ D_b B dA (exact: B is linear, 3-point rule)."""
+        """(nt, 9, 9) element stiffness ∫ Bᵀ D_b B dA (exact: B is linear, 3-point rule), exactly
+        symmetric: with D_b = Lᵀ L (Cholesky), Σ_p w_p A (L B_p)ᵀ (L B_p), one product XᵀX over
+        the stacked (component, point) rows X, in chunks of :data:`CHUNK` triangles (their
+        temporaries stay in cache)."""
         xy = _as_tris(xy)
-        _, area = self._grad_l(xy)
         nt = len(xy)
-        # (nt, 9 rows: component and point, 9 dofs)
-        B = np.ascontiguousarray(self._curvature_first(xy, MID_POINTS).transpose(2, 1, 3, 0)).reshape(nt, 9, 9)
-        DB = np.matmul(bending_matrix(D, nu), B.reshape(nt, 3, 27)).reshape(nt, 9, 9)  # D_b κ
-        # Σ_p w_p B_pᵀ D_b B_p (equal weights): one product over the (component, point) rows
-        K = np.swapaxes(B, 1, 2) @ DB
-        K *= (MID_WEIGHTS[0] * area)[:, None, None]
-        return 0.5 * (K + np.swapaxes(K, 1, 2))
+        L = np.linalg.cholesky(bending_matrix(D, nu)).T  # upper triangular, D_b = Lᵀ L
+        K = np.empty((nt, 9, 9))
+        for a in range(0, nt, CHUNK):
+            part = xy[a:a + CHUNK]
+            n = len(part)
+            _, area = self._grad_l(part)
+            C = self._curvature_first(part, MID_POINTS)  # (9 dofs, 3 components, n, 3 points)
+            s = np.sqrt(MID_WEIGHTS[0] * area)[:, None]
+            X = np.empty((3, 9, n, 3))  # L κ, scaled by √(w A)
+            np.multiply(C[:, 0], L[0, 0], out=X[0])
+            X[0] += L[0, 1] * C[:, 1]
+            X[0] *= s
+            np.multiply(C[:, 1], L[1, 1] * s, out=X[1])
+            np.multiply(C[:, 2], L[2, 2] * s, out=X[2])
+            X = np.ascontiguousarray(X.transpose(2, 0, 3, 1)).reshape(n, 9, 9)  # (triangle, rows, dofs)
+            np.matmul(np.swapaxes(X, 1, 2), X, out=K[a:a + n])
+        return K
 
     def shape(self, xy, lam) -> np.ndarray:
         """(nt, npts, 9): the cubic Hermite deflection shape functions at barycentric points
