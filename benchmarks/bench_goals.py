@@ -4,7 +4,8 @@ Each figure is CPU time (``time.process_time``, BLAS on one thread) ÷ "raw": on
 CHOLMOD symbolic analysis + numeric factorisation + solve of the same plate matrix, called
 directly (``bench_fast.raw_cholmod``), the steps interleaved in one process, medians of
 ``--repeat`` (one run from 512²). Every timed solve must pass its KKT check at accuracy 1e-10
-(a failed check stops the run). The rows:
+(a failed check stops the run), or, where the plate's rounding floor lies above 1e-10 (the bed
+from 256²), at the first decade above three times that floor (column ``accuracy``). The rows:
 
 * ``solve``: the whole ``pq.solve(scene, accuracy=1e-10)`` (assembly included) on bench_fast's
   grid (a slab on four walls, 30 × 30 rigid posts) and bed (a free plate on a tensionless bed)
@@ -85,13 +86,25 @@ def plate_matrix(kind: str, model) -> tuple[sp.csc_matrix, np.ndarray]:
     return bf.plate_matrix(kind, model)
 
 
+def reachable(scene, model) -> float:
+    """The accuracy asked of the timed solves: 1e-10, or, where the plate's stationarity rounding
+    floor lies above it (the bed from 256²: no answer in double precision shows 1e-10 there, and
+    the solve says so), the first decade above three times that floor."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        r = pq.solve(scene, accuracy=bf.ACCURACY, model=model)
+    if r.kkt.ok:
+        return bf.ACCURACY
+    return float(10.0 ** np.ceil(np.log10(3.0 * r.kkt.floor)))
+
+
 def solve_row(kind: str, n: int, repeat: int) -> dict:
     """raw and the whole pq.solve interleaved (the order alternating), medians."""
     scene = scene_for(kind, n)
     model = build_model(scene)
     K, f = plate_matrix(kind, model)
     A = bf.to_cvxopt(K)
-    bf.whole_solve(scene)  # first-call imports paid
+    acc = reachable(scene, model)  # also pays the first call's imports
     times: dict[str, list[float]] = {"raw": [], "solve": []}
     worst, res = 0.0, None
     for r in range(repeat):
@@ -99,16 +112,16 @@ def solve_row(kind: str, n: int, repeat: int) -> dict:
             if name == "raw":
                 times["raw"].append(bf.cpu(lambda: bf.raw_cholmod(A, f))[0])
                 continue
-            dt, res = bf.cpu(lambda: bf.whole_solve(scene))
+            dt, res = bf.cpu(lambda: bf.whole_solve(scene, acc))
             if not res.kkt.ok:
-                raise SystemExit(f"{kind} {n}: the KKT check failed ({res.status.value})")
+                raise SystemExit(f"{kind} {n}: the KKT check failed at accuracy {acc:g} ({res.status.value})")
             worst = max(worst, bf.kkt_worst(res))
             times["solve"].append(dt)
     raw, solve = float(np.median(times["raw"])), float(np.median(times["solve"]))
     dofs = int(model.n_free)
     goal = disc_goal(dofs) if kind == "disc" else solve_goal(n)
     return {"goal": "solve", "scene": kind, "mesh": f"R/{n}" if kind == "disc" else f"{n}²", "dofs": dofs,
-            "route": f"{res.backend}/{res.formulation}", "repeat": repeat, "unit": "s", "raw": raw, "measured": solve,
+            "route": f"{res.backend}/{res.formulation}", "accuracy": acc, "repeat": repeat, "unit": "s", "raw": raw, "measured": solve,
             "ratio": solve / raw, "limit": goal, "met": None if goal is None else solve / raw <= goal,
             "kkt_worst": worst}
 
@@ -125,7 +138,8 @@ def _memory(args, q):
         A = bf.to_cvxopt(K)
         step = lambda: bf.raw_cholmod(A, f)  # noqa: E731
     else:
-        step = lambda: pq.solve(scene, accuracy=bf.ACCURACY, model=model)  # noqa: E731
+        acc = reachable(scene, model)
+        step = lambda: pq.solve(scene, accuracy=acc, model=model)  # noqa: E731
     try:
         with open("/proc/self/clear_refs", "w") as fh:
             fh.write("5")  # VmHWM reset to the current RSS
@@ -135,7 +149,7 @@ def _memory(args, q):
     before = _status_kb()
     out = step()
     after = _status_kb()
-    ok = what == "raw" or out.kkt.ok
+    ok = what == "raw" or bool(out.kkt.ok)
     q.put({"mem_mb": (after[1] - before[0]) / 1024 if before else None, "ok": ok})
 
 
@@ -190,10 +204,11 @@ def main(argv=None) -> int:
     cases += [lambda k=k, s=s: sweep_row(k, a.sweep_mesh, a.values, a.repeat, s)
               for k in scenes for s in bsr.KINDS] if a.sweep_mesh else []
     bf.table([], a.out, "Speed goals (CPU, one BLAS thread; ratios to raw CHOLMOD)",
-             ["goal", "scene", "mesh", "route", "detail", "unit", "raw", "measured", "ratio", "limit", "met",
+             ["goal", "scene", "mesh", "route", "accuracy", "detail", "unit", "raw", "measured", "ratio", "limit", "met",
               "KKT worst"],
              cases,
-             lambda r: [r["goal"], r["scene"], r["mesh"], r.get("route", ""), r.get("detail", ""), r["unit"],
+             lambda r: [r["goal"], r["scene"], r["mesh"], r.get("route", ""), bf.fmt(r.get("accuracy"), "{:g}"),
+                        r.get("detail", ""), r["unit"],
                         bf.fmt(r["raw"]), bf.fmt(r["measured"]), bf.fmt(r["ratio"], "{:.2f}"),
                         bf.fmt(r["limit"], "{:g}"), {True: "yes", False: "**no**", None: "–"}[r["met"]],
                         bf.fmt(r.get("kkt_worst"), "{:.1e}")])

@@ -267,7 +267,7 @@ def goals_section(df, figdir):
     short = d[d["met"].notna()]
     hit = int((short["met"] == True).sum())  # noqa: E712 - a pandas column
     d["met"] = met
-    cols = [c for c in ("goal", "scene", "mesh", "route", "detail", "unit", "raw", "measured", "ratio", "limit",
+    cols = [c for c in ("goal", "scene", "mesh", "route", "accuracy", "detail", "unit", "raw", "measured", "ratio", "limit",
                         "met", "kkt_worst") if c in d]
     return f"Goals met today: {hit} of {len(short)}.\n\n" + table(d[cols].astype(object).fillna(""))
 
