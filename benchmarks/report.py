@@ -276,8 +276,25 @@ def soils_section(df, figdir):
             "each one sparse solve and the soil's FFTs). " + verdict + "\n\n" + table(df))
 
 
+def goals_section(df, figdir):
+    d = df.copy()
+    met = d["met"].map({True: "yes", False: "**no**"}).fillna("–")
+    short = d[d["met"].notna()]
+    hit = int((short["met"] == True).sum())  # noqa: E712 - a pandas column
+    d["met"] = met
+    cols = [c for c in ("goal", "scene", "mesh", "route", "accuracy", "detail", "unit", "raw", "measured", "ratio", "limit",
+                        "met", "kkt_worst") if c in d]
+    return f"Goals met today: {hit} of {len(short)}.\n\n" + table(d[cols].astype(object).fillna(""))
+
+
 def parts() -> dict[str, Part]:
     p = {}
+    p["goals"] = Part(
+        "goals", "bench_goals", "goals.csv", "goals.csv",
+        ["--out", "OUT"],
+        ["--meshes", "32", "--big", "", "--disc-sizes", "8", "--memory-meshes", "32", "--memory-disc", "8",
+         "--sweep-mesh", "32", "--values", "3", "--repeat", "1", "--out", "OUT"],
+        goals_section, "Speed goals")
     p["work-precision"] = Part(
         "work-precision", "bench_work_precision", "work-precision.csv", "work_precision.csv",
         ["--sizes", "16", "--timeout", "60"],
