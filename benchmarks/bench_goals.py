@@ -10,7 +10,7 @@ from 256²), at the first decade above three times that floor (column ``accuracy
 * ``solve``: the whole ``pq.solve(scene, accuracy=1e-10)`` (assembly included) on bench_fast's
   grid (a slab on four walls, 30 × 30 rigid posts) and bed (a free plate on a tensionless bed)
   at ``--meshes`` and ``--big`` (one run), and on bench_tri's DKT disc (R = 1, 12 posts, q + P)
-  at ``--disc-sizes`` (R/n; the mesh generated inside the timed call). Goals: ≤ 3× at 64²,
+  at ``--disc-sizes`` (R/n; the mesh generated inside the timed call: no kept mesh). Goals: ≤ 3× at 64²,
   ≤ 2.5× at 128², ≤ 2× at 256² and 512²; on the disc ≤ 4× at about 12k dofs and ≤ 2.5× at
   ≥ 100k dofs.
 * ``memory``: the peak resident memory of ``pq.solve`` on the built model above what the process
@@ -98,8 +98,16 @@ def reachable(scene, model) -> float:
     return float(10.0 ** np.ceil(np.log10(3.0 * r.kkt.floor)))
 
 
+def cold() -> None:
+    """No kept triangle mesh: every timed solve meshes its plate (plateqp keeps the last
+    geometries' meshes; a second solve of one plate would time the kept one)."""
+    from plateqp.model import trimesh
+
+    trimesh.MESHES.clear()
+
+
 def solve_row(kind: str, n: int, repeat: int) -> dict:
-    """raw and the whole pq.solve interleaved (the order alternating), medians."""
+    """raw and the whole pq.solve interleaved (the order alternating), medians; cold."""
     scene = scene_for(kind, n)
     model = build_model(scene)
     K, f = plate_matrix(kind, model)
@@ -112,6 +120,7 @@ def solve_row(kind: str, n: int, repeat: int) -> dict:
             if name == "raw":
                 times["raw"].append(bf.cpu(lambda: bf.raw_cholmod(A, f))[0])
                 continue
+            cold()
             dt, res = bf.cpu(lambda: bf.whole_solve(scene, acc))
             if not res.kkt.ok:
                 raise SystemExit(f"{kind} {n}: the KKT check failed at accuracy {acc:g} ({res.status.value})")
