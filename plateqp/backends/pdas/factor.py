@@ -125,12 +125,15 @@ class SpringFactor:
         diag = indptr[1:] - 1 if upper else indptr[:-1]  # sorted: the diagonal ends (starts) each column
         if np.any(lcount == 0) or np.any(li[diag] != np.arange(n)):
             return False
-        keys = lc.astype(np.int64) * n + li
         inside = pair_r <= pair_c if upper else pair_r >= pair_c  # each off-diagonal pair once
-        pk = pair_c[inside].astype(np.int64) * n + pair_r[inside]
-        pos = np.minimum(np.searchsorted(keys, pk), keys.size - 1)
-        if keys.size == 0 or not np.all(keys[pos] == pk):
-            return False
+        if np.array_equal(pair_r, pair_c):  # one unknown a row (a bed, posts at nodes): all on the diagonal
+            pos = diag[pair_r]
+        else:
+            keys = lc.astype(np.int64) * n + li
+            pk = pair_c[inside].astype(np.int64) * n + pair_r[inside]
+            pos = np.minimum(np.searchsorted(keys, pk), keys.size - 1)
+            if keys.size == 0 or not np.all(keys[pos] == pk):
+                return False
         base = np.asarray(Ks.data[low], dtype=float)
         base[diag] += sigma * Kd
         base *= self.s[li] * np.repeat(self.s, lcount)  # s_i s_j first: as in _whole, to the bit
