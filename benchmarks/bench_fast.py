@@ -42,10 +42,11 @@ Parts (``--parts``, comma-separated):
   ``plateqp.linalg.residual.Residual`` (K split once), the first and a further one, CPU
   medians of ``--repeat`` interleaved.
 * ``flops``: why the grid's condensed method costs what it does: at ``--meshes``, one
-  factorisation of the grid scene's equilibrated K in AMD order ("plain") and one with the 900
-  contact dofs moved last (the condensed method's), each through plateqp's CHOLMOD seam: CPU
-  time (median of ``--repeat``), multiply-adds counted from the factor's supernodes
-  (``plateqp.linalg.cholmod.Cholesky.flops``) and the rate.
+  factorisation of the grid scene's equilibrated K in AMD order ("plain"), one with the 900
+  contact dofs moved last (the condensed method's) and one with only the dofs of the posts in
+  contact at the answer moved last (the floor of a Schur complement on the active posts), each
+  through plateqp's CHOLMOD seam: CPU time (median of ``--repeat``), multiply-adds counted from
+  the factor's supernodes (``plateqp.linalg.cholmod.Cholesky.flops``) and the rate.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_fast.py --parts goal
     python benchmarks/bench_fast.py --parts backends,mesh --scale-meshes 32,64,128,256
@@ -288,22 +289,31 @@ def _other(args, q):
 
 
 def flops_row(n: int, repeat: int) -> dict:
-    """One factorisation of the grid scene's K in AMD order and one with the contact dofs last:
-    CPU time (medians, interleaved) and the multiply-adds read from each factor."""
+    """One factorisation of the grid scene's K in AMD order, one with the contact dofs last, and
+    one with only the dofs of the posts in contact at the answer last (what a Schur complement
+    on the active posts alone would cost, were that set known before the factorisation): CPU
+    time (medians, interleaved) and the multiply-adds read from each factor."""
     from plateqp.linalg.cholmod import Cholesky, lower
     from plateqp.linalg.factor import equilibration
 
-    model = build_model(make_scene("grid", n))
+    scene = make_scene("grid", n)
+    model = build_model(scene)
     K = sp.csc_matrix(model.K)
-    last = np.unique(sp.csr_matrix(model.contacts.B).indices)
+    B = sp.csr_matrix(model.contacts.B)
+    last = np.unique(B.indices)
+    active = np.unique(B[whole_solve(scene).active].indices)
     s = equilibration(K, None)
     first = Cholesky("cvxopt")
     if first.direct is None:
         raise SystemExit("--parts flops needs plateqp's CHOLMOD seam (cvxopt's wheels)")
     amd = first.order(lower(K, s, upper=first.upper))
-    mask = np.zeros(K.shape[0], dtype=bool)
-    mask[last] = True
-    orders = {"plain": amd, "last": np.concatenate([amd[~mask[amd]], last])}
+
+    def moved_last(dofs):
+        mask = np.zeros(K.shape[0], dtype=bool)
+        mask[dofs] = True
+        return np.concatenate([amd[~mask[amd]], dofs])
+
+    orders = {"plain": amd, "last": moved_last(last), "active": moved_last(active)}
     times: dict[str, list[float]] = {k: [] for k in orders}
     flops = {}
     for r in range(repeat):
@@ -316,7 +326,8 @@ def flops_row(n: int, repeat: int) -> dict:
             flops[name] = chol.flops()
     return {"part": "flops", "scene": "grid", "mesh": n, "dofs": K.shape[0], "rows": int(last.size),
             "plain_s": statistics.median(times["plain"]), "last_s": statistics.median(times["last"]),
-            "plain_flops": flops["plain"], "last_flops": flops["last"], "repeat": repeat}
+            "plain_flops": flops["plain"], "last_flops": flops["last"], "in_contact": int(active.size),
+            "active_s": statistics.median(times["active"]), "active_flops": flops["active"], "repeat": repeat}
 
 
 # ----------------------------------------------------------------------------- residual
@@ -586,16 +597,17 @@ def main():
 
     if "flops" in parts:
         table(rows, args.out,
-              "grid_rigid(n, 30): CHOLMOD's factorisation of K, plain (AMD) and with the contact dofs last "
-              f"(CPU s, medians of {args.repeat})",
+              "grid_rigid(n, 30): CHOLMOD's factorisation of K, plain (AMD), with the contact dofs last, and "
+              f"with only the dofs in contact at the answer last (CPU s, medians of {args.repeat})",
               ["mesh", "dofs", "contact dofs", "plain s", "plain G flops", "GF/s", "last s", "last G flops", "GF/s",
-               "time ratio", "flop ratio"],
+               "time ratio", "flop ratio", "in contact", "active last s", "active last G flops"],
               (lambda n=n: flops_row(n, args.repeat) for n in (int(v) for v in args.meshes.split(","))),
               lambda row: [f"{row['mesh']}²", row["dofs"], row["rows"], f"{row['plain_s']:.3f}",
                            f"{row['plain_flops'] / 1e9:.2f}", f"{row['plain_flops'] / row['plain_s'] / 1e9:.1f}",
                            f"{row['last_s']:.3f}", f"{row['last_flops'] / 1e9:.2f}",
                            f"{row['last_flops'] / row['last_s'] / 1e9:.1f}", f"{row['last_s'] / row['plain_s']:.2f}",
-                           f"{row['last_flops'] / row['plain_flops']:.2f}"])
+                           f"{row['last_flops'] / row['plain_flops']:.2f}", row["in_contact"],
+                           f"{row['active_s']:.3f}", f"{row['active_flops'] / 1e9:.2f}"])
 
     if "residual" in parts:
         table(rows, args.out,

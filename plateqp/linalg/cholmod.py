@@ -357,9 +357,11 @@ class Cholesky:
             return False
         v = np.random.default_rng(0).standard_normal(k)
         y = self._cvx_solve(np.concatenate([np.zeros(no), v]), (4,))  # cvxopt's sys 4: L alone
-        r = T @ y[no:] - v
-        scale = np.abs(T) @ np.abs(y[no:]) + np.abs(v)
-        return bool(np.all(np.abs(y[:no]) == 0) and np.all(np.abs(r) <= 1e-10 * scale.max()))
+        yl = y[no:]
+        r = T @ yl - v
+        # a bound on max_i Σ_j |T_ij y_j| + |v_i| with no |T| formed: |T_i|·|y| ≤ ‖T‖_F ‖y‖₂
+        scale = np.linalg.norm(T) * np.linalg.norm(yl) + np.abs(v).max()
+        return bool(np.all(np.abs(y[:no]) == 0) and np.all(np.abs(r) <= 1e-10 * scale))
 
     def flops(self) -> float | None:
         """The numeric factorisation's multiply-adds, counted from the factor's supernodes:
@@ -440,7 +442,7 @@ def _trailing_at(ptr: int, no: int) -> np.ndarray | None:
     if not 0 <= no <= n:
         return None
     k = n - no
-    out = np.zeros((k, k))
+    out = np.zeros((k, k), order="F")  # column-major, as CHOLMOD holds it and LAPACK reads it: no copy
     if is_super:
         if not is_ll:
             return None
@@ -460,7 +462,15 @@ def _trailing_at(ptr: int, no: int) -> np.ndarray | None:
             nr, nc = rows.size, c1 - c0
             blk = x[px[j]:px[j] + nr * nc].reshape(nc, nr).T  # column-major, leading dimension nr
             j0 = max(no - c0, 0)  # the supernode's first column in the trailing block
-            out[np.ix_(rows[j0:] - no, np.arange(c0 + j0, c1) - no)] = np.tril(blk[j0:, j0:])
+            r0, a, b = int(rows[j0]) - no, c0 + j0 - no, c1 - no
+            if r0 == a and int(rows[-1]) - no == k - 1 and nr - j0 == k - a:
+                # its rows are the trailing ones from its own first column on (the last supernode,
+                # a dense block): copied by columns, the part above its diagonal zeroed
+                out[a:, a:b] = blk[j0:, j0:]
+                for i in range(a + 1, b):
+                    out[a:i, i] = 0.0
+            else:
+                out[np.ix_(rows[j0:] - no, np.arange(c0 + j0, c1) - no)] = np.tril(blk[j0:, j0:])
         return out
     p = _view(int(h[_P]), n + 1, np.int64)
     i = _view(int(h[_I]), int(h[_NZMAX]), np.int64)

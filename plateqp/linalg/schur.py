@@ -44,6 +44,19 @@ BLOCK = 256  # right-hand sides solved together (fallback)
 SCHUR_METHODS = ("auto", "sksparse", "cvxopt", "blocks")
 
 
+def symmetric_from_lower(A: np.ndarray, block: int = 128) -> np.ndarray:
+    """``A`` (square) made symmetric from its lower triangle, in place, and returned: the part
+    above the diagonal is overwritten, by blocks of columns (no mask or second array of A's size,
+    as ``np.tril(A) + np.tril(A, -1).T`` makes)."""
+    n = A.shape[0]
+    for j0 in range(0, n, block):
+        j1 = min(n, j0 + block)
+        A[j0:j1, j1:] = A[j1:, j0:j1].T
+        D = A[j0:j1, j0:j1]
+        D[...] = np.tril(D) + np.tril(D, -1).T
+    return A
+
+
 class _Solver(Refined):
     """``K`` (or ``K_oo``) with a raw solve function, refined on ``K`` itself."""
 
@@ -198,8 +211,7 @@ class SchurFactor:
         """``S = K_ll − K_lo K_oo⁻¹ K_ol`` (dense, rows and columns in the order of ``last``);
         ``equilibrated``: in the factor's units (``D S D``, ``D = diag(s)`` on ``last``)."""
         L = self.Lll
-        S = sla.blas.dsyrk(1.0, L, lower=1) if L.size else np.zeros((0, 0))
-        S = np.tril(S) + np.tril(S, -1).T
+        S = symmetric_from_lower(sla.blas.dsyrk(1.0, L, lower=1)) if L.size else np.zeros((0, 0))
         if self.shift:
             S[np.diag_indices_from(S)] -= self.shift
         if equilibrated:
@@ -248,15 +260,13 @@ class SchurFactor:
             return np.zeros((0, 0))
         if m == self.nl and np.all(np.diff(Bl.indptr) == 1) and np.unique(Bl.indices).size == m:
             dof, b = Bl.indices, Bl.data
-            Sinv = sla.lapack.dpotri(self.Lll, lower=1)[0]  # (L Lᵀ)⁻¹, lower triangle
-            Sinv = np.tril(Sinv) + np.tril(Sinv, -1).T
+            Sinv = symmetric_from_lower(sla.lapack.dpotri(self.Lll, lower=1)[0])  # (L Lᵀ)⁻¹, from its lower triangle
             if not np.array_equal(dof, np.arange(m)):  # rows in another order than their unknowns
                 Sinv = Sinv[np.ix_(dof, dof)]
             Sinv *= np.outer(b, b)
             return Sinv
         Z = sla.solve_triangular(self.Lll, Bl.T.toarray(), lower=True, check_finite=False)
-        M = sla.blas.dsyrk(1.0, Z, trans=1, lower=1)
-        return np.tril(M) + np.tril(M, -1).T
+        return symmetric_from_lower(sla.blas.dsyrk(1.0, Z, trans=1, lower=1))
 
     # ------------------------------------------------------------------ solves
 

@@ -84,7 +84,9 @@ class SpringFactor:
         self.t_solve = None
         self.target = None  # the w solved for: self.w (the factor's) plus the low-rank rows
         self.lr = None  # the low-rank correction in use: (rows, Z columns, U, LU of C)
-        self._zcols: dict = {}  # row -> column of H(self.w)⁻¹ Bᵀ (kept while the factor is)
+        # row -> its column of Z (kept while the factor is): with CHOLMOD the forward half
+        # L⁻¹ P D B_rᵀ (see :meth:`_columns`), else H(self.w)⁻¹ B_rᵀ
+        self._zcols: dict = {}
         self.stats = {"analyse_s": 0.0, "factorisations": 0, "factor_s": 0.0, "updates": 0, "updated_rows": 0,
                       "update_s": 0.0, "lowrank": 0, "lowrank_rows": 0, "lowrank_s": 0.0, "solves": 0,
                       "solve_s": 0.0}
@@ -123,12 +125,15 @@ class SpringFactor:
         diag = indptr[1:] - 1 if upper else indptr[:-1]  # sorted: the diagonal ends (starts) each column
         if np.any(lcount == 0) or np.any(li[diag] != np.arange(n)):
             return False
-        keys = lc.astype(np.int64) * n + li
         inside = pair_r <= pair_c if upper else pair_r >= pair_c  # each off-diagonal pair once
-        pk = pair_c[inside].astype(np.int64) * n + pair_r[inside]
-        pos = np.minimum(np.searchsorted(keys, pk), keys.size - 1)
-        if keys.size == 0 or not np.all(keys[pos] == pk):
-            return False
+        if np.array_equal(pair_r, pair_c):  # one unknown a row (a bed, posts at nodes): all on the diagonal
+            pos = diag[pair_r]
+        else:
+            keys = lc.astype(np.int64) * n + li
+            pk = pair_c[inside].astype(np.int64) * n + pair_r[inside]
+            pos = np.minimum(np.searchsorted(keys, pk), keys.size - 1)
+            if keys.size == 0 or not np.all(keys[pos] == pk):
+                return False
         base = np.asarray(Ks.data[low], dtype=float)
         base[diag] += sigma * Kd
         base *= self.s[li] * np.repeat(self.s, lcount)  # s_i s_j first: as in _whole, to the bit
@@ -190,7 +195,9 @@ class SpringFactor:
         data = self.base + np.bincount(self.pair_pos, weights=w[self.pair_row] * self.pair_val,
                                        minlength=self.nnz)
         n = self.s.size
-        return sp.csc_matrix((data, self.indices, self.indptr), shape=(n, n))
+        H = sp.csc_matrix((data, self.indices, self.indptr), shape=(n, n))
+        H.has_sorted_indices = True  # the pattern's columns were sorted when it was built: not checked again
+        return H
 
     def refactor(self, w: np.ndarray) -> None:
         t0 = time.perf_counter()
@@ -276,14 +283,13 @@ class SpringFactor:
             return False
         t0 = time.perf_counter()
         if new.size:
-            Ut = self.B[new].T.toarray()
-            Znew = self._solve(Ut)
+            Znew = self._columns(self.B[new].T.toarray())
             for j, r in enumerate(new.tolist()):
                 self._zcols[r] = Znew[:, j]  # a view: the block stays one array
             self.stats["solves"] += 1
         Z = np.column_stack([self._zcols[r] for r in changed.tolist()])
         U = self.B[changed]
-        C = U @ Z
+        C = Z.T @ Z if self.chol is not None else U @ Z  # U H(w₀)⁻¹ Uᵀ either way
         # Woodbury is not backward stable for a stiff row: U x comes out with an absolute error
         # of about ε |Δw_i| (U H⁻¹ Uᵀ)_ii relative to x, which the row's weight then multiplies
         # into the residual (a rigid row added: ε κ, ~1e-7 of the load); and where H is nearly
@@ -317,10 +323,26 @@ class SpringFactor:
             return s * self.chol.solve(s * b)
         return self.fac.solve(b, refine=0)
 
+    def _columns(self, Ut: np.ndarray) -> np.ndarray:
+        """The Woodbury columns of the rows ``Ut`` (n × k). With CHOLMOD (``H(w₀) = D⁻¹ Pᵀ L Lᵀ P
+        D⁻¹``, ``D = diag(s)``), ``Y = L⁻¹ P D Uᵀ``: the forward half of a solve only (half the
+        block solve's time), since ``U H(w₀)⁻¹ Uᵀ = YᵀY`` and ``H(w)⁻¹ b = D Pᵀ L⁻ᵀ (y − Y C⁻¹
+        Yᵀ y)`` with ``y = L⁻¹ P D b`` (:meth:`solve`). Else ``Z = H(w₀)⁻¹ Uᵀ``."""
+        if self.chol is not None:
+            return self.chol.forward(self.s[:, None] * Ut)
+        return self._solve(Ut)
+
     def solve(self, b: np.ndarray) -> np.ndarray:
         t0 = time.perf_counter()
-        x = self._solve(b)
-        if self.lr is not None:
+        if self.lr is not None and self.chol is not None:  # in the factor's own terms (see _columns)
+            _, Y, _, lu = self.lr
+            s = self.s if b.ndim == 1 else self.s[:, None]
+            y = self.chol.forward(s * b)
+            y -= Y @ sla.lu_solve(lu, Y.T @ y, check_finite=False)
+            x = s * self.chol.backward(y)
+        else:
+            x = self._solve(b)
+        if self.lr is not None and self.chol is None:
             _, Z, U, lu = self.lr
             x = x - Z @ sla.lu_solve(lu, U @ x, check_finite=False)
         self.stats["solves"] += 1
