@@ -25,7 +25,7 @@ import scipy.sparse as sp
 from ..accuracy import Accuracy, Status
 from ..backends import get_backend
 from ..model.assembly import Model, build_model
-from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError
+from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError, SolverError
 from ..estimate import COARSE_FAILURES, with_mesh
 from ..model.generators import mesh_cells
 from ..linalg import row_stiffness
@@ -110,18 +110,24 @@ def predicted_set(model: Model, solve=None) -> tuple[np.ndarray | None, dict]:
     return A, {"mesh": [cx, cy], "rows": int(A.sum()), "seconds": time.perf_counter() - t0}
 
 
+def _no_equilibrium(data: Scaled, acc: Accuracy) -> None:
+    """NoEquilibriumError where statics says the supports cannot carry the load (asked only
+    after the coarse solve stopped short: a solve that ends OPTIMAL needs no such check)."""
+    reach = supports_reach(data, band=acc.tol)
+    if not reach.possible and not reach.marginal:
+        raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({reach.why}; found by statics)")
+
+
 def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray | None, str]:
     """The deflection of the coarse model's answer (pdas on the primal, accuracy "default") at
     the points (x, y), −inf at a point off the coarse plate; (None, why) where the backend's
-    answer is not OPTIMAL. NoEquilibriumError where statics says the coarse supports cannot carry
-    the load. Started, as the pipeline would, from the set of its own coarse mesh where
-:func:`wanted` says so. The answer in the user's units as :func:`plateqp.contact.answer.to_result` makes
-    it (a floating plate's canonical deflection: :func:`plateqp.contact.statics.settle`)."""
+    answer is not OPTIMAL. NoEquilibriumError where the solve stops short and statics says the
+    coarse supports cannot carry the load. Started, as the pipeline would, from the set of its
+    own coarse mesh where :func:`wanted` says so. The answer in the user's units as
+    :func:`plateqp.contact.answer.to_result` makes it (a floating plate's canonical deflection:
+    :func:`plateqp.contact.statics.settle`)."""
     acc = Accuracy.parse("default")
     data = Scaled.from_model(coarse)
-    reach = supports_reach(data, band=acc.tol)
-    if not reach.possible and not reach.marginal:
-        raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({reach.why}; found by statics, before any solve)")
     form = formulate(data, "primal")
     b = get_backend("pdas")
     options = {}
@@ -129,8 +135,13 @@ def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.
         A0 = predicted_set(coarse)[0]                                    # from its own coarse mesh's set
         if A0 is not None:
             options["active"] = A0
-    raw = b.solve(form.problem(b.accepts), accuracy=acc, options=options)
+    try:
+        raw = b.solve(form.problem(b.accepts), accuracy=acc, options=options)
+    except SolverError:
+        _no_equilibrium(data, acc)
+        raise
     if raw.status != Status.OPTIMAL or raw.x is None:
+        _no_equilibrium(data, acc)
         return None, f"the coarse solve ended {raw.status.value}"
     sol = form.recover(raw)
     u_s = settle(data, sol.u, sol.R, sol.s, max(acc.tol, 1e-9))[0] if data.floating else sol.u
