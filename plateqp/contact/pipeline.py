@@ -214,7 +214,7 @@ class _Step:
         first = options
         predicted = {"why": wanted(self.model, self.data, backend, formulation, options, self.predict)}
         if predicted["why"] is None:  # the coarse mesh's contact set starts the solve
-            A0, predicted = predicted_set(self.model, solve_contact)
+            A0, predicted = predicted_set(self.model)
             if A0 is not None:
                 first = dict(options, active=A0)
         t_predict = time.perf_counter() - t1

@@ -9,7 +9,8 @@ wrong rows are taken by a low-rank correction, and the second factorisation a co
 for the set it settles on is saved. A bad prediction costs PCG iterations, never a wrong
 answer (the exact steps and the KKT check decide, as on a cold start).
 
-:func:`predicted_set` is what :func:`plateqp.contact.pipeline.solve_contact` calls; the option
+:func:`predicted_set` is what :func:`plateqp.contact.pipeline.solve_contact` calls (the coarse
+problem solved directly, with only what the start needs: :func:`coarse_deflections`); the option
 ``predict`` of :func:`plateqp.solve` ("auto", True or False) says whether (see :func:`wanted`).
 """
 
@@ -21,13 +22,16 @@ import warnings
 import numpy as np
 import scipy.sparse as sp
 
-from ..accuracy import Status
+from ..accuracy import Accuracy, Status
+from ..backends import get_backend
 from ..model.assembly import Model, build_model
-from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError
+from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError, SolverError
 from ..estimate import COARSE_FAILURES, with_mesh
 from ..model.generators import mesh_cells
 from ..linalg import row_stiffness
+from .formulations import formulate
 from .scaling import Scaled
+from .statics import NO_EQUILIBRIUM, settle, supports_reach
 
 #: The coarse mesh has this many times the cell size of the scene's own (a sixteenth of its cells).
 DIVISOR = 4
@@ -38,7 +42,7 @@ COARSE_MIN = 16
 #: prediction saves costs less than the coarse solve; measured in benchmarks/bench_predict.py).
 ROWS_MIN = 4000
 
-__all__ = ["COARSE_MIN", "DIVISOR", "ROWS_MIN", "predicted_set", "soft_rows", "wanted"]
+__all__ = ["COARSE_MIN", "DIVISOR", "ROWS_MIN", "coarse_deflections", "predicted_set", "soft_rows", "wanted"]
 
 
 def soft_rows(data: Scaled) -> bool:
@@ -78,32 +82,72 @@ def check_predict(value) -> None:
         raise ProblemError(f"option predict must be 'auto', True or False, got {value!r}")
 
 
-def predicted_set(model: Model, solve) -> tuple[np.ndarray | None, dict]:
+def predicted_set(model: Model, solve=None) -> tuple[np.ndarray | None, dict]:
     """The contact set the scene's mesh coarsened DIVISOR times predicts, one entry per contact
     row of ``model`` (a point off the coarse plate: not in contact), and what it cost:
     ``{"mesh": coarse mesh, "rows": rows predicted in contact, "seconds": …}``; ``(None, {"why": …})``
-    where the coarse scene cannot be built or solved. ``solve`` is
-    :func:`plateqp.contact.pipeline.solve_contact` (passed in: this module stays below it)."""
+    where the coarse scene cannot be built or solved. The coarse problem is solved by pdas on the
+    primal directly (:func:`coarse_deflections`): the set only starts the fine solve, whose exact
+    steps and KKT check decide the answer, so the coarse answer gets no Result and no KKT report.
+    ``solve``: not used (the coarse problem needs no pipeline)."""
     t0 = time.perf_counter()
     nx, ny = mesh_cells(model.scene)
     cx, cy = max(1, round(nx / DIVISOR)), max(1, round(ny / DIVISOR))
+    c = model.contacts
+    x, y = c.xy[:, 0], c.xy[:, 1]
     try:
-        coarse_scene = with_mesh(model.scene, cx, cy)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", PlateQPWarning)
-            coarse = solve(build_model(coarse_scene), backend="pdas", formulation="primal", accuracy="default")
+            w, why = coarse_deflections(build_model(with_mesh(model.scene, cx, cy)), x, y)
     except (*COARSE_FAILURES, NoEquilibriumError) as exn:
         # the coarse answer is only a start: whatever stops it (a bed region whose coarse cells
         # end short of the load, so that the coarse plate tips off them) leaves the fine solve
         # to start cold, never fails it
         return None, {"mesh": [cx, cy], "why": f"the coarse mesh failed: {type(exn).__name__}: {exn}"}
-    if coarse.status != Status.OPTIMAL:
-        return None, {"mesh": [cx, cy], "why": f"the coarse solve ended {coarse.status.value}"}
-    c = model.contacts
-    x, y = c.xy[:, 0], c.xy[:, 1]
-    on = coarse.model.grid.locate(x, y)[0] >= 0
-    w = np.full(c.m, -np.inf)
-    if on.any():
-        w[on] = np.asarray(coarse.deflection(x[on], y[on]), dtype=float)
+    if w is None:
+        return None, {"mesh": [cx, cy], "why": why}
     A = np.nan_to_num(w - c.scene_gaps, nan=-np.inf) > 0
     return A, {"mesh": [cx, cy], "rows": int(A.sum()), "seconds": time.perf_counter() - t0}
+
+
+def _no_equilibrium(data: Scaled, acc: Accuracy) -> None:
+    """NoEquilibriumError where statics says the supports cannot carry the load (asked only
+    after the coarse solve stopped short: a solve that ends OPTIMAL needs no such check)."""
+    reach = supports_reach(data, band=acc.tol)
+    if not reach.possible and not reach.marginal:
+        raise NoEquilibriumError(f"{NO_EQUILIBRIUM} ({reach.why}; found by statics)")
+
+
+def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray | None, str]:
+    """The deflection of the coarse model's answer (pdas on the primal, accuracy "default") at
+    the points (x, y), −inf at a point off the coarse plate; (None, why) where the backend's
+    answer is not OPTIMAL. NoEquilibriumError where the solve stops short and statics says the
+    coarse supports cannot carry the load. Started, as the pipeline would, from the set of its
+    own coarse mesh where :func:`wanted` says so. The answer in the user's units as
+    :func:`plateqp.contact.answer.to_result` makes it (a floating plate's canonical deflection:
+    :func:`plateqp.contact.statics.settle`)."""
+    acc = Accuracy.parse("default")
+    data = Scaled.from_model(coarse)
+    form = formulate(data, "primal")
+    b = get_backend("pdas")
+    options = {}
+    if wanted(coarse, data, "pdas", "primal", options, "auto") is None:  # a coarse mesh large enough starts
+        A0 = predicted_set(coarse)[0]                                    # from its own coarse mesh's set
+        if A0 is not None:
+            options["active"] = A0
+    try:
+        raw = b.solve(form.problem(b.accepts), accuracy=acc, options=options)
+    except SolverError:
+        _no_equilibrium(data, acc)
+        raise
+    if raw.status != Status.OPTIMAL or raw.x is None:
+        _no_equilibrium(data, acc)
+        return None, f"the coarse solve ended {raw.status.value}"
+    sol = form.recover(raw)
+    u_s = settle(data, sol.u, sol.R, sol.s, max(acc.tol, 1e-9))[0] if data.floating else sol.u
+    u = coarse.expand(data.dof_scale * u_s)
+    on = coarse.grid.locate(x, y)[0] >= 0
+    w = np.full(x.shape, -np.inf)
+    if on.any():
+        w[on] = coarse.interpolation(x[on], y[on], 0, 0) @ u
+    return w, ""
