@@ -92,3 +92,24 @@ def test_each_value_is_the_cold_solve(case):
         R, Rc = np.array(row["reactions"]), cold.reactions
         assert np.abs(R - Rc).max() <= 1e-10 * np.abs(Rc).max()
         assert row["w_max"] == pytest.approx(float(cold.to_dict()["w_max"]), rel=1e-10)
+
+
+def test_exact_sweep_values_share_the_path_start_factor(halves, monkeypatch):
+    """``sweep --exact``: the path's start solve keeps its factor in the model the values adapt,
+    so every value, the first included, pays two halves at most."""
+    from plateqp.studies import homotopy
+
+    inner = homotopy.sweep
+
+    def counted(*a, **k):
+        halves["n"] = 0  # the values' solves alone, not the path's
+        return inner(*a, **k)
+
+    monkeypatch.setattr(homotopy, "sweep", counted)
+    make, path, values = CASES["gap"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        res = homotopy.exact_sweep(make(), path, values, backend="pdas", accuracy=ACC, executor="serial",
+                                   progress=False)
+    assert all(r["status"] == "optimal" for r in res.rows)
+    assert halves["n"] / len(values) <= 2.0, f"{halves['n'] / len(values)} halves of K's factor per value"
