@@ -33,7 +33,7 @@ from .options import (
     LH_PROBE,
     PIVOT_TOL,
 )
-from .reduced import Exchange, Outcome, ReducedQP, at_rounding, infeasible
+from .reduced import Exchange, Outcome, ReducedQP, gaps_at_rounding, infeasible, stationary_at_rounding
 
 __all__ = ["DenseDual", "NotApplicable", "anchored_set", "first_set", "run_dense"]
 
@@ -152,7 +152,8 @@ class DenseDual:
         """``(u, λ)`` of active set ``A`` on the exact sparse equations: ``basic``'s ``λ``, then
         iterative refinement with ``K⁻¹`` and the Cholesky factor of ``M_AA`` while the
         residuals are above rounding (:func:`.reduced.at_rounding`) and still halve: for
-        residuals ``r_u``, ``r_A``, ``v = K⁻¹ r_u``, ``M_AA δλ = r_A + B_A v``, ``δu = v − K⁻¹ B_Aᵀ δλ``."""
+        residuals ``r_u``, ``r_A``, ``v = K⁻¹ r_u``, ``M_AA δλ = r_A + B_A v``, ``δu = v − K⁻¹ B_Aᵀ δλ``
+        (``v = 0`` where ``r_u`` is at rounding already: :func:`.reduced.stationary_at_rounding`)."""
         if self.yf is None:
             raise ValueError("an anchored LCP has no exact steps (its K is not the plate's)")
         pb = self.pb
@@ -169,12 +170,18 @@ class DenseDual:
             delta = max(np.abs(pb.B @ u).max(initial=0.0), np.abs(pb.g).max(initial=0.0), tiny)
             res = max(np.abs(r_u).max() / max(np.abs(pb.f).max(), np.abs(BtL).max(initial=0.0), tiny),
                       np.abs(r_A).max(initial=0.0) / delta)
-            if res == 0.0 or (k >= 1 and res > 0.5 * best) or at_rounding(pb, u, idx, BA, lam[idx], r_u, r_A):
+            if res == 0.0 or (k >= 1 and res > 0.5 * best):
+                break
+            still = stationary_at_rounding(pb, u, BA, lam[idx], r_u)  # the two halves of at_rounding
+            if still and gaps_at_rounding(pb, u, idx, BA, lam[idx], r_A):
                 break
             best = min(best, res)
-            y = self._forward(r_u)  # v = K⁻¹ (r_u − B_Aᵀ δλ): one solve in two halves
+            # v = K⁻¹ (r_u − B_Aᵀ δλ): one solve in two halves; where r_u is rounding already (the
+            # step of a kept factor: only λ is off), v = 0 and the step corrects λ alone (half a solve)
+            lone = still and self.fac.can_split and idx.size > 0
+            y = np.zeros(self.fac.n) if lone else self._forward(r_u)
             if idx.size:
-                rhs = r_A + BcA @ self._tail(y)
+                rhs = r_A if lone else r_A + BcA @ self._tail(y)
                 dlam = (sla.cho_solve(self._chol, rhs, check_finite=False) if self._chol is not None
                         else np.linalg.lstsq(self.M[np.ix_(idx, idx)], rhs, rcond=None)[0])
                 y = self._sub_rows(y, BcA, dlam)

@@ -5,7 +5,7 @@ output", "Accuracy")."""
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -51,6 +51,9 @@ def auto_max_dense(n: int, soft: bool = False) -> int:
     return max(lo, min(hi, int(per_root * np.sqrt(n))))
 
 
+#: the loads (and their first half-solves) a kept condensed factorisation keeps (:class:`_Kept`)
+REFS = 3
+
 #: the linear-algebra counts of :attr:`.dense.DenseDual.stats` that add up over the solves of a factor
 _COUNTS = ("analyse_s", "factor_s", "extract_s", "factorisations", "solves", "solve_s")
 
@@ -65,6 +68,23 @@ class _Kept:
     Kd: np.ndarray
     B: object
     rho: np.ndarray
+    #: loads solved before and their first half-solves (``DenseDual.yf``), each load past the
+    #: first the part of one orthogonal to the loads before it (at most REFS): a load that is a
+    #: combination of them to rounding takes that combination of their first halves
+    refs: list = field(default_factory=list)
+
+    def _new_direction(self, f: np.ndarray) -> np.ndarray:
+        """``yf`` of a load outside the span of :attr:`refs`: the first half of its part ``d``
+        orthogonal to them (half a solve), plus the combination of theirs for the rest; ``d``
+        joins them (no cancellation between the parts: each no larger than the load)."""
+        cond = self.cond
+        refs = [r for r in self.refs if r[0].shape == f.shape]
+        alpha = np.linalg.lstsq(np.column_stack([r for r, _ in refs]), f, rcond=None)[0] if refs else []
+        d = f - sum((a * r for a, (r, _) in zip(alpha, refs)), np.zeros_like(f))
+        yd = cond._forward(d)
+        if np.linalg.norm(d) > 1e-8 * np.linalg.norm(f):
+            self.refs = (refs + [(d, yd)])[-REFS:]
+        return yd + sum((a * y for a, (_, y) in zip(alpha, refs)), np.zeros_like(yd))
 
     def fits(self, pb: ReducedQP, max_dense: int) -> bool:
         """The same K (its diagonal, to rounding: the scaling of K differs by an ulp between
@@ -78,18 +98,42 @@ class _Kept:
     def again(self, pb: ReducedQP) -> DenseDual:
         """The kept DenseDual for this solve's flexibilities, gaps and loads: its M's diagonal
         moved to the new ρ, ``d = g − B K⁻¹ f`` from the kept factor (half a solve, none where the
-        load is the last solve's: its first half ``yf`` is kept)."""
+        load is the last solve's: its first half ``yf`` is kept, nor where it is a combination of
+        loads solved before to rounding, one load's magnitude swept beside others: ``yf`` is
+        that combination of their first halves, :func:`combination`; a load outside their span
+        costs half a solve, :meth:`_new_direction`)."""
         cond = self.cond
         diag = np.diag_indices(pb.m)
         cond.M[diag] += pb.rho - self.rho
         self.rho = pb.rho.copy()
         same_load = cond.yf is not None and np.array_equal(pb.f, cond.pb.f)  # a gap or spring sweep
+        if not self.refs and cond.yf is not None:
+            self.refs.append((cond.pb.f, cond.yf))
         cond.pb, cond._chol, cond.first, cond._dense_s = pb, None, {}, 0.0
         cond.Bc = pb.B[:, cond.fac.last].tocsr()
         if not same_load:
-            cond.yf = cond._forward(pb.f)
+            alpha = combination(pb.f, [f for f, _ in self.refs])
+            if alpha is None:
+                cond.yf = self._new_direction(pb.f)
+            else:
+                cond.yf = sum(a * y for a, (_, y) in zip(alpha, self.refs))
         cond.d = pb.g - cond.Bc @ cond._tail(cond.yf)
         return cond
+
+
+def combination(f: np.ndarray, refs: list, grow: float = 16.0) -> list | None:
+    """Coefficients α with ``f = Σ α_j refs_j`` entry by entry to rounding (within 32 ε of
+    ``Σ |α_j| |refs_j|``, itself at most ``grow`` times ``|f|`` at its largest: no cancellation
+    that would cost the combined half-solve its digits), or None."""
+    if not refs or any(r.shape != f.shape for r in refs) or not np.any(f):
+        return None
+    R = np.column_stack(refs)
+    alpha = np.linalg.lstsq(R, f, rcond=None)[0]
+    size = np.abs(R) @ np.abs(alpha)
+    if not np.all(np.isfinite(alpha)) or size.max() > grow * np.abs(f).max():
+        return None
+    ok = np.abs(f - R @ alpha) <= 32.0 * np.finfo(float).eps * size
+    return [float(a) for a in alpha] if bool(np.all(ok)) else None
 
 
 def _dense_dual(pb: ReducedQP, max_dense: int) -> tuple[DenseDual, _Kept | None, dict | None]:

@@ -19,8 +19,8 @@ from ..base import QP
 #: rigid motions from its coordinates: about 1e-15 at 128²).
 NULL_ROUNDING = 1e-10
 
-__all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "heave_force", "infeasible", "natural_residuals",
-           "penalty_stiffness"]
+__all__ = ["Exchange", "Outcome", "ReducedQP", "at_rounding", "force_scale", "gaps_at_rounding", "heave_force",
+           "infeasible", "natural_residuals", "penalty_stiffness", "stationary_at_rounding"]
 
 #: A rigid row's penalty spring puts at most PENALTY_SOFT · κ K_jj on each unknown j it reads
 #: (:func:`penalty_stiffness`): ε κ PENALTY_SOFT lost on that unknown's pivot. Above 1 so that
@@ -260,12 +260,20 @@ def at_rounding(pb: ReducedQP, u: np.ndarray, idx: np.ndarray, BA, lamA: np.ndar
     the max norm, the test LAPACK's iterative refinement stops at): ``|r_u| ≤ c ε (|K||u| +
     |B_A|ᵀ|λ_A| + |f|)`` and ``|r_A| ≤ c ε (|B_A||u| + |g_A| + ρ_A|λ_A|)``. Another
     refinement step would not change the answer."""
+    return stationary_at_rounding(pb, u, BA, lamA, r_u) and gaps_at_rounding(pb, u, idx, BA, lamA, r_A)
+
+
+def stationary_at_rounding(pb: ReducedQP, u: np.ndarray, BA, lamA: np.ndarray, r_u: np.ndarray) -> bool:
+    """The first half of :func:`at_rounding`: ``|r_u| ≤ c ε (|K||u| + |B_A|ᵀ|λ_A| + |f|)``."""
     eps = ROUNDING_STOP * np.finfo(float).eps
-    au, al = np.abs(u), np.abs(lamA)
-    su = (pb.abs_K_times(au) + abs(BA.T) @ al + np.abs(pb.f)).max(initial=0.0)
-    if np.abs(r_u).max(initial=0.0) > eps * su:
-        return False
-    sA = abs(BA) @ au + np.abs(pb.g[idx]) + pb.rho[idx] * al
+    su = (pb.abs_K_times(np.abs(u)) + abs(BA.T) @ np.abs(lamA) + np.abs(pb.f)).max(initial=0.0)
+    return bool(np.abs(r_u).max(initial=0.0) <= eps * su)
+
+
+def gaps_at_rounding(pb: ReducedQP, u: np.ndarray, idx: np.ndarray, BA, lamA: np.ndarray, r_A: np.ndarray) -> bool:
+    """The second half of :func:`at_rounding`: ``|r_A| ≤ c ε (|B_A||u| + |g_A| + ρ_A|λ_A|)``."""
+    eps = ROUNDING_STOP * np.finfo(float).eps
+    sA = abs(BA) @ np.abs(u) + np.abs(pb.g[idx]) + pb.rho[idx] * np.abs(lamA)
     return bool(np.all(np.abs(r_A) <= eps * sA.max(initial=0.0)))
 
 

@@ -1,0 +1,115 @@
+"""A sweep on the condensed method's kept factor (posts: pdas with the contact dofs last) pays, per
+value after the first, at most two triangular halves of K's factor: one for the deflection of
+the value's active set and one for its refinement step. A gap or spring sweep's load is the one
+the factor solved before; a sweep of one load's magnitude scales its first half instead of
+solving it again; a refinement step whose stationarity residual is already rounding corrects
+the reactions alone (half a solve, not two halves). Every value is the cold solve's, to
+rounding, and passes the KKT check."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import plateqp as pq
+from plateqp.linalg import schur
+from plateqp.model.paths import set_param
+from plateqp.scenes.families import grid_elastic, grid_rigid
+from plateqp.studies.sweep import sweep
+
+pytestmark = pytest.mark.skipif(not pq.linalg.bindings(), reason="no CHOLMOD binding")
+
+ACC = 1e-10
+
+CASES = {
+    "gap": (lambda: grid_rigid(24, 5), "supports.1.gap", [-1e-3, -5e-4, 0.0, 5e-4, 1e-3, 2e-3]),
+    "load": (lambda: grid_rigid(24, 5), "loads.0.q", [5.0, 8.0, 12.0, 20.0, 30.0, 45.0]),
+    "stiffness": (lambda: grid_elastic(24, 5), "supports.*.stiffness", [1e4, 3e4, 1e5, 3e5, 1e6, 3e6]),
+}
+
+
+@pytest.fixture
+def halves(monkeypatch):
+    """Counts the triangular halves of the Schur factor's solves (a whole solve is two)."""
+    count = {"n": 0}
+    forward, backward, whole = schur.SchurFactor.forward, schur.SchurFactor.backward, schur.SchurFactor.solve
+
+    def fw(self, *a, **k):
+        count["n"] += 1
+        return forward(self, *a, **k)
+
+    def bw(self, *a, **k):
+        count["n"] += 1
+        return backward(self, *a, **k)
+
+    def sv(self, *a, **k):
+        count["n"] += 2
+        return whole(self, *a, **k)
+
+    monkeypatch.setattr(schur.SchurFactor, "forward", fw)
+    monkeypatch.setattr(schur.SchurFactor, "backward", bw)
+    monkeypatch.setattr(schur.SchurFactor, "solve", sv)
+    return count
+
+
+def run(scene, path, values, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        return sweep(scene, path, values, backend="pdas", accuracy=ACC, executor="serial", progress=False,
+                     refine_breakpoints=False, **kw)
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_two_halves_per_value_after_the_first(case, halves):
+    """A gap or spring sweep: two halves from the second value on. A sweep of the uniform load
+    beside the point load: its loads span a plane, known once two of them are solved; two
+    halves from the third value on."""
+    make, path, values = CASES[case]
+    scene = make()
+    first = 2 if case == "load" else 1
+    run(scene, path, values[:first])
+    before = halves["n"]
+    halves["n"] = 0
+    res = run(scene, path, values)
+    assert all(r["status"] == "optimal" for r in res.rows)
+    per_value = (halves["n"] - before) / (len(values) - first)
+    assert per_value <= 2.0, f"{per_value} halves of K's factor per value after the first"
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_each_value_is_the_cold_solve(case):
+    make, path, values = CASES[case]
+    scene = make()
+    hot = run(scene, path, values)
+    for v, row in zip(values, hot.rows):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", pq.PlateQPWarning)
+            cold = pq.solve(set_param(scene, path, v), backend="pdas", accuracy=ACC)
+        assert row["status"] == "optimal" and row["kkt_worst"] <= ACC
+        assert row["active"] == [bool(a) for a in cold.active]
+        R, Rc = np.array(row["reactions"]), cold.reactions
+        assert np.abs(R - Rc).max() <= 1e-10 * np.abs(Rc).max()
+        assert row["w_max"] == pytest.approx(float(cold.to_dict()["w_max"]), rel=1e-10)
+
+
+def test_exact_sweep_values_share_the_path_start_factor(halves, monkeypatch):
+    """``sweep --exact``: the path's start solve keeps its factor in the model the values adapt,
+    so every value, the first included, pays two halves at most."""
+    from plateqp.studies import homotopy
+
+    inner = homotopy.sweep
+
+    def counted(*a, **k):
+        halves["n"] = 0  # the values' solves alone, not the path's
+        return inner(*a, **k)
+
+    monkeypatch.setattr(homotopy, "sweep", counted)
+    make, path, values = CASES["gap"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", pq.PlateQPWarning)
+        res = homotopy.exact_sweep(make(), path, values, backend="pdas", accuracy=ACC, executor="serial",
+                                   progress=False)
+    assert all(r["status"] == "optimal" for r in res.rows)
+    assert halves["n"] / len(values) <= 2.0, f"{halves['n'] / len(values)} halves of K's factor per value"
