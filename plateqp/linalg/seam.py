@@ -178,10 +178,12 @@ class _Direct:
 
     def _indices(self, A: sp.csc_matrix) -> tuple[np.ndarray, np.ndarray]:
         """``A``'s indptr and indices as CHOLMOD's 64-bit integers, widened once per matrix (the
-        same triangle goes through order, analyse and factor)."""
+        same triangle goes through order, analyse and factor). ``A`` then holds the wide arrays
+        itself: one copy of its pattern alive, not two (10 MB at 256²)."""
         if self._wide is None or self._wide[0] is not A:
             self._wide = (A, np.ascontiguousarray(A.indptr, dtype=np.int64),
                           np.ascontiguousarray(A.indices, dtype=np.int64))
+            A.indptr, A.indices = self._wide[1], self._wide[2]
         return self._wide[1], self._wide[2]
 
     def _sparse(self, A: sp.csc_matrix) -> _Sparse:

@@ -137,7 +137,7 @@ class SpringFactor:
         base = np.asarray(Ks.data[low], dtype=float)
         base[diag] += sigma * Kd
         base *= self.s[li] * np.repeat(self.s, lcount)  # s_i s_j first: as in _whole, to the bit
-        self.base, self.indices, self.indptr = base, li, indptr
+        self.base, self.indices, self.indptr = base, li.astype(np.int64), indptr  # CHOLMOD's width
         self.pair_row, self.pair_pos = pr[inside], pos
         self.pair_val = pair_val[inside] * (self.s[pair_r[inside]] * self.s[pair_c[inside]])
         self.nnz = low.size
@@ -180,7 +180,7 @@ class SpringFactor:
             low = np.flatnonzero(indices <= cols if self.chol.upper else indices >= cols)
             scale = self.s[indices[low]] * self.s[cols[low]]
             self.base = base[low] * scale
-            self.indices = indices[low]
+            self.indices = indices[low].astype(np.int64)  # CHOLMOD's width: read, not widened again
             self.indptr = np.concatenate([[0], np.cumsum(np.bincount(cols[low], minlength=n))])
             where = np.full(nnz, -1, dtype=np.int64)
             where[low] = np.arange(low.size)
@@ -195,7 +195,8 @@ class SpringFactor:
         data = self.base + np.bincount(self.pair_pos, weights=w[self.pair_row] * self.pair_val,
                                        minlength=self.nnz)
         n = self.s.size
-        H = sp.csc_matrix((data, self.indices, self.indptr), shape=(n, n))
+        H = sp.csc_matrix((n, n))  # the pattern's arrays set, not passed: SciPy would narrow them (a copy)
+        H.data, H.indices, H.indptr = data, self.indices, self.indptr
         H.has_sorted_indices = True  # the pattern's columns were sorted when it was built: not checked again
         return H
 
