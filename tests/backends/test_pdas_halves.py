@@ -102,3 +102,11 @@ def test_many_posts_condensed_pdas_agrees_with_lemke():
     assert a.kkt.ok
     assert np.array_equal(a.active, b.active)
     assert rel(a.reactions, b.reactions) < 1e-7
+
+
+def test_the_triangular_solve_of_an_empty_set_is_empty():
+    """Lawson–Hanson's first step solves on an empty set: LAPACK's TRTRS is not asked (SciPy
+    1.15's wrapper refused its leading dimension 0 with info −8)."""
+    for trans in (False, True):
+        x = _lower_solve(np.zeros((0, 0)), np.zeros(0), trans=trans)
+        assert x.shape == (0,)

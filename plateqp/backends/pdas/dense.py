@@ -198,6 +198,8 @@ def _lower_solve(L: np.ndarray, b: np.ndarray, trans: bool = False) -> np.ndarra
     buffer: LAPACK's TRTRS on ``Lᵀ`` as ``scipy.linalg.solve_triangular`` calls it for such a
     block (the same arithmetic), without its checks and wrappers (Lawson–Hanson calls it a few
     hundred times a solve, where they took 0.015 s at 64²)."""
+    if L.shape[0] == 0:  # an empty set: nothing to solve (SciPy 1.15's TRTRS refuses its LDA = 0)
+        return np.array(b, dtype=float)
     x, info = _TRTRS(L.T, b, lower=0, trans=0 if trans else 1)
     if info != 0:  # a zero pivot (cannot happen for a Cholesky factor); as solve_triangular says it
         raise np.linalg.LinAlgError(f"singular matrix: resolution failed at diagonal {info - 1}")
