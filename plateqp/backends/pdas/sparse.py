@@ -140,7 +140,7 @@ def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, st
     ``(u, A, steps)``; 0 steps where the warm start's own minimiser keeps its set or moves at
     most LOWRANK_MAX rows of it (the exact steps take those on the warm start's factor).
     """
-    B, K, f, g, D = pb.B, pb.K, pb.f, pb.g, pb.Kd
+    B, K, f, g = pb.B, pb.K, pb.f, pb.g
     first = W.copy() if start is None else np.where(start, W, 0.0)
     u, A, start = _first_minimiser(pb, fac, W, sigma, first, start)
     if start is not None:
@@ -160,25 +160,7 @@ def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, st
     for k in range(NEWTON_STEPS):
         WA = np.where(A, W, 0.0)
         grad = K @ u - f + B.T @ (WA * (B @ u - g))
-        du = np.zeros_like(u)
-        res = -grad
-        z = fac.solve(res)
-        d = z.copy()
-        rz = rz0 = float(res @ z)
-        for j in range(PCG_MAX):
-            Hd = K @ d + sigma * D * d + B.T @ (WA * (B @ d))
-            dHd = float(d @ Hd)
-            if dHd <= 0:
-                break
-            a = rz / dHd
-            du += a * d
-            res -= a * Hd
-            z = fac.solve(res)
-            rz_new = float(res @ z)
-            if rz_new <= PCG_TOL**2 * rz0:
-                break
-            d = z + (rz_new / rz) * d
-            rz = rz_new
+        du, its = _pcg(pb, fac, WA, sigma, -grad)
         alpha = line_search(pb, W, u, du)
         if not np.isfinite(alpha):
             break
@@ -187,7 +169,7 @@ def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, st
         changes = int((A_new ^ A).sum())
         if steps is not None:
             steps.append({"step": f"newton {k + 1}", "active": int(A.sum()), "infeasible": changes,
-                          "solve": f"pcg {j + 1}", "alpha": round(alpha, 3)})
+                          "solve": f"pcg {its}", "alpha": round(alpha, 3)})
         A = A_new
         if changes <= max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION * pb.m):
             break
@@ -209,7 +191,7 @@ def _first_minimiser(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: flo
         # Where the set's minimiser (solved to WARM_PCG_TOL: PCG_TOL misjudged rows near their
         # threshold, 30 for 16 on the 64² grid of elastic posts) moves few rows, the factor of the
         # warm start's set serves the exact steps as after a plain start (a low-rank correction)
-        u = _pcg(pb, fac, first, sigma, f + B.T @ (first * g), np.zeros_like(f), WARM_PCG_TOL)
+        u = _pcg(pb, fac, first, sigma, f + B.T @ (first * g), tol=WARM_PCG_TOL)[0]
         A = B @ u - g > 0
         if int((A ^ start).sum()) > LOWRANK_MAX:
             start = None  # to the Newton steps (u is a rough solve)
@@ -236,21 +218,22 @@ def _springs_changed(fac: SpringFactor, first: np.ndarray, start: np.ndarray | N
     return int(np.count_nonzero(first[start] != w[start])) > LOWRANK_MAX
 
 
-def _pcg(pb: ReducedQP, fac: SpringFactor, WA: np.ndarray, sigma: float, b: np.ndarray, x: np.ndarray,
-         tol: float = PCG_TOL) -> np.ndarray:
-    """``x`` + a rough solution (to ``tol``) of ``(K + σD + B_Aᵀ W_A B_A) δ = b − H x``, by
-    conjugate gradients with ``fac`` as preconditioner (at most PCG_MAX iterations)."""
+def _pcg(pb: ReducedQP, fac: SpringFactor, WA: np.ndarray, sigma: float, b: np.ndarray,
+         tol: float = PCG_TOL) -> tuple[np.ndarray, int]:
+    """A rough solution (to ``tol``) of ``(K + σD + B_Aᵀ W_A B_A) x = b`` from ``x = 0``, by
+    conjugate gradients with ``fac`` as preconditioner, and its iterations (at most PCG_MAX)."""
     B, K, D = pb.B, pb.K, pb.Kd
 
     def H(v):
         return K @ v + sigma * D * v + B.T @ (WA * (B @ v))
 
-    x = x.copy()
-    res = b - H(x)
+    x = np.zeros_like(b)
+    res = np.array(b, dtype=float)
     z = fac.solve(res)
     d = z.copy()
     rz = rz0 = float(res @ z)
-    for _ in range(PCG_MAX):
+    j = 0
+    for j in range(PCG_MAX):
         Hd = H(d)
         dHd = float(d @ Hd)
         if dHd <= 0 or rz0 <= 0:
@@ -264,7 +247,7 @@ def _pcg(pb: ReducedQP, fac: SpringFactor, WA: np.ndarray, sigma: float, b: np.n
             break
         d = z + (rz_new / rz) * d
         rz = rz_new
-    return x
+    return x, j + 1
 
 
 def _dual_energy(pb: ReducedQP, uf: np.ndarray, lam: np.ndarray, u: np.ndarray) -> float:
