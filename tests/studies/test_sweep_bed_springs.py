@@ -12,35 +12,15 @@ import numpy as np
 import pytest
 
 import plateqp as pq
-from plateqp.linalg import cholmod
 from plateqp.model.paths import set_param
 from plateqp.studies.sweep import sweep
+
+from test_sweep_factor_reuse import bed  # one bed scene; the counting fixture is conftest.py's
 
 pytestmark = pytest.mark.skipif(not pq.linalg.bindings(), reason="no CHOLMOD binding")
 
 ACC = 1e-10
 VALUES = list(np.geomspace(1.0e4, 4.0e4, 6))
-
-
-def bed(n: int = 24) -> pq.Scene:
-    """A free plate on a tensionless bed falling away towards (1, 1): part of it lifts off."""
-    return pq.Scene(name="bed", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
-                    edges={}, loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
-                    foundation=pq.Foundation(2.0e4, gap={"profile": "linear", "g0": 0.0, "gx": 0.004, "gy": 0.002}))
-
-
-@pytest.fixture
-def factorisations(monkeypatch):
-    """Counts CHOLMOD's numeric factorisations: every sparse Cholesky of the package goes there."""
-    count = {"n": 0}
-    factor = cholmod.Cholesky.factor
-
-    def counted(self, *args, **kw):
-        count["n"] += 1
-        return factor(self, *args, **kw)
-
-    monkeypatch.setattr(cholmod.Cholesky, "factor", counted)
-    return count
 
 
 def run(scene, values):
@@ -51,7 +31,7 @@ def run(scene, values):
 
 
 def test_one_factorisation_per_modulus(factorisations):
-    scene = bed()
+    scene = bed(24)
     run(scene, VALUES[:1])
     one = factorisations["n"]
     factorisations["n"] = 0
@@ -63,7 +43,7 @@ def test_one_factorisation_per_modulus(factorisations):
 
 
 def test_each_modulus_is_the_cold_solve():
-    scene = bed()
+    scene = bed(24)
     hot = run(scene, VALUES)
     for v, row in zip(VALUES, hot.rows):
         with warnings.catch_warnings():

@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 
 import plateqp as pq
-from plateqp.linalg import cholmod
 from plateqp.model.paths import set_param
 from plateqp.studies.sweep import sweep
 
@@ -38,26 +37,6 @@ def bed(n: int = 10) -> pq.Scene:
     return pq.Scene(name="bed", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
                     edges={}, loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
                     foundation=pq.Foundation(2.0e4, gap={"profile": "linear", "g0": 0.0, "gx": 0.004, "gy": 0.002}))
-
-
-@pytest.fixture
-def factorisations(monkeypatch):
-    """Counts CHOLMOD's numeric factorisations ("n") and symbolic analyses ("analyse"): every
-    sparse Cholesky of the package goes there."""
-    count = {"n": 0, "analyse": 0}
-    factor, analyse = cholmod.Cholesky.factor, cholmod.Cholesky.analyse
-
-    def counted(self, *args, **kw):
-        count["n"] += 1
-        return factor(self, *args, **kw)
-
-    def analysed(self, *args, **kw):
-        count["analyse"] += 1
-        return analyse(self, *args, **kw)
-
-    monkeypatch.setattr(cholmod.Cholesky, "factor", counted)
-    monkeypatch.setattr(cholmod.Cholesky, "analyse", analysed)
-    return count
 
 
 def run(scene, path, values, reuse):
