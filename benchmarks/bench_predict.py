@@ -111,7 +111,6 @@ def predicted(kind: str, n: int, d: int) -> tuple:
     import plateqp as pq
     from plateqp.model.assembly import build_model
     from plateqp.contact import predict
-    from plateqp.contact.pipeline import solve_contact
 
     predict.DIVISOR = d
     scene = SCENES[kind](n)
@@ -120,7 +119,7 @@ def predicted(kind: str, n: int, d: int) -> tuple:
     dt = time.process_time() - t0
     if "rows" not in res.extras["predicted"]:
         raise RuntimeError(f"no prediction: {res.extras['predicted']}")
-    A, _ = predict.predicted_set(build_model(scene), solve_contact)  # the set it started from, off the clock
+    A, _ = predict.predicted_set(build_model(scene))  # the set it started from, off the clock
     return (dt, res.times["predict"], res.status.value, _kkt(res), res.extras["factorisations"],
             res.extras["solves"], A, np.asarray(res.reactions))
 

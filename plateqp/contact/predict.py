@@ -82,14 +82,13 @@ def check_predict(value) -> None:
         raise ProblemError(f"option predict must be 'auto', True or False, got {value!r}")
 
 
-def predicted_set(model: Model, solve=None) -> tuple[np.ndarray | None, dict]:
+def predicted_set(model: Model) -> tuple[np.ndarray | None, dict]:
     """The contact set the scene's mesh coarsened DIVISOR times predicts, one entry per contact
     row of ``model`` (a point off the coarse plate: not in contact), and what it cost:
     ``{"mesh": coarse mesh, "rows": rows predicted in contact, "seconds": …}``; ``(None, {"why": …})``
     where the coarse scene cannot be built or solved. The coarse problem is solved by pdas on the
     primal directly (:func:`coarse_deflections`): the set only starts the fine solve, whose exact
-    steps and KKT check decide the answer, so the coarse answer gets no Result and no KKT report.
-    ``solve``: not used (the coarse problem needs no pipeline)."""
+    steps and KKT check decide the answer, so the coarse answer gets no Result and no KKT report."""
     t0 = time.perf_counter()
     nx, ny = mesh_cells(model.scene)
     cx, cy = max(1, round(nx / DIVISOR)), max(1, round(ny / DIVISOR))

@@ -19,7 +19,6 @@ import plateqp as pq
 from plateqp.scenes import families as F
 from plateqp.model.assembly import build_model
 from plateqp.contact import predict as P
-from plateqp.contact.pipeline import solve_contact
 from plateqp.errors import ProblemError
 
 pytest.importorskip("cvxopt")  # the sparse method's factor on the default install
@@ -84,7 +83,7 @@ def test_a_large_bed_starts_from_the_coarse_mesh_and_factorises_once(bed_64, mon
 def test_the_predicted_set_is_nearly_the_answers(bed_64):
     """The 16² mesh's contact set read at the 64² mesh's springs: a handful of 4225 wrong."""
     sc, cold = bed_64
-    A, info = P.predicted_set(build_model(sc), solve_contact)
+    A, info = P.predicted_set(build_model(sc))
     assert info["mesh"] == [16, 16] and info["rows"] == int(A.sum())
     assert 0 < np.sum(A != cold.active) <= 0.01 * A.size
 
@@ -115,7 +114,7 @@ def bump_bed(n):
 def test_a_feature_finer_than_the_coarse_cells_costs_iterations_not_the_answer():
     sc = bump_bed(32)
     model = build_model(sc)
-    A, _ = P.predicted_set(model, solve_contact)
+    A, _ = P.predicted_set(model)
     res = solve(sc, backend="pdas", options={"predict": True})
     cold = solve(sc, backend="pdas", options={"predict": False})
     ref = solve(sc, backend="bpp", formulation="condensed", accuracy=1e-8)
@@ -194,7 +193,7 @@ def test_springs_off_the_coarse_plate_are_predicted_open():
     xy = model.contacts.xy
     off = build_model(P.with_mesh(sc, 8, 8)).grid.locate(xy[:, 0], xy[:, 1])[0] < 0
     assert off.sum() >= 3
-    A, info = P.predicted_set(model, solve_contact)
+    A, info = P.predicted_set(model)
     assert info["mesh"] == [8, 8] and not A[off].any()
     res = solve(sc, backend="pdas", options={"predict": True})
     cold = solve(sc, backend="pdas", options={"predict": False})

@@ -44,7 +44,7 @@ def _reference_set(model):
     ids=["column", "tilted"])
 def test_the_coarse_set_is_the_whole_pipelines(scene):
     model = build_model(scene)
-    A, info = P.predicted_set(model, solve_contact)
+    A, info = P.predicted_set(model)
     ref = _reference_set(model)
     assert 0 < ref.sum() <= ref.size
     assert np.array_equal(A, ref)
@@ -61,6 +61,6 @@ def test_the_coarse_solve_makes_no_result_nor_kkt_report(monkeypatch):
 
     monkeypatch.setattr(kkt, "kkt_report", refused)
     monkeypatch.setattr(pipeline, "kkt_report", refused)
-    A, info = P.predicted_set(model, solve_contact)
+    A, info = P.predicted_set(model)
     assert A is not None, info
     assert A.sum() == info["rows"] > 0
