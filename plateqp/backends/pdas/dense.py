@@ -150,7 +150,8 @@ class DenseDual:
         return lam, gap
 
     def exact(self, A: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(u, λ)`` of active set ``A`` on the exact sparse equations: ``basic``'s ``λ``, then
+        """``(u, λ)`` of active set ``A`` on the exact sparse equations: ``basic``'s ``λ``, refined
+        on the trailing unknowns (:meth:`_refine_tail`) before ``u``'s backward half, then
         iterative refinement with ``K⁻¹`` and the Cholesky factor of ``M_AA`` while the
         residuals are above rounding (:func:`.reduced.at_rounding`) and still halve: for
         residuals ``r_u``, ``r_A``, ``v = K⁻¹ r_u``, ``M_AA δλ = r_A + B_A v``, ``δu = v − K⁻¹ B_Aᵀ δλ``
