@@ -68,8 +68,10 @@ def from_curvatures(plate, quantity: str, kxx, kyy, kxy) -> np.ndarray:
         return moments(plate, kxx, kyy, kxy)[("Mx", "My", "Mxy").index(quantity)]
     if quantity in ("sx", "sy", "txy"):
         return stresses(plate, kxx, kyy, kxy)[("sx", "sy", "txy").index(quantity)]
-    if quantity in ("s1", "s2"):
-        return principal(*stresses(plate, kxx, kyy, kxy))[("s1", "s2").index(quantity)]
+    if quantity in ("s1", "s2"):  # principal's σ1 or σ2 (its angle not computed)
+        sx, sy, txy = stresses(plate, kxx, kyy, kxy)
+        c, r = 0.5 * (sx + sy), np.hypot(0.5 * (sx - sy), txy)
+        return c + r if quantity == "s1" else c - r
     check_quantity(quantity)
     raise ValueError(f"{quantity!r} is not recovered from the curvatures")
 
@@ -81,7 +83,8 @@ class NodalOperator:
     mean over the cells that hold it. Values come as (n,) arrays, one per node of the plate in
     the order of ``mesh.nodes``. The operator from the full dofs to the cells' corner
     curvatures (w,xx, w,yy, w,xy) is built on first use and kept, so that many solutions on
-    one mesh (a sweep) cost a sparse product each. Valid for every model that shares the mesh,
+    one mesh (a sweep) cost a product each: on a mesh of equal cells (the structured grid) one
+    cell's corner matrix applied to every cell's dofs, else a sparse operator. Valid for every model that shares the mesh,
     element and kept cells of ``model`` (an adapted model of a sweep).
 
     A cell's corner values are its element's answer, one call on every mesh:
@@ -144,9 +147,21 @@ class NodalOperator:
                 self._w = self._op(self.model.element.corner_w(self._xy)[:, :, None])
             return self._averaged(self._w @ u)
         if self._curv is None:
-            self._curv = self._op(self.model.element.corner_curvatures(self._xy))
-        kxx, kyy, kxy = (self._curv @ u).reshape(3, -1)
+            self._curv = self._curvatures_op(self.model.element.corner_curvatures(self._xy))
+        if isinstance(self._curv, np.ndarray):  # one cell's (corners · 3, ndof): every cell's
+            nc, nv = self._xy.shape[:2]
+            kxx, kyy, kxy = (np.asarray(u, dtype=float)[self.model.cell_dofs] @ self._curv.T).reshape(nc * nv, 3).T
+        else:
+            kxx, kyy, kxy = (self._curv @ u).reshape(3, -1)
         return self._averaged(from_curvatures(plate, quantity, kxx, kyy, kxy))
+
+    def _curvatures_op(self, values: np.ndarray):
+        """The corner curvatures' operator: where every cell's corner values are the first
+        cell's (a mesh of equal cells: the structured grid), that cell's (corners · 3, ndof)
+        matrix, applied to each cell's dofs; else the sparse operator of :meth:`_op`."""
+        if values.shape[0] and np.array_equal(values, np.broadcast_to(values[:1], values.shape)):
+            return np.ascontiguousarray(values[0].reshape(-1, values.shape[-1]))
+        return self._op(values)
 
 
 def nodal_operator(model) -> NodalOperator:

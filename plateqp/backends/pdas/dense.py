@@ -33,7 +33,8 @@ from .options import (
     LH_PROBE,
     PIVOT_TOL,
 )
-from .reduced import Exchange, Outcome, ReducedQP, gaps_at_rounding, infeasible, stationary_at_rounding
+from .reduced import (ROUNDING_STOP, Exchange, Outcome, ReducedQP, gaps_at_rounding, infeasible,
+                      stationary_at_rounding)
 
 __all__ = ["DenseDual", "NotApplicable", "anchored_set", "first_set", "run_dense"]
 
@@ -149,7 +150,8 @@ class DenseDual:
         return lam, gap
 
     def exact(self, A: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(u, λ)`` of active set ``A`` on the exact sparse equations: ``basic``'s ``λ``, then
+        """``(u, λ)`` of active set ``A`` on the exact sparse equations: ``basic``'s ``λ``, refined
+        on the trailing unknowns (:meth:`_refine_tail`) before ``u``'s backward half, then
         iterative refinement with ``K⁻¹`` and the Cholesky factor of ``M_AA`` while the
         residuals are above rounding (:func:`.reduced.at_rounding`) and still halve: for
         residuals ``r_u``, ``r_A``, ``v = K⁻¹ r_u``, ``M_AA δλ = r_A + B_A v``, ``δu = v − K⁻¹ B_Aᵀ δλ``
@@ -160,7 +162,8 @@ class DenseDual:
         idx = np.flatnonzero(A)
         BA, BcA = pb.B[idx], self.Bc[idx]
         lam = lam.copy()
-        u = self._backward(self._sub_rows(self.yf, BcA, lam[idx]))  # K⁻¹ (f − B_Aᵀ λ_A): half a solve
+        y = self._refine_tail(idx, BcA, lam, self._sub_rows(self.yf, BcA, lam[idx]))
+        u = self._backward(y)  # K⁻¹ (f − B_Aᵀ λ_A): half a solve
         best = np.inf
         tiny = np.finfo(float).tiny
         for k in range(INNER_EXACT):
@@ -188,6 +191,28 @@ class DenseDual:
                 lam[idx] += dlam
             u += self._backward(y)
         return u, lam
+
+    def _refine_tail(self, idx: np.ndarray, BcA, lam: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``λ_A`` (in place) refined on the trailing unknowns alone, and its ``y``: ``B_A u``
+        needs only them (a dense triangular solve of the trailing block, no sparse half), so the
+        gap residual ``r_A`` is driven to rounding (:func:`.reduced.gaps_at_rounding`'s test)
+        before the one backward half that gives ``u``; a step that does not halve it stops."""
+        if not (self.fac.can_split and idx.size and self._chol is not None and self._chol[0].shape[0] == idx.size):
+            return y
+        pb, eps = self.pb, ROUNDING_STOP * np.finfo(float).eps
+        best = np.inf
+        for _ in range(INNER_EXACT):
+            uc = self._tail(y)
+            r_A = BcA @ uc - pb.g[idx] - pb.rho[idx] * lam[idx]
+            size = np.abs(r_A).max()
+            scale = (abs(BcA) @ np.abs(uc) + np.abs(pb.g[idx]) + pb.rho[idx] * np.abs(lam[idx])).max()
+            if size <= eps * scale or size > 0.5 * best:
+                break
+            best = size
+            dlam = sla.cho_solve(self._chol, r_A, check_finite=False)
+            y = self._sub_rows(y, BcA, dlam)
+            lam[idx] += dlam
+        return y
 
 
 _TRTRS = sla.get_lapack_funcs("trtrs", dtype=np.float64)
