@@ -28,7 +28,7 @@ from ..model.assembly import Model, build_model
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError, SolverError
 from ..estimate import COARSE_FAILURES, with_mesh
 from ..model.generators import mesh_cells
-from ..linalg import row_stiffness
+from ..linalg import Factor, SingularMatrixError, pattern, row_stiffness
 from .formulations import formulate
 from .scaling import Scaled
 from .statics import NO_EQUILIBRIUM, settle, supports_reach
@@ -41,8 +41,11 @@ COARSE_MIN = 16
 #: With ``predict="auto"``: at least this many contact rows (below it the second factorisation a
 #: prediction saves costs less than the coarse solve; measured in benchmarks/bench_predict.py).
 ROWS_MIN = 4000
+#: Newton steps on a coarse mesh of springs (:func:`spring_deflections`) before its solve is left
+#: to pdas (the benchmark bed's 16² mesh settles in 4 to 6).
+NEWTON_STEPS = 25
 
-__all__ = ["COARSE_MIN", "DIVISOR", "ROWS_MIN", "coarse_deflections", "predicted_set", "soft_rows", "wanted"]
+__all__ = ["COARSE_MIN", "DIVISOR", "ROWS_MIN", "coarse_deflections", "predicted_set", "soft_rows", "spring_deflections", "wanted"]
 
 
 def soft_rows(data: Scaled) -> bool:
@@ -125,6 +128,9 @@ def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.
     own coarse mesh where :func:`wanted` says so. The answer in the user's units as
     :func:`plateqp.contact.answer.to_result` makes it (a floating plate's canonical deflection:
     :func:`plateqp.contact.statics.settle`)."""
+    u = spring_deflections(coarse)
+    if u is not None:
+        return _at_points(coarse, coarse.expand(u), x, y), ""
     acc = Accuracy.parse("default")
     data = Scaled.from_model(coarse)
     form = formulate(data, "primal")
@@ -144,9 +150,62 @@ def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.
         return None, f"the coarse solve ended {raw.status.value}"
     sol = form.recover(raw)
     u_s = settle(data, sol.u, sol.R, sol.s, max(acc.tol, 1e-9))[0] if data.floating else sol.u
-    u = coarse.expand(data.dof_scale * u_s)
+    return _at_points(coarse, coarse.expand(data.dof_scale * u_s), x, y), ""
+
+
+def _at_points(coarse: Model, u: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The deflection of the coarse model's full dofs ``u`` at the points (x, y), −inf at a point
+    off the coarse plate."""
     on = coarse.grid.locate(x, y)[0] >= 0
     w = np.full(x.shape, -np.inf)
     if on.any():
         w[on] = coarse.interpolation(x[on], y[on], 0, 0) @ u
-    return w, ""
+    return w
+
+
+def spring_deflections(coarse: Model) -> np.ndarray | None:
+    r"""The coarse model's answer (its free dofs) where every contact row is a spring (ρ > 0, no
+    soil with unknowns of its own), by Newton's method on the contact set: the minimiser of
+
+    .. math:: \tfrac12 u^T K u - f^T u + \tfrac12 \sum_i \max(0, B_i u - g_i)^2 / \rho_i
+
+    is the solution of :math:`(K + B_A^T \rho_A^{-1} B_A) u = f + B_A^T \rho_A^{-1} g_A` on the set
+    :math:`A = \{i : B_i u > g_i\}` it gives; starting from every row pressed, each step solves
+    for its set and takes the rows that press, until the set repeats (the answer, exact to
+    rounding). None where a row is rigid, the plate is not held by a set (a singular matrix) or
+    the set does not repeat within NEWTON_STEPS steps: the caller then solves with pdas. Only the
+    contact set is read from it (the fine solve's exact steps and KKT check decide the answer);
+    no scaling, formulation or backend is built around so small a problem."""
+    c = coarse.contacts
+    if coarse.n_soil or c is None or not np.all(c.rho > 0):
+        return None
+    B, g, k = c.B.tocsr(), c.g0, 1.0 / c.rho
+    Bt = B.T.tocsr()
+    # Bᵀ diag(k_A) B from its terms k_i B_ij B_il, one per pair of entries of each row: the sum
+    # with K on one stored pattern whatever the set (pattern.add keeps zeros), so that the
+    # analysis of the first set serves every step
+    per_row = np.diff(B.indptr)
+    entry_row = np.repeat(np.arange(c.m), per_row)
+    times = per_row[entry_row]
+    first = np.repeat(np.arange(B.nnz), times)
+    second = B.indptr[entry_row[first]] + np.arange(first.size) - np.repeat(np.cumsum(times) - times, times)
+    term = B.data[first] * B.data[second]
+    cols = (B.indices[first], B.indices[second])
+    A = np.ones(c.m, dtype=bool)
+    F = None
+    for _ in range(NEWTON_STEPS):
+        kA = np.where(A, k, 0.0)
+        H = pattern.add(coarse.K, sp.coo_matrix((term * kA[entry_row[first]], cols), shape=coarse.K.shape))
+        try:
+            if F is None:
+                F = Factor(H)
+            else:
+                F.refactor(H)
+            u = F.solve(coarse.f + Bt @ (kA * g), refine=0)
+        except SingularMatrixError:
+            return None
+        pressed = B @ u > g
+        if np.array_equal(pressed, A):
+            return u if np.all(np.isfinite(u)) else None
+        A = pressed
+    return None
