@@ -155,11 +155,17 @@ def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.
 
 def _at_points(coarse: Model, u: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """The deflection of the coarse model's full dofs ``u`` at the points (x, y), −inf at a point
-    off the coarse plate."""
-    on = coarse.grid.locate(x, y)[0] >= 0
+    off the coarse plate: the element's basis in the cell the mesh locates each point in, as
+    :func:`plateqp.model.assembly.interpolation` takes it, summed with the cell's dofs directly
+    (one search of the points, no operator built for one product)."""
+    mesh = coarse.grid
+    cell, local = mesh.locate(x, y)
+    on = cell >= 0
     w = np.full(x.shape, -np.inf)
     if on.any():
-        w[on] = coarse.interpolation(x[on], y[on], 0, 0) @ u
+        cell = cell[on]
+        N = coarse.element.basis(mesh.nodes[mesh.cells[cell]], local[on], 0, 0)
+        w[on] = np.einsum("pk,pk->p", N, u[coarse.cell_dofs[cell]])
     return w
 
 

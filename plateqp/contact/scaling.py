@@ -223,7 +223,14 @@ def contact_spacing(model: Model, nearest: list | None = None) -> np.ndarray:
     p = model.scene.plate
     if pts.shape[0] < 2:
         return np.full(c.m, max(p.a, p.b))
-    d, _ = cKDTree(pts).query(c.xy, k=2)
+    # first within a cell's reach (a bed's nodes, posts on a grid: most points have a neighbour
+    # there, and the bounded search prunes the tree), then without bound for the points left
+    tree = cKDTree(pts, balanced_tree=False, compact_nodes=False)
+    reach = 1.5 * max(model.grid.hx, model.grid.hy)
+    d, _ = tree.query(c.xy, k=2, distance_upper_bound=reach)
+    far = ~np.isfinite(d[:, 1])
+    if far.any():
+        d[far] = tree.query(c.xy[far], k=2)[0]
     if nearest is not None:
         nearest.append(d[:, 1])
     s = np.where(d[:, 1] > 0, d[:, 1], max(p.a, p.b))

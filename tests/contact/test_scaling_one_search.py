@@ -46,3 +46,25 @@ def test_close_points_are_still_refused(monkeypatch):
                                pq.Support(x=0.8, y=0.3)])
     with pytest.raises(ProblemError, match="too stiff to tell apart"):
         Scaled.from_model(build_model(scene))
+
+
+@pytest.mark.parametrize("scene", [F.bed(16), F.grid_rigid(16, 5), F.floating(16, 3)], ids=["bed", "walls", "floating"])
+def test_the_spacing_is_the_nearest_point_by_brute_force(scene):
+    """The bounded search finds each point's nearest other point exactly: against every distance
+    computed (a point's own distance left out), walls' and pins' nodes and lines not met here
+    closer than the other points (checked: the spacing is at most the nearest point's)."""
+    from scipy.spatial.distance import cdist
+
+    from plateqp.contact.scaling import contact_spacing
+
+    model = build_model(scene)
+    xy = model.contacts.xy
+    nearest: list = []
+    s = contact_spacing(model, nearest)
+    nd = model.element.ndof_node
+    held = model.fixed[model.fixed % nd == 0] // nd
+    pts = np.vstack([xy, model.grid.node_xy()[held]])
+    D = cdist(xy, pts)
+    D[np.arange(len(xy)), np.arange(len(xy))] = np.inf
+    assert np.array_equal(nearest[0], D.min(axis=1))
+    assert np.all(s <= D.min(axis=1))
