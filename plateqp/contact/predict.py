@@ -127,10 +127,14 @@ def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.
     coarse supports cannot carry the load. Started, as the pipeline would, from the set of its
     own coarse mesh where :func:`wanted` says so. The answer in the user's units as
     :func:`plateqp.contact.answer.to_result` makes it (a floating plate's canonical deflection:
-    :func:`plateqp.contact.statics.settle`)."""
-    u = spring_deflections(coarse)
-    if u is not None:
-        return _at_points(coarse, coarse.expand(u), x, y), ""
+    :func:`plateqp.contact.statics.settle`). A coarse mesh too small for a prediction of its own
+    whose rows are all springs is solved by :func:`spring_deflections` instead (a few small
+    factorisations against pdas's cold start; a larger one keeps pdas started from its own
+    coarse set: one factorisation, where Newton's steps would each take one)."""
+    if _too_small_to_predict(coarse):
+        u = spring_deflections(coarse)
+        if u is not None:
+            return _at_points(coarse, coarse.expand(u), x, y), ""
     acc = Accuracy.parse("default")
     data = Scaled.from_model(coarse)
     form = formulate(data, "primal")
@@ -151,6 +155,13 @@ def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.
     sol = form.recover(raw)
     u_s = settle(data, sol.u, sol.R, sol.s, max(acc.tol, 1e-9))[0] if data.floating else sol.u
     return _at_points(coarse, coarse.expand(data.dof_scale * u_s), x, y), ""
+
+
+def _too_small_to_predict(model: Model) -> bool:
+    """:func:`wanted`'s size rules ("auto"): fewer than ROWS_MIN contact rows, or a mesh too
+    coarse to coarsen again (a pdas solve of it would start cold)."""
+    nx, ny = mesh_cells(model.scene)
+    return model.contacts.m < ROWS_MIN or min(nx, ny) // DIVISOR < COARSE_MIN
 
 
 def _at_points(coarse: Model, u: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:

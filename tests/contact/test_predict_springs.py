@@ -69,3 +69,22 @@ def test_the_prediction_on_springs_asks_no_backend(name, monkeypatch):
 def test_rigid_rows_are_left_to_pdas():
     """A rigid post is no spring: no Newton step; the pdas route answers."""
     assert P.spring_deflections(build_model(F.grid_rigid(16, 3))) is None
+
+
+def test_a_coarse_mesh_large_enough_keeps_pdas_from_its_own_set(monkeypatch):
+    """Where the coarse mesh is large enough for a prediction of its own, pdas solves it from
+    that set (one factorisation) and Newton's steps solve only the coarsest mesh."""
+    monkeypatch.setattr(P, "ROWS_MIN", 100)
+    monkeypatch.setattr(P, "COARSE_MIN", 4)
+    model = build_model(SCENES["tilted bed"](64))  # coarse 16² (289 rows), its own coarse 4²
+    solved = []
+    real = P.spring_deflections
+
+    def spy(coarse):
+        solved.append(coarse.scene.mesh.nx)
+        return real(coarse)
+
+    monkeypatch.setattr(P, "spring_deflections", spy)
+    A, info = P.predicted_set(model)
+    assert A is not None and info["mesh"] == [16, 16]
+    assert solved == [4]
