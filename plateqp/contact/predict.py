@@ -28,7 +28,7 @@ from ..model.assembly import Model, build_model
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError, SolverError
 from ..estimate import COARSE_FAILURES, with_mesh
 from ..model.generators import mesh_cells
-from ..linalg import row_stiffness
+from ..linalg import Factor, SingularMatrixError, pattern, row_stiffness
 from .formulations import formulate
 from .scaling import Scaled
 from .statics import NO_EQUILIBRIUM, settle, supports_reach
@@ -41,8 +41,11 @@ COARSE_MIN = 16
 #: With ``predict="auto"``: at least this many contact rows (below it the second factorisation a
 #: prediction saves costs less than the coarse solve; measured in benchmarks/bench_predict.py).
 ROWS_MIN = 4000
+#: Newton steps on a coarse mesh of springs (:func:`spring_deflections`) before its solve is left
+#: to pdas (the benchmark bed's 16² mesh settles in 4 to 6).
+NEWTON_STEPS = 25
 
-__all__ = ["COARSE_MIN", "DIVISOR", "ROWS_MIN", "coarse_deflections", "predicted_set", "soft_rows", "wanted"]
+__all__ = ["COARSE_MIN", "DIVISOR", "ROWS_MIN", "coarse_deflections", "predicted_set", "soft_rows", "spring_deflections", "wanted"]
 
 
 def soft_rows(data: Scaled) -> bool:
@@ -124,7 +127,14 @@ def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.
     coarse supports cannot carry the load. Started, as the pipeline would, from the set of its
     own coarse mesh where :func:`wanted` says so. The answer in the user's units as
     :func:`plateqp.contact.answer.to_result` makes it (a floating plate's canonical deflection:
-    :func:`plateqp.contact.statics.settle`)."""
+    :func:`plateqp.contact.statics.settle`). A coarse mesh too small for a prediction of its own
+    whose rows are all springs is solved by :func:`spring_deflections` instead (a few small
+    factorisations against pdas's cold start; a larger one keeps pdas started from its own
+    coarse set: one factorisation, where Newton's steps would each take one)."""
+    if _too_small_to_predict(coarse):
+        u = spring_deflections(coarse)
+        if u is not None:
+            return _at_points(coarse, coarse.expand(u), x, y), ""
     acc = Accuracy.parse("default")
     data = Scaled.from_model(coarse)
     form = formulate(data, "primal")
@@ -144,9 +154,83 @@ def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.
         return None, f"the coarse solve ended {raw.status.value}"
     sol = form.recover(raw)
     u_s = settle(data, sol.u, sol.R, sol.s, max(acc.tol, 1e-9))[0] if data.floating else sol.u
-    u = coarse.expand(data.dof_scale * u_s)
-    on = coarse.grid.locate(x, y)[0] >= 0
+    return _at_points(coarse, coarse.expand(data.dof_scale * u_s), x, y), ""
+
+
+def _too_small_to_predict(model: Model) -> bool:
+    """:func:`wanted`'s size rules ("auto"): fewer than ROWS_MIN contact rows, or a mesh too
+    coarse to coarsen again (a pdas solve of it would start cold)."""
+    nx, ny = mesh_cells(model.scene)
+    return model.contacts.m < ROWS_MIN or min(nx, ny) // DIVISOR < COARSE_MIN
+
+
+def _at_points(coarse: Model, u: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The deflection of the coarse model's full dofs ``u`` at the points (x, y), −inf at a point
+    off the coarse plate: the element's basis in the cell the mesh locates each point in, as
+    :func:`plateqp.model.assembly.interpolation` takes it, summed with the cell's dofs directly
+    (one search of the points, no operator built for one product)."""
+    mesh = coarse.grid
+    cell, local = mesh.locate(x, y)
+    on = cell >= 0
     w = np.full(x.shape, -np.inf)
     if on.any():
-        w[on] = coarse.interpolation(x[on], y[on], 0, 0) @ u
-    return w, ""
+        cell = cell[on]
+        N = coarse.element.basis(mesh.nodes[mesh.cells[cell]], local[on], 0, 0)
+        w[on] = np.einsum("pk,pk->p", N, u[coarse.cell_dofs[cell]])
+    return w
+
+
+def spring_deflections(coarse: Model) -> np.ndarray | None:
+    r"""The coarse model's answer (its free dofs) where every contact row is a spring (ρ > 0, no
+    soil with unknowns of its own), by Newton's method on the contact set: the minimiser of
+
+    .. math:: \tfrac12 u^T K u - f^T u + \tfrac12 \sum_i \max(0, B_i u - g_i)^2 / \rho_i
+
+    is the solution of :math:`(K + B_A^T \rho_A^{-1} B_A) u = f + B_A^T \rho_A^{-1} g_A` on the set
+    :math:`A = \{i : B_i u > g_i\}` it gives; starting from every row pressed, each step solves
+    for its set and takes the rows that press, until the set repeats (the answer, exact to
+    rounding). None where a row is rigid, the plate is not held by a set (a singular matrix) or
+    the set does not repeat within NEWTON_STEPS steps: the caller then solves with pdas. Only the
+    contact set is read from it (the fine solve's exact steps and KKT check decide the answer);
+    no scaling, formulation or backend is built around so small a problem."""
+    c = coarse.contacts
+    if coarse.n_soil or c is None or not np.all(c.rho > 0):
+        return None
+    B, g, k = c.B.tocsr(), c.g0, 1.0 / c.rho
+    Bt = B.T.tocsr()
+    # Bᵀ diag(k_A) B from its terms k_i B_ij B_il, one per pair of entries of each row, summed
+    # with K on one stored pattern whatever the set (the union of theirs: pattern.add keeps
+    # zeros), so that the analysis of the first set serves every step; each step only sums
+    # values into that pattern's places
+    per_row = np.diff(B.indptr)
+    entry_row = np.repeat(np.arange(c.m), per_row)
+    times = per_row[entry_row]
+    first = np.repeat(np.arange(B.nnz), times)
+    second = B.indptr[entry_row[first]] + np.arange(first.size) - np.repeat(np.cumsum(times) - times, times)
+    term, term_row = B.data[first] * B.data[second], entry_row[first]
+    rows, cols = B.indices[first], B.indices[second]
+    K = sp.coo_matrix(coarse.K)
+    H = pattern.add(K, sp.coo_matrix((np.ones(term.size), (rows, cols)), shape=K.shape))
+    n = H.shape[0]
+    key = np.repeat(np.arange(n, dtype=np.int64), np.diff(H.indptr)) * n + H.indices  # sorted: CSC, rows sorted
+    at_K = np.searchsorted(key, K.col.astype(np.int64) * n + K.row)
+    at_term = np.searchsorted(key, cols.astype(np.int64) * n + rows)
+    K_values = np.bincount(at_K, weights=K.data, minlength=H.nnz)
+    A = np.ones(c.m, dtype=bool)
+    F = None
+    for _ in range(NEWTON_STEPS):
+        kA = np.where(A, k, 0.0)
+        H.data = K_values + np.bincount(at_term, weights=term * kA[term_row], minlength=H.nnz)
+        try:
+            if F is None:
+                F = Factor(H)
+            else:
+                F.refactor(H)
+            u = F.solve(coarse.f + Bt @ (kA * g), refine=0)
+        except SingularMatrixError:
+            return None
+        pressed = B @ u > g
+        if np.array_equal(pressed, A):
+            return u if np.all(np.isfinite(u)) else None
+        A = pressed
+    return None

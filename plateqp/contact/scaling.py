@@ -109,12 +109,13 @@ class Scaled:
         modes = modes / S[:, None]
         if modes.shape[1]:
             modes = modes / np.linalg.norm(modes, axis=0)
+        nearest: list = []  # the points' search, kept for check_distinct_contacts
         data = cls(K, f, B, c.g0 / W, c.rho * D / L**2, S, L, W, F0, modes, order == 0, model.K, c.B,
-                   w_load=W_load / W, spacing=contact_spacing(model) / L, derived=model.derived, memo=memo,
+                   w_load=W_load / W, spacing=contact_spacing(model, nearest) / L, derived=model.derived, memo=memo,
                    soil=soil_of(model))
         if memo is not None:  # K̃ = S K S / (F0 W) and B̃ = B S / W do not depend on W (S ∝ W, F0 ∝ W)
             memo.update(K=K, B=B, modes=modes, is_w=data.is_w, spacing=data.spacing, per_W=S / W)
-        check_distinct_contacts(data, model)
+        check_distinct_contacts(data, model, nearest[0] if nearest else None)
         return data
 
     @classmethod
@@ -207,10 +208,12 @@ def soil_of(model: Model) -> str | None:
     return model.scene.foundation.model if model.n_soil else None
 
 
-def contact_spacing(model: Model) -> np.ndarray:
+def contact_spacing(model: Model, nearest: list | None = None) -> np.ndarray:
     """Distance from each contact point to the nearest other point that holds the plate: another
     contact point, a node whose deflection is prescribed (pins, edges), or a held edge's line;
-    the plate's size where there is none."""
+    the plate's size where there is none. ``nearest``: a list that, where the points were
+    searched, is given each point's distance to the nearest other point (contact point or held
+    node, 0 for a point given twice): what :func:`check_distinct_contacts` would search again."""
     from scipy.spatial import cKDTree
 
     c = model.contacts
@@ -220,7 +223,16 @@ def contact_spacing(model: Model) -> np.ndarray:
     p = model.scene.plate
     if pts.shape[0] < 2:
         return np.full(c.m, max(p.a, p.b))
-    d, _ = cKDTree(pts).query(c.xy, k=2)
+    # first within a cell's reach (a bed's nodes, posts on a grid: most points have a neighbour
+    # there, and the bounded search prunes the tree), then without bound for the points left
+    tree = cKDTree(pts, balanced_tree=False, compact_nodes=False)
+    reach = 1.5 * max(model.grid.hx, model.grid.hy)
+    d, _ = tree.query(c.xy, k=2, distance_upper_bound=reach)
+    far = ~np.isfinite(d[:, 1])
+    if far.any():
+        d[far] = tree.query(c.xy[far], k=2)[0]
+    if nearest is not None:
+        nearest.append(d[:, 1])
     s = np.where(d[:, 1] > 0, d[:, 1], max(p.a, p.b))
     # an edge held along its length (w prescribed at both its nodes) holds the plate between its
     # nodes too: nearer than its nodes
@@ -276,14 +288,19 @@ def deflection_scale(model: Model, floating: bool) -> tuple[float, float]:
 DEPENDENT_ROWS = 1e-12
 
 
-def check_distinct_contacts(data: Scaled, model: Model) -> None:
-    """ProblemError if two contact points are too close (and too stiff) to carry separate reactions."""
+def check_distinct_contacts(data: Scaled, model: Model, nearest: np.ndarray | None = None) -> None:
+    """ProblemError if two contact points are too close (and too stiff) to carry separate reactions.
+    ``nearest``: each point's distance to the nearest other point among the contact points and
+    more (:func:`contact_spacing`'s); where every one is beyond the closeness searched for, no two
+    contact points are that close, and the search is not made again."""
     c = model.contacts
     if data.m < 2:
         return
     from scipy.spatial import cKDTree
 
     h = min(model.grid.hx, model.grid.hy)
+    if nearest is not None and nearest.min(initial=np.inf) > 1e-3 * h:
+        return
     memo = data.memo if data.memo is not None else {}
     if "close_points" not in memo:  # the points' places alone
         memo["close_points"] = cKDTree(c.xy).query_pairs(1e-3 * h, output_type="ndarray")
