@@ -58,3 +58,23 @@ def test_the_kept_triangle_is_unchanged_and_each_factor_is_that_of_its_own_w():
         H = sp.csc_matrix(pb.K + sp.diags(sigma * pb.Kd) + pb.B.T @ sp.diags(w) @ pb.B)
         x = fac.solve(b)
         assert np.linalg.norm(H @ x - b) <= 1e-9 * np.linalg.norm(b)
+
+
+def test_the_woodbury_columns_cost_two_blocks_of_memory():
+    """A few rows changed on cvxopt's CHOLMOD: their columns ``L⁻¹ P D Uᵀ`` (n × k) come from one
+    block of the rows, scaled in place and read by CHOLMOD as it is, and the block solved."""
+    pb = _bed(32)
+    fac = _factor(pb)
+    w = np.where(np.arange(pb.m) % 3 == 0, 1.0 / pb.rho, 0.0)
+    fac.set(w)
+    fac.t_solve = 0.0  # the columns priced as free: the low-rank correction is taken
+    changed = np.flatnonzero(w == 0)[:8]
+    w2 = w.copy()
+    w2[changed] = 1.0 / pb.rho[changed]
+    block = pb.K.shape[0] * changed.size * 8
+    tracemalloc.start()
+    fac.set(w2)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert fac.lr is not None and fac.stats["lowrank"] == 1
+    assert peak < 2.5 * block  # the block and its solve; a scaled copy and a Fortran copy made four

@@ -315,7 +315,7 @@ class SpringFactor:
             return False
         t0 = time.perf_counter()
         if new.size:
-            Znew = self._columns(self.B[new].T.toarray())
+            Znew = self._columns(self.B[new].T.toarray(order="F"))  # CHOLMOD's layout: not copied again
             for j, r in enumerate(new.tolist()):
                 self._zcols[r] = Znew[:, j]  # a view: the block stays one array
             self.stats["solves"] += 1
@@ -361,7 +361,8 @@ class SpringFactor:
         block solve's time), since ``U H(w₀)⁻¹ Uᵀ = YᵀY`` and ``H(w)⁻¹ b = D Pᵀ L⁻ᵀ (y − Y C⁻¹
         Yᵀ y)`` with ``y = L⁻¹ P D b`` (:meth:`solve`). Else ``Z = H(w₀)⁻¹ Uᵀ``."""
         if self.chol is not None:
-            return self.chol.forward(self.s[:, None] * Ut)
+            Ut *= self.s[:, None]  # in place: the caller's array is made for this
+            return self.chol.forward(Ut)
         return self._solve(Ut)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
