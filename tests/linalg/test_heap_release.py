@@ -65,6 +65,11 @@ def test_a_first_numeric_factorisation_releases_the_heap_first(monkeypatch):
     chol = Cholesky("cvxopt")
     A = lower(K, 1.0 / np.sqrt(K.diagonal()), upper=chol.upper)
     chol.analyse(A)
+    chol.factor(A)
+    assert calls == []  # a small factor: not worth it
+    monkeypatch.setattr(heap, "RELEASE_FROM", A.nnz)
+    chol = Cholesky("cvxopt")
+    chol.analyse(A)
     assert calls == []
     chol.factor(A)
     assert calls == [1]
