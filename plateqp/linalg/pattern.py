@@ -26,6 +26,10 @@ except ImportError:  # pragma: no cover - another SciPy layout: the blocks are b
     _csr_matvec = _csr_matvecs = None
 
 
+#: entries :func:`scaled` scales at a time (a block's arrays stay in cache: 2 MB of values)
+SCALE_BLOCK = 1 << 18
+
+
 def scaled(K: sp.spmatrix, s: np.ndarray, factor: float = 1.0) -> sp.csr_matrix | sp.csc_matrix:
     """``factor · diag(s) K diag(s)`` with exactly ``K``'s stored pattern (CSR or CSC as ``K``;
     any other format becomes CSR). One copy of the values, no product. Where ``K``'s indices are
@@ -35,11 +39,17 @@ def scaled(K: sp.spmatrix, s: np.ndarray, factor: float = 1.0) -> sp.csr_matrix 
     K = K if sp.isspmatrix_csr(K) or sp.isspmatrix_csc(K) else sp.csr_matrix(K)
     s = np.asarray(s, dtype=float)
     # in place on one array: (s_i s_j)·factor·K_ij, the same rounding for (i, j) and (j, i), so a
-    # symmetric K stays exactly symmetric (0.065 s against 0.10 s for 5.3 M entries at 256²)
+    # symmetric K stays exactly symmetric; a block of entries at a time (SCALE_BLOCK), each
+    # block's four passes in cache and no gather of the size of K
     data = np.repeat(s, np.diff(K.indptr))
-    data *= s[K.indices]
-    data *= factor
-    data *= K.data
+    tmp = np.empty(min(SCALE_BLOCK, data.size))
+    for a in range(0, data.size, SCALE_BLOCK):
+        b = min(a + SCALE_BLOCK, data.size)
+        part, t = data[a:b], tmp[:b - a]
+        np.take(s, K.indices[a:b], out=t, mode="clip")  # (mode "raise" buffers out: a copy)
+        part *= t
+        part *= factor
+        part *= K.data[a:b]
     if not K.has_sorted_indices:  # SciPy may sort the result in place: its own indices
         return type(K)((data, K.indices.copy(), K.indptr.copy()), shape=K.shape)
     out = type(K)((data, K.indices, K.indptr), shape=K.shape, copy=False)

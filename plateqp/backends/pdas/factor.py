@@ -14,6 +14,7 @@ import scipy.sparse as sp
 
 from ...errors import ProblemError, SingularMatrixError, SolverError
 from ...linalg import Cholesky, Factor, bindings
+from ...linalg.pattern import SCALE_BLOCK
 from .options import DOWNDATE_LOSS, LOWRANK_COND, LOWRANK_COST, LOWRANK_MAX
 
 __all__ = ["SpringFactor", "TrailingFactor"]
@@ -123,14 +124,17 @@ class SpringFactor:
             return False
         cols = np.repeat(np.arange(n, dtype=Ks.indices.dtype), counts)
         upper = self.chol.upper
+        # sorted columns: the triangle's part of each ends (starts) at its diagonal
+        on_diag = np.flatnonzero(Ks.indices == cols)
+        if (on_diag.size != n or np.any(on_diag < Ks.indptr[:-1]) or np.any(on_diag >= Ks.indptr[1:])
+                or not Ks.has_sorted_indices):
+            return False  # a column without its diagonal stored (or with it twice)
         inside_k = Ks.indices <= cols if upper else Ks.indices >= cols
         del cols
         li = Ks.indices[inside_k]
-        lcount = np.add.reduceat(inside_k, Ks.indptr[:-1], dtype=np.int64)
+        lcount = on_diag - Ks.indptr[:-1] + 1 if upper else Ks.indptr[1:] - on_diag
         indptr = np.concatenate([[0], np.cumsum(lcount)])
-        diag = indptr[1:] - 1 if upper else indptr[:-1]  # sorted: the diagonal ends (starts) each column
-        if np.any(lcount == 0) or np.any(li[diag] != np.arange(n)):
-            return False
+        diag = indptr[1:] - 1 if upper else indptr[:-1]
         inside = pair_r <= pair_c if upper else pair_r >= pair_c  # each off-diagonal pair once
         if np.array_equal(pair_r, pair_c):  # one unknown a row (a bed, posts at nodes): all on the diagonal
             pos = diag[pair_r]
@@ -144,10 +148,15 @@ class SpringFactor:
         base = np.asarray(Ks.data[inside_k], dtype=float)
         del inside_k
         base[diag] += sigma * Kd
-        scale = self.s[li]
-        scale *= np.repeat(self.s, lcount)
-        base *= scale  # s_i s_j first: as in _whole, to the bit
-        del scale
+        # s_i s_j first, as in _whole (to the bit), a block of columns at a time (no arrays of
+        # the triangle's size for the scales)
+        step = max(1, int(n * SCALE_BLOCK // max(base.size, 1)))
+        for j0 in range(0, n, step):
+            j1 = min(n, j0 + step)
+            a, b = indptr[j0], indptr[j1]
+            scale = self.s.take(li[a:b])
+            scale *= np.repeat(self.s[j0:j1], lcount[j0:j1])
+            base[a:b] *= scale
         self.base, self.indices, self.indptr = base, li.astype(np.int64), indptr  # CHOLMOD's width
         self.pair_row, self.pair_pos = pr[inside], pos
         self.pair_val = pair_val[inside] * (self.s[pair_r[inside]] * self.s[pair_c[inside]])
