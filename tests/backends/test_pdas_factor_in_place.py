@@ -78,3 +78,29 @@ def test_the_woodbury_columns_cost_two_blocks_of_memory():
     tracemalloc.stop()
     assert fac.lr is not None and fac.stats["lowrank"] == 1
     assert peak < 2.5 * block  # the block and its solve; a scaled copy and a Fortran copy made four
+
+
+def test_the_woodbury_columns_are_held_once():
+    """Rows changed in two steps: the second correction's columns gathered into one array, and
+    the blocks they were solved in let go (each column held once, in that array)."""
+    pb = _bed(32)
+    fac = _factor(pb)
+    w = np.where(np.arange(pb.m) % 3 == 0, 1.0 / pb.rho, 0.0)
+    fac.set(w)
+    fac.t_solve = 0.0  # the columns priced as free: the low-rank corrections are taken
+    off = np.flatnonzero(w == 0)
+    w1 = w.copy()
+    w1[off[:6]] = 1.0 / pb.rho[off[:6]]
+    fac.set(w1)
+    w2 = w1.copy()
+    w2[off[6:10]] = 1.0 / pb.rho[off[6:10]]
+    fac.set(w2)
+    assert fac.stats["lowrank"] == 2
+    Z = fac.lr[1]
+    assert Z.shape[1] == 10
+    assert all(np.shares_memory(col, Z) for col in fac._zcols.values())
+    # and the correction is right: the factor solves H(w2)
+    H = sp.csc_matrix(pb.K + sp.diags(1e-12 * pb.Kd) + pb.B.T @ sp.diags(w2) @ pb.B)
+    b = np.random.default_rng(2).standard_normal(pb.K.shape[0])
+    x = fac.solve(b)
+    assert np.linalg.norm(H @ x - b) <= 1e-8 * np.linalg.norm(b)

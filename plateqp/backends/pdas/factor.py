@@ -328,7 +328,12 @@ class SpringFactor:
             for j, r in enumerate(new.tolist()):
                 self._zcols[r] = Znew[:, j]  # a view: the block stays one array
             self.stats["solves"] += 1
-        Z = np.column_stack([self._zcols[r] for r in changed.tolist()])
+        if new.size == k:  # every column is the new block's, in order: that block is Z
+            Z = Znew
+        else:  # the columns gathered into one array, which they then live in: no block kept beside it
+            Z = np.column_stack([self._zcols[r] for r in changed.tolist()])
+            for j, r in enumerate(changed.tolist()):
+                self._zcols[r] = Z[:, j]
         U = self.B[changed]
         C = Z.T @ Z if self.chol is not None else U @ Z  # U H(w₀)⁻¹ Uᵀ either way
         # Woodbury is not backward stable for a stiff row: U x comes out with an absolute error
