@@ -3,8 +3,8 @@
 NumPy's arrays below glibc's mmap threshold (which grows to 32 MB once a larger block is freed)
 come from the process's heap, and freed they stay resident: the heap keeps them for the next
 allocation. A CHOLMOD factor is one allocation far above the threshold, mapped apart, so that
-memory is never re-used for it and counts beside it in the process's peak (54 MB held after the
-symbolic analysis of a 256² bed). :func:`release` returns it (glibc's ``malloc_trim``).
+memory is never re-used for it and counts beside it in the process's peak (docs/design/pdas.md).
+:func:`release` returns it (glibc's ``malloc_trim``).
 """
 
 from __future__ import annotations
