@@ -106,13 +106,18 @@ class Formulation:
 
 
 def _with_identity(K: sp.csc_matrix, k: int) -> sp.csc_matrix:
-    """``block_diag(K, I_k)`` in CSC, K's entries as stored (zeros and order kept)."""
+    """``block_diag(K, I_k)`` in CSC, K's entries as stored (zeros and order kept); its values
+    are K's own array, extended, where :func:`plateqp.linalg.pattern.scaled` left room for them."""
     n = K.shape[0]
     nnz = K.indptr[-1]
     idx = np.int64 if n + k > np.iinfo(np.int32).max or nnz + k > np.iinfo(np.int32).max else np.int32
     indptr = np.concatenate([K.indptr.astype(idx, copy=False), nnz + np.arange(1, k + 1, dtype=idx)])
     indices = np.concatenate([K.indices[:nnz].astype(idx, copy=False), np.arange(n, n + k, dtype=idx)])
-    data = np.concatenate([K.data[:nnz].astype(float, copy=False), np.ones(k)])
+    data = pattern.extended_values(K, k) if K.data.dtype == float else None
+    if data is None:
+        data = np.concatenate([K.data[:nnz].astype(float, copy=False), np.ones(k)])
+    else:  # K's values where they were scaled, the identity's in the room left after them
+        data[nnz:] = 1.0
     P = sp.csc_matrix((data, indices, indptr), shape=(n + k, n + k))
     P.has_sorted_indices = K.has_sorted_indices
     return P

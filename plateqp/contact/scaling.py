@@ -103,7 +103,8 @@ class Scaled:
         # CSC, the format every factorisation and the primal QP take: converted here, once, so
         # that no copy of it is alive beside this one when K is factorised (15 MB at 128²)
         K = pattern.scaled(pattern.csc_of_symmetric(model.K, model.symmetric), S,
-                           1.0 / (F0 * W))  # its stored pattern kept (AMD); a copy, not model.K's arrays
+                           1.0 / (F0 * W),  # its stored pattern kept (AMD); a copy, not model.K's arrays
+                           spare=int(np.count_nonzero(c.rho > 0)))  # the primal Hessian's identity
         f = S * model.f / (F0 * W)
         B = (c.B @ Sm / W).tocsr()
         modes = modes / S[:, None]

@@ -17,6 +17,8 @@
                        the stored pattern: a plate's structural zeros keep nodes together)
 :mod:`seam`            CHOLMOD's C API inside cvxopt's wheel through ctypes (NumPy arrays
                        read in place; cvxopt's binding where it does not load)
+:mod:`heap`            the C heap's freed memory returned to the system before a factor
+                       is allocated (glibc's ``malloc_trim``)
 =====================  ===========================================================
 
 Errors are :class:`~plateqp.errors.SingularMatrixError`, in matrix words; a caller that

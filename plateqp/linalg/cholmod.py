@@ -36,6 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SingularMatrixError
+from . import heap
 from .seam import _Direct, _seam, _stype
 from .seam import view as _view
 
@@ -248,6 +249,8 @@ class Cholesky:
         positive definite (``column``: where it stopped, in the factor's order)."""
         if self.sym is None:
             self.analyse(A)
+        if self.F is None and A.nnz >= heap.RELEASE_FROM:  # the factor is allocated now: the heap's
+            heap.release()  # freed memory goes back to the system first (plateqp.linalg.heap)
         if self.direct is not None:
             self.direct.factor(A)
             self.F = self.sym

@@ -256,6 +256,8 @@ class _Direct:
                     raise SingularMatrixError("CHOLMOD's solve failed (out of memory?)")
                 owned.append(ctypes.c_void_p(out))
                 cur = out
+                if len(owned) > 1:  # the system before is read: freed now, not held beside this one
+                    self.s.c.cholmod_l_free_dense(ctypes.byref(owned.pop(0)), self.cm)
             D = _Dense.from_address(owned[-1].value)
             x = np.frombuffer((ctypes.c_double * (n * k)).from_address(D.x), dtype=np.float64).copy()
         finally:

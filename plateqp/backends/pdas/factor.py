@@ -4,6 +4,7 @@ correction on the factor in hand; see the package docstring, "The method")."""
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import time
 
@@ -13,6 +14,7 @@ import scipy.sparse as sp
 
 from ...errors import ProblemError, SingularMatrixError, SolverError
 from ...linalg import Cholesky, Factor, bindings
+from ...linalg.pattern import SCALE_BLOCK
 from .options import DOWNDATE_LOSS, LOWRANK_COND, LOWRANK_COST, LOWRANK_MAX
 
 __all__ = ["SpringFactor", "TrailingFactor"]
@@ -66,6 +68,7 @@ class SpringFactor:
         ib = B.indptr[pr] + within % L[pr]
         pair_r, pair_c = B.indices[ia], B.indices[ib]
         pair_val = B.data[ia] * B.data[ib]
+        self._touched = None  # the triangle's entries the rows add to, and each product's (_in_place)
         self.pattern_nnz = Ks.nnz  # entries of K + BᵀB's pattern (K's own, stored zeros too, where B lies in it)
         if self.chol is None or not self._triangle(Ks, Kd, sigma, pr, pair_r, pair_c, pair_val):
             self._whole(Ks, Kd, sigma, pr, pair_r, pair_c, pair_val)
@@ -102,7 +105,8 @@ class SpringFactor:
     def twin(self) -> SpringFactor:
         """A second factor of the same ``H(w)`` family (the sparse method's factor of ``K``
         alone beside its active-set one): the pattern, its equilibration and the rows'
-        positions are shared (read only), not built again; the factor is its own."""
+        positions are shared, not built again (each refactorisation writes its rows into the
+        shared triangle and restores it: :meth:`_in_place`); the factor is its own."""
         other = copy.copy(self)
         other.chol = Cholesky(self._lib) if self._lib else None
         other._fresh()
@@ -110,37 +114,53 @@ class SpringFactor:
 
     def _triangle(self, Ks, Kd, sigma, pr, pair_r, pair_c, pair_val) -> bool:
         """CHOLMOD's triangle of ``K + σ diag(K)`` equilibrated, and where each product of a
-        row's entries adds in it, built on that triangle alone (0.06 s → 0.02 s at 128²);
-        False where ``B``'s pattern does not lie in ``K``'s or the diagonal is not all stored
-        (then :meth:`_whole`)."""
+        row's entries adds in it, built on that triangle alone; False where ``B``'s pattern
+        does not lie in ``K``'s or the diagonal is not all stored (then :meth:`_whole`). One
+        mask over ``K``'s entries, no list of their positions (each array of the size of
+        ``K`` is paid for in time as well as memory: its pages are new)."""
         n = Ks.shape[0]
         counts = np.diff(Ks.indptr)
+        if np.any(counts == 0):
+            return False
         cols = np.repeat(np.arange(n, dtype=Ks.indices.dtype), counts)
         upper = self.chol.upper
-        low = np.flatnonzero(Ks.indices <= cols if upper else Ks.indices >= cols)
-        li, lc = Ks.indices[low], cols[low]
+        # sorted columns: the triangle's part of each ends (starts) at its diagonal
+        on_diag = np.flatnonzero(Ks.indices == cols)
+        if (on_diag.size != n or np.any(on_diag < Ks.indptr[:-1]) or np.any(on_diag >= Ks.indptr[1:])
+                or not Ks.has_sorted_indices):
+            return False  # a column without its diagonal stored (or with it twice)
+        inside_k = Ks.indices <= cols if upper else Ks.indices >= cols
         del cols
-        lcount = np.bincount(lc, minlength=n)
+        li = Ks.indices[inside_k]
+        lcount = on_diag - Ks.indptr[:-1] + 1 if upper else Ks.indptr[1:] - on_diag
         indptr = np.concatenate([[0], np.cumsum(lcount)])
-        diag = indptr[1:] - 1 if upper else indptr[:-1]  # sorted: the diagonal ends (starts) each column
-        if np.any(lcount == 0) or np.any(li[diag] != np.arange(n)):
-            return False
+        diag = indptr[1:] - 1 if upper else indptr[:-1]
         inside = pair_r <= pair_c if upper else pair_r >= pair_c  # each off-diagonal pair once
         if np.array_equal(pair_r, pair_c):  # one unknown a row (a bed, posts at nodes): all on the diagonal
             pos = diag[pair_r]
         else:
-            keys = lc.astype(np.int64) * n + li
+            keys = np.repeat(np.arange(n, dtype=np.int64), lcount) * n + li
             pk = pair_c[inside].astype(np.int64) * n + pair_r[inside]
             pos = np.minimum(np.searchsorted(keys, pk), keys.size - 1)
             if keys.size == 0 or not np.all(keys[pos] == pk):
                 return False
-        base = np.asarray(Ks.data[low], dtype=float)
+            del keys
+        base = np.asarray(Ks.data[inside_k], dtype=float)
+        del inside_k
         base[diag] += sigma * Kd
-        base *= self.s[li] * np.repeat(self.s, lcount)  # s_i s_j first: as in _whole, to the bit
+        # s_i s_j first, as in _whole (to the bit), a block of columns at a time (no arrays of
+        # the triangle's size for the scales)
+        step = max(1, int(n * SCALE_BLOCK // max(base.size, 1)))
+        for j0 in range(0, n, step):
+            j1 = min(n, j0 + step)
+            a, b = indptr[j0], indptr[j1]
+            scale = self.s.take(li[a:b])
+            scale *= np.repeat(self.s[j0:j1], lcount[j0:j1])
+            base[a:b] *= scale
         self.base, self.indices, self.indptr = base, li.astype(np.int64), indptr  # CHOLMOD's width
         self.pair_row, self.pair_pos = pr[inside], pos
         self.pair_val = pair_val[inside] * (self.s[pair_r[inside]] * self.s[pair_c[inside]])
-        self.nnz = low.size
+        self.nnz = base.size
         return True
 
     def _whole(self, Ks, Kd, sigma, pr, pair_r, pair_c, pair_val) -> None:
@@ -194,26 +214,46 @@ class SpringFactor:
         """``H(w)``: with CHOLMOD, one triangle of it, equilibrated; else the whole matrix."""
         data = self.base + np.bincount(self.pair_pos, weights=w[self.pair_row] * self.pair_val,
                                        minlength=self.nnz)
+        return self._on(data)
+
+    def _on(self, data: np.ndarray) -> sp.csc_matrix:
+        """The pattern with the values ``data``."""
         n = self.s.size
         H = sp.csc_matrix((n, n))  # the pattern's arrays set, not passed: SciPy would narrow them (a copy)
         H.data, H.indices, H.indptr = data, self.indices, self.indptr
         H.has_sorted_indices = True  # the pattern's columns were sorted when it was built: not checked again
         return H
 
+    @contextlib.contextmanager
+    def _in_place(self, w: np.ndarray):
+        """``H(w)`` on :attr:`base`'s own array for the length of the block (CHOLMOD reads it
+        there: no second array of the triangle's values), the entries the rows add to restored
+        after it. The same values, to the bit, as :meth:`_matrix`: each entry's products are
+        summed in the same order, then added once."""
+        if self._touched is None:
+            self._touched = np.unique(self.pair_pos, return_inverse=True)
+        at, which = self._touched
+        kept = self.base[at]
+        self.base[at] += np.bincount(which, weights=w[self.pair_row] * self.pair_val, minlength=at.size)
+        try:
+            yield self._on(self.base)
+        finally:
+            self.base[at] = kept
+
     def refactor(self, w: np.ndarray) -> None:
         t0 = time.perf_counter()
         if self.chol is not None:
-            H = self._matrix(w)
-            if self.chol.sym is None:
-                self.chol.analyse(H)
-                t1 = time.perf_counter()
-                self.stats["analyse_s"] += t1 - t0
-                t0 = t1
-            try:
-                self.chol.factor(H)
-            except SingularMatrixError as exn:
-                raise SolverError(f"pdas: the active-set matrix is not positive definite ({exn}); is P "
-                                  "positive semidefinite?") from exn
+            with self._in_place(w) as H:
+                if self.chol.sym is None:
+                    self.chol.analyse(H)
+                    t1 = time.perf_counter()
+                    self.stats["analyse_s"] += t1 - t0
+                    t0 = t1
+                try:
+                    self.chol.factor(H)
+                except SingularMatrixError as exn:
+                    raise SolverError(f"pdas: the active-set matrix is not positive definite ({exn}); is P "
+                                      "positive semidefinite?") from exn
         else:  # plateqp.linalg.Factor: its own choice of library, or SuperLU; analysis not re-used
             try:
                 self.fac = Factor(self._matrix(w), method="auto" if self.method == "linalg" else "superlu")
@@ -284,11 +324,16 @@ class SpringFactor:
             return False
         t0 = time.perf_counter()
         if new.size:
-            Znew = self._columns(self.B[new].T.toarray())
+            Znew = self._columns(self.B[new].T.toarray(order="F"))  # CHOLMOD's layout: not copied again
             for j, r in enumerate(new.tolist()):
                 self._zcols[r] = Znew[:, j]  # a view: the block stays one array
             self.stats["solves"] += 1
-        Z = np.column_stack([self._zcols[r] for r in changed.tolist()])
+        if new.size == k:  # every column is the new block's, in order: that block is Z
+            Z = Znew
+        else:  # the columns gathered into one array, which they then live in: no block kept beside it
+            Z = np.column_stack([self._zcols[r] for r in changed.tolist()])
+            for j, r in enumerate(changed.tolist()):
+                self._zcols[r] = Z[:, j]
         U = self.B[changed]
         C = Z.T @ Z if self.chol is not None else U @ Z  # U H(w₀)⁻¹ Uᵀ either way
         # Woodbury is not backward stable for a stiff row: U x comes out with an absolute error
@@ -330,7 +375,8 @@ class SpringFactor:
         block solve's time), since ``U H(w₀)⁻¹ Uᵀ = YᵀY`` and ``H(w)⁻¹ b = D Pᵀ L⁻ᵀ (y − Y C⁻¹
         Yᵀ y)`` with ``y = L⁻¹ P D b`` (:meth:`solve`). Else ``Z = H(w₀)⁻¹ Uᵀ``."""
         if self.chol is not None:
-            return self.chol.forward(self.s[:, None] * Ut)
+            Ut *= self.s[:, None]  # in place: the caller's array is made for this
+            return self.chol.forward(Ut)
         return self._solve(Ut)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
