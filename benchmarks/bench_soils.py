@@ -3,6 +3,7 @@
     python benchmarks/bench_soils.py                       # meshes 32, 64, 128 (half-space 16 … 128)
     python benchmarks/bench_soils.py --meshes 16 --hs-meshes 8 --repeats 1    # quick
     python benchmarks/bench_soils.py --hs-memory 512       # the half-space at 512²: peak memory, once
+    python benchmarks/bench_soils.py --meshes "" --hs-meshes 64,128    # the half-space rows alone
 
 The scene: a 1 × 1 plate (h = 0.02, E = 1e7, ν = 0.3) simply supported on its left and right
 edges, under q = 20 and P = 200 at (0.6, 0.55), on soil over its whole area whose gap falls away
@@ -74,8 +75,8 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--out", default=str(HERE / "results" / "soils.csv"))
     args = ap.parse_args(argv)
-    cases = [(s, int(n)) for n in args.meshes.split(",") for s in ("winkler", "pasternak")]
-    cases += [("halfspace", int(n)) for n in args.hs_meshes.split(",")]
+    cases = [(s, int(n)) for n in args.meshes.split(",") if n for s in ("winkler", "pasternak")]
+    cases += [("halfspace", int(n)) for n in args.hs_meshes.split(",") if n]
     rows = []
     with warnings.catch_warnings():  # imports and first-call costs out of the first case's clock
         warnings.simplefilter("ignore")

@@ -65,6 +65,11 @@ START_TOL = 1e-4
 START_PRODUCTS = 1000
 #: a rigid post's spring in the preconditioner's sparse soil: this many times its stiffest
 RIGID = 100.0
+#: the preconditioner's coarse plate resolves this many times the wavenumber where the plate's
+#: compliance falls below the soil's (:func:`coarse_cells`)
+COARSE_WAVES = 8.0
+#: the preconditioner's coarse plate has at least this many cells a side
+COARSE_MIN = 8
 
 
 class PressureProblem:
@@ -154,16 +159,73 @@ def soil_fit(model, data: Scaled) -> sp.csr_matrix:
 def preconditioner(model, data: Scaled):
     """v ↦ P⁻¹ v with P = B K⁻¹ Bᵀ + S̃⁻¹ (:func:`soil_fit`'s soil in place of the half-space):
     by Woodbury's identity P⁻¹ = S̃ − S̃ B (K + Bᵀ S̃ B)⁻¹ Bᵀ S̃, one sparse factorisation (the
-    plate on the fitted soil, definite even for a floating plate), no dense matrix."""
+    plate on the fitted soil, definite even for a floating plate), no dense matrix. The plate's
+    part B K⁻¹ Bᵀ matters only at the wavenumbers where the plate is more compliant than the soil
+    (:func:`coarse_cells`): where a coarser mesh resolves those, its plate takes the fine one's
+    place (:func:`two_level`: the same form, a solve of the coarse plate per step); else, or where
+    that mesh cannot be built, the fine plate itself."""
     S = soil_fit(model, data)
-    B = data.B.tocsr()
-    fac = Factor((data.K + B.T @ S @ B).tocsc())
+    cells = coarse_cells(model)
+    if cells is not None:
+        apply = two_level(model, data, cells, S)
+        if apply is not None:
+            return apply
+    return _woodbury(S, data.B.tocsr(), data.K)
+
+
+def _woodbury(S: sp.csr_matrix, B: sp.csr_matrix, K: sp.spmatrix):
+    """v ↦ S v − S B (K + Bᵀ S B)⁻¹ Bᵀ S v (B: the rows' deflections from K's unknowns)."""
+    fac = Factor((K + B.T @ S @ B).tocsc())
     BT = B.T.tocsr()
 
     def apply(v: np.ndarray) -> np.ndarray:
         y = S @ v
         return y - S @ (B @ fac.solve(BT @ y, refine=0))
     return apply
+
+
+def coarse_cells(model) -> tuple[int, int] | None:
+    """The coarsest mesh of :func:`two_level` (the scene's cells halved k ≥ 1 times, at least
+    :data:`COARSE_MIN` a side) whose cells are at most π / (:data:`COARSE_WAVES` ξ*) wide, ξ* =
+    (a / D)^(1/3) the wavenumber where the plate's compliance 1 / (D ξ⁴) equals the fitted soil's
+    1 / (a ξ) (a = E / (1 − ν²) / 2, :func:`soil_fit`); None where not even one halving is."""
+    from ..model.generators import mesh_cells
+
+    nx, ny = mesh_cells(model.scene)
+    fnd, p = model.scene.foundation, model.scene.plate
+    width = np.pi / (COARSE_WAVES * (fnd.E / (1.0 - fnd.nu**2) / 2.0 / p.D) ** (1.0 / 3.0))
+    best = None
+    f = 2
+    while min(nx, ny) // f >= COARSE_MIN and p.a / (nx // f) <= width and p.b / (ny // f) <= width:
+        best, f = (nx // f, ny // f), 2 * f
+    return best
+
+
+def two_level(model, data: Scaled, cells: tuple[int, int], S: sp.csr_matrix):
+    """:func:`_woodbury`'s form with the plate of the mesh of ``cells`` in place of the fine one:
+    v ↦ S̃ v − S̃ Π (K̃_c + Πᵀ S̃ Π)⁻¹ Πᵀ S̃ v, Π the coarse plate's deflections at the fine rows'
+    points (its element's interpolation, in the scaled dofs of :class:`Scaled`), K̃_c its scaled
+    stiffness; symmetric positive definite as the fine form is (Πᵀ S̃ Π is the fine soil seen by
+    the coarse plate). None where that plate cannot be built, or Π does not reach every row."""
+    from ..errors import SingularMatrixError
+    from ..estimate import COARSE_FAILURES, with_mesh
+    from ..model.assembly import build_model
+
+    p = model.scene.plate
+    L = max(p.a, p.b)
+    xy = model.contacts.xy
+    try:
+        scene = with_mesh(model.scene, *cells)
+        scene.foundation = None  # only its plate: K and the interpolation
+        coarse = build_model(scene)
+        per = 1.0 / L ** coarse.dof_orders  # the scaled dofs per unit of the user's (W cancels)
+        Pi = (coarse.interpolation(xy[:, 0], xy[:, 1])[:, coarse.free] @ sp.diags(per)).tocsr()
+        K = sp.diags(per) @ sp.csr_matrix(coarse.K) @ sp.diags(per) * (L**2 / p.D)
+        if np.any(np.diff(Pi.indptr) == 0):
+            return None
+        return _woodbury(S, Pi, K)
+    except (*COARSE_FAILURES, SingularMatrixError):
+        return None
 
 
 def coarse_start(model, accuracy) -> np.ndarray | None:
