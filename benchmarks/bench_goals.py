@@ -22,8 +22,8 @@ from 256²), at the first step of 1, 2, 5 × 10ᵏ at or above three times that 
   value after the first ÷ raw. Goal ≤ 0.3 at 128², every value OPTIMAL.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_goals.py            # the full table (~10 min)
-    python benchmarks/bench_goals.py --meshes 16 --big "" --disc-sizes 8 --memory-meshes "" \\
-        --sweep-mesh 16 --values 3 --repeat 1                          # a smoke run
+    python benchmarks/bench_goals.py --meshes 32 --big "" --disc-sizes 8 --memory-meshes "" \\
+        --memory-disc "" --sweep-mesh 32 --values 3 --repeat 1         # a smoke run
 
 Writes benchmarks/results/goals.csv and prints a Markdown table.
 """
@@ -201,7 +201,8 @@ def main(argv=None) -> int:
     ap.add_argument("--disc-sizes", default="32,128", help="DKT disc sizes R/n")
     ap.add_argument("--memory-meshes", default="256", help="grid and bed meshes of the memory rows")
     ap.add_argument("--memory-disc", default="128", help="disc sizes of the memory rows")
-    ap.add_argument("--sweep-mesh", type=int, default=128)
+    ap.add_argument("--sweep-mesh", type=lambda v: int(v) if v.strip() else 0, default=128,
+                    help="mesh of the sweep rows (empty or 0: none)")
     ap.add_argument("--values", type=int, default=11)
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--timeout", type=float, default=900.0, help="wall limit of each memory run (s)")
