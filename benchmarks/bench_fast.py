@@ -84,6 +84,7 @@ HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 from bench_contact import run_in_subprocess
 from bench_scaling import _status_kb  # (VmRSS, VmHWM) from /proc/self/status
+from timing import cpu, forked  # noqa: F401  (other scripts import them from here)
 
 KKT_KEYS = ("stationarity", "spring", "primal", "dual", "complementarity", "natural")
 OTHERS = ("clarabel", "qpsolvers:piqp", "qpsolvers:proxqp", "qpsolvers:scs", "osqp")
@@ -145,47 +146,6 @@ def whole_solve(scene, accuracy=ACCURACY):
         return pq.solve(scene, accuracy=accuracy)
 
 
-def cpu(fn):
-    t0 = time.process_time()
-    out = fn()
-    return time.process_time() - t0, out
-
-
-def _in_child(conn, fn) -> None:
-    try:
-        conn.send(fn())
-    except BaseException as exn:  # sent back and raised in the parent, not lost
-        conn.send(RuntimeError(f"{type(exn).__name__}: {exn}"))
-    finally:
-        conn.close()
-
-
-def forked(fn):
-    """``fn()`` (returning something small to pickle) in a child forked from this process, where
-    fork exists (Linux): every route then starts from the same heap and the same imports, so
-    the order the routes run in does not move their times. Run one after another in one
-    process, the same route (auto's choice and pdas/primal) took 1.0-1.8 s at 256² with 9
-    posts depending on which route freed its memory before it (the primal formulation's
-    copies of K paid their pages again). Elsewhere ``fn()`` runs here."""
-    import multiprocessing
-
-    if "fork" not in multiprocessing.get_all_start_methods():
-        return fn()
-    ctx = multiprocessing.get_context("fork")
-    parent, child = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_in_child, args=(child, fn))
-    proc.start()
-    child.close()
-    try:
-        out = parent.recv()
-    except EOFError:
-        out = RuntimeError(f"the child ended without an answer (exit code {proc.exitcode})")
-    proc.join()
-    if isinstance(out, BaseException):
-        raise out
-    return out
-
-
 def goal_row(kind: str, n: int, repeat: int) -> dict:
     """Medians of interleaved CPU times: raw CHOLMOD, plateqp's two-sided Factor, pq.solve."""
     scene = make_scene(kind, n)
@@ -229,8 +189,6 @@ def goal_row(kind: str, n: int, repeat: int) -> dict:
 
 
 # ----------------------------------------------------------------------------- memory, in a fresh interpreter
-
-
 
 
 def _reset_peak() -> bool:
