@@ -64,8 +64,8 @@ def test_a_product_on_a_whole_bed_takes_four_ffts(monkeypatch):
 
         def counted(a, *args, _real=real, _name=name, **kw):
             b = np.asarray(a)
-            if b.ndim >= 2:  # each plane of a grid transformed along one axis (a line alone: not counted)
-                calls.append(int(np.prod(b.shape[:-2])))
+            if b.ndim >= 3:  # (columns, [quarters,] rows, cols): each plane transformed along one axis
+                calls.append(int(np.prod(b.shape[1:-2])))  # (a line, (columns, n): not counted)
             return _real(a, *args, **kw)
         monkeypatch.setattr(scipy.fft, name, counted)
     op @ x
