@@ -28,7 +28,8 @@ a node not in ``nodes``: a node whose deflection is prescribed presses no soil),
     (k_{ab} \star Y)_{n - (a, b)},
 
 four discrete convolutions summed, and four correlations (⋆) of the nodes' values Y: ten real FFTs
-of a grid padded to at least 2 ny × 2 nx per product (the DC-FFT of Liu, Wang & Liu 2000), the
+of a grid padded to at least 2 ny × 2 nx per product (the DC-FFT of Liu, Wang & Liu 2000; four
+where the bed is every cell of the grid, :class:`_WholeBed`), the
 kernels' transforms computed once. The kernels are Boussinesq's integral exact over each quarter
 (:func:`plateqp.model.halfspace.polygon_potential`, the dense route's own formula).
 
