@@ -21,8 +21,9 @@ the convex QP of the source paper's condensed route, here in the forces:
 
 whose gradient is the gap and whose equality multipliers are α. Its matrix is never formed:
 one product costs a solve with the plate's one factorisation and the soil's FFT. It is solved
-by MPRGP inside SMALBE (:mod:`plateqp.backends.mprgp`), and the answer is checked as every other
-is (:func:`plateqp.contact.kkt.kkt_report`: the plate's stationarity with K itself, the soil's
+by an active-set PCG (:mod:`plateqp.backends.active_pcg`; :func:`solve_pressures` says how it is
+started and preconditioned), with MPRGP inside SMALBE (:mod:`plateqp.backends.mprgp`) from its
+answer where it does not settle, and the answer is checked as every other is (:func:`plateqp.contact.kkt.kkt_report`: the plate's stationarity with K itself, the soil's
 law with the operator, the gaps and complementarity row by row).
 
 The bonded comparison (:func:`solve_bilateral`) is the same problem without the bound.
