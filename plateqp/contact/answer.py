@@ -37,8 +37,9 @@ def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, ba
         v[model.contacts.source == "bed"] = u[model.n_free:]
         s, w = s + v, w + v
     gaps = model.contacts.g0 + s - w
-    stat = model.K @ u - model.f + model.contacts.B.T @ R
-    res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(model.contacts.B.T @ R), 1e-300))
+    BtR = model.contacts.B.T @ R
+    stat = model.K @ u - model.f + BtR
+    res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(BtR), 1e-300))
     # in contact: the reaction carries load, or the support touches (gap ≈ 0), both judged at
     # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports).
     # The gap is judged at each support's own deflection scale (the load's, its own initial gap, its
