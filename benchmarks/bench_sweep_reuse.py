@@ -14,7 +14,7 @@ of one value; a serial sweep of ``--values`` values (reuse on, warm starts on: t
 Per value after the first = (sweep of V values − sweep of one) / (V − 1). Every row of every
 sweep must be OPTIMAL (its KKT check passed at ``ACCURACY``); the rows carry the route and
 the worst KKT residual over the values (the factorisations per value are counted by the tests
-tests/studies/test_sweep_halves.py, test_sweep_one_half.py and test_sweep_bed_springs.py, not
+tests/studies/test_sweep_halves.py and test_sweep_bed_springs.py, not
 here).
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_sweep_reuse.py [--meshes 64,128] [--repeats 5]

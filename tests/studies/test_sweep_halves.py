@@ -1,10 +1,11 @@
 """A sweep on the condensed method's kept factor (posts: pdas with the contact dofs last) pays, per
-value after the first, at most two triangular halves of K's factor: one for the deflection of
-the value's active set and one for its refinement step. A gap or spring sweep's load is the one
-the factor solved before; a sweep of one load's magnitude scales its first half instead of
-solving it again; a refinement step whose stationarity residual is already rounding corrects
-the reactions alone (half a solve, not two halves). Every value is the cold solve's, to
-rounding, and passes the KKT check."""
+value after the first, at most two triangular halves of K's factor, and usually one: the value's
+reactions are refined on the trailing unknowns alone (B u needs only them: a dense triangular
+solve of the trailing block), so that the one backward half that gives the deflection is the
+last. A gap or spring sweep's load is the one the factor solved before; a sweep of one load's
+magnitude scales its first half instead of solving it again; a refinement step whose
+stationarity residual is already rounding corrects the reactions alone (half a solve, not two
+halves). Every value is the cold solve's, to rounding, and passes the KKT check."""
 
 from __future__ import annotations
 
@@ -76,6 +77,30 @@ def test_two_halves_per_value_after_the_first(case, halves):
     assert all(r["status"] == "optimal" for r in res.rows)
     per_value = (halves["n"] - before) / (len(values) - first)
     assert per_value <= 2.0, f"{per_value} halves of K's factor per value after the first"
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_one_half_per_value_after_the_first(case, halves):
+    """A gap or spring sweep from the second value on, a load sweep from the third (its loads
+    span a plane, known once two are solved): one half per value, and each value the cold
+    solve's."""
+    make, path, values = CASES[case]
+    scene = make()
+    first = 2 if case == "load" else 1
+    run(scene, path, values[:first])
+    before = halves["n"]
+    halves["n"] = 0
+    res = run(scene, path, values)
+    assert all(r["status"] == "optimal" for r in res.rows)
+    per_value = (halves["n"] - before) / (len(values) - first)
+    assert per_value <= 1.0, f"{per_value} halves of K's factor per value after the first"
+    for v, row in zip(values, res.rows):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", pq.PlateQPWarning)
+            cold = pq.solve(set_param(scene, path, v), backend="pdas", accuracy=ACC)
+        R, Rc = np.array(row["reactions"]), cold.reactions
+        assert np.abs(R - Rc).max() <= 1e-9 * np.abs(Rc).max(), f"{path} = {v}: reactions off the cold solve's"
+        assert row["active"] == [bool(a) for a in cold.active]
 
 
 @pytest.mark.parametrize("case", list(CASES))
