@@ -28,7 +28,7 @@ from ..model.assembly import Model, build_model
 from ..errors import NoEquilibriumError, PlateQPWarning, ProblemError, SolverError
 from ..estimate import COARSE_FAILURES, with_mesh
 from ..model.generators import mesh_cells
-from ..linalg import Factor, SingularMatrixError, pattern, row_stiffness
+from ..linalg import SingularMatrixError, row_stiffness
 from .formulations import formulate
 from .scaling import Scaled
 from .statics import NO_EQUILIBRIUM, settle, supports_reach
@@ -196,38 +196,23 @@ def spring_deflections(coarse: Model) -> np.ndarray | None:
     c = coarse.contacts
     if coarse.n_soil or c is None or not np.all(c.rho > 0):
         return None
+    from ..backends.pdas.factor import SpringFactor
+
     B, g, k = c.B.tocsr(), c.g0, 1.0 / c.rho
+    K = sp.csc_matrix(coarse.K)
+    Kd = K.diagonal()
+    if not np.all(Kd > 0):
+        return None
     Bt = B.T.tocsr()
-    # Bᵀ diag(k_A) B from its terms k_i B_ij B_il, one per pair of entries of each row, summed
-    # with K on one stored pattern whatever the set (the union of theirs: pattern.add keeps
-    # zeros), so that the analysis of the first set serves every step; each step only sums
-    # values into that pattern's places
-    per_row = np.diff(B.indptr)
-    entry_row = np.repeat(np.arange(c.m), per_row)
-    times = per_row[entry_row]
-    first = np.repeat(np.arange(B.nnz), times)
-    second = B.indptr[entry_row[first]] + np.arange(first.size) - np.repeat(np.cumsum(times) - times, times)
-    term, term_row = B.data[first] * B.data[second], entry_row[first]
-    rows, cols = B.indices[first], B.indices[second]
-    K = sp.coo_matrix(coarse.K)
-    H = pattern.add(K, sp.coo_matrix((np.ones(term.size), (rows, cols)), shape=K.shape))
-    n = H.shape[0]
-    key = np.repeat(np.arange(n, dtype=np.int64), np.diff(H.indptr)) * n + H.indices  # sorted: CSC, rows sorted
-    at_K = np.searchsorted(key, K.col.astype(np.int64) * n + K.row)
-    at_term = np.searchsorted(key, cols.astype(np.int64) * n + rows)
-    K_values = np.bincount(at_K, weights=K.data, minlength=H.nnz)
+    # K + Bᵀ diag(k_A) B on one analysis whatever the set (a few changed rows by Woodbury)
+    F = SpringFactor(K, B, Kd, k, 0.0, "auto")
     A = np.ones(c.m, dtype=bool)
-    F = None
     for _ in range(NEWTON_STEPS):
         kA = np.where(A, k, 0.0)
-        H.data = K_values + np.bincount(at_term, weights=term * kA[term_row], minlength=H.nnz)
         try:
-            if F is None:
-                F = Factor(H)
-            else:
-                F.refactor(H)
-            u = F.solve(coarse.f + Bt @ (kA * g), refine=0)
-        except SingularMatrixError:
+            F.set(kA)
+            u = F.solve(coarse.f + Bt @ (kA * g))
+        except (SolverError, SingularMatrixError):
             return None
         pressed = B @ u > g
         if np.array_equal(pressed, A):
