@@ -1,4 +1,4 @@
-"""Extremes (issue 5, item 4): every installed backend × formulation on scenes at the edges of
+"""Extremes: every installed backend × formulation on scenes at the edges of
 the parameter space, each against a reference that does not come from the solver under test.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_extremes.py                  # everything

@@ -1,4 +1,4 @@
-"""The exact contact solve against one raw sparse Cholesky of the same plate (issue 11).
+"""The exact contact solve against one raw sparse Cholesky of the same plate.
 
 The floor ("raw") is one CHOLMOD symbolic analysis + numeric factorisation + solve of the
 plate's matrix, written directly against cvxopt's bindings (``cvxopt.cholmod``, the CHOLMOD
@@ -294,7 +294,7 @@ def flops_row(n: int, repeat: int) -> dict:
 def residual_row(kind: str, n: int, repeat: int) -> dict:
     """The residual ``f − K u`` that ``Factor.solve``'s refinement reads, three ways, on the
     floor's matrix and a raw solve's ``u``: in double (the floor: one SciPy product); in long
-    double (what refinement read until issue 11's thirteenth session: the values widened once,
+    double (what refinement read in earlier versions: the values widened once,
     then a long-double product); and by ``plateqp.linalg.residual.Residual`` (the split of K,
     then three double products). CPU ms, medians of ``repeat`` interleaved; "first" includes
     the one-time widening or split, "again" is a further residual with it."""

@@ -1,4 +1,4 @@
-"""A floating slab on a few posts (issue 11, "`auto` never the slow choice"): pdas on the primal
+"""A floating slab on a few posts: pdas on the primal
 QP against BPP on the condensed LCP, and what ``backend="auto"`` picks, for single solves.
 
 Scenes: :func:`plateqp.scenes.families.floating` ``(n, k)``, the slab held only by a k × k grid of rigid

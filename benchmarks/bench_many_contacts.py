@@ -1,4 +1,4 @@
-"""Many contacts (issue 11, "no cliff"): pdas against the external backends from 9 posts to a
+"""Many contacts: pdas against the external backends from 9 posts to a
 post on every interior node, and on the tensionless bed.
 
 Scenes (:mod:`plateqp.scenes.families`, kN and m): ``grid_rigid(n, k)``, the slab on four walls and a

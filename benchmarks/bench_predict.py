@@ -1,4 +1,4 @@
-"""A coarse mesh's contact set as the first set of the fine solve (issue 11): the built-in
+"""A coarse mesh's contact set as the first set of the fine solve: the built-in
 prediction of ``pq.solve`` (``plateqp.contact.predict``; option ``predict``) against a cold start.
 
 Each scene at ``n × n`` cells is solved three ways, each in a child forked from this process

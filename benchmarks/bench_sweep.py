@@ -1,4 +1,4 @@
-"""Sweeps: re-use of the model (issue 4) and warm starts (issue 6, item 3).
+"""Sweeps: re-use of the model and warm starts.
 
 Scene: the paper's fig. 5 set-up at scale, a 32 × 32 ACM plate (400 × 400, h = 20, kgf and cm)
 on 8 × 8 = 64 elastic supports (three heaved by 0.02), a point load and self-weight; the
