@@ -14,6 +14,7 @@ import scipy.fft
 import plateqp as pq
 from plateqp.model.assembly import build_model
 from plateqp.model.soil import halfspace_flexibility
+from test_halfspace_grid import operator_of  # the model's own operator for its bed
 
 E_SOIL, NU_SOIL = 3e7, 0.3
 
@@ -33,11 +34,6 @@ CASES = [
     ("clamped-bottom-pin", lambda: scene(2.0, 1.0, 10, 5, edges={"bottom": pq.Edge("clamped")},
                                           pins=[pq.Pin(1.0, 0.6)])),
 ]
-
-
-def operator_of(model):
-    fnd = model.scene.foundation
-    return model.grid.halfspace_flexibility_operator(fnd.region, fnd.E, fnd.nu, model.soil_nodes)
 
 
 @pytest.mark.parametrize("make", [c[1] for c in CASES], ids=[c[0] for c in CASES])
