@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..accuracy import NO_WORK, Accuracy, Status
+from ..linalg.products import times
 from ..model.assembly import Model
 from ..results import Result
 from .formulations import ContactSolution
@@ -38,7 +39,12 @@ def to_result(model: Model, data: Scaled, c: ContactSolution, status: Status, ba
         s, w = s + v, w + v
     gaps = model.contacts.g0 + s - w
     BtR = model.contacts.B.T @ R
-    stat = model.K @ u - model.f + BtR
+    if u_s is c.u and data.K_src is model.K and data.compliance is None:
+        # K u − f + Bᵀ R = (F0 W / S) (K̃ ũ − f̃ + B̃ᵀ R̃) (Scaled: K̃ = S K S / (F0 W)): the scaled
+        # product the KKT report made on this ũ (plateqp.linalg.products), not a second one
+        stat = (data.F0 * data.W / data.dof_scale) * (times(data.K, u_s) - data.f + data.B.T @ c.R)
+    else:
+        stat = model.K @ u - model.f + BtR
     res = float(np.linalg.norm(stat) / max(np.linalg.norm(model.f), np.linalg.norm(BtR), 1e-300))
     # in contact: the reaction carries load, or the support touches (gap ≈ 0), both judged at
     # the tolerance of the asked accuracy (an iterative solver leaves R ~ tol · max R on open supports).

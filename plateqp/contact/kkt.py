@@ -59,6 +59,7 @@ from ..accuracy import NO_WORK, PRESET_TOL, Accuracy
 from ..errors import MechanismError
 from ..linalg import row_stiffness, solve_saddle
 from ..linalg.pattern import abs_matvec
+from ..linalg.products import remembered, times
 from ..results import KKTReport
 from .formulations import ContactSolution
 from .scaling import Scaled
@@ -75,7 +76,7 @@ def kkt_report(data: Scaled, c: ContactSolution, accuracy: str | float | Accurac
         return KKTReport(inf, inf, inf, inf, inf, inf, Accuracy.parse(accuracy).tol, 1.0)
     tol = Accuracy.parse(accuracy).tol
     BtR = data.B.T @ R
-    r = data.K @ u - data.f + BtR
+    r = times(data.K, u) - data.f + BtR
     kb = plate_stiffness(data)
     k = kb / (1.0 + data.rho * kb)  # local_stiffness
     force = max(np.linalg.norm(data.f), np.linalg.norm(BtR))
@@ -131,14 +132,14 @@ def abs_K_times(data: Scaled, x: np.ndarray) -> np.ndarray:
     for the solves of the same K (its values only; K's index arrays shared)."""
     memo = data.memo
     if memo is None:
-        return abs_matvec(data.K, x)
+        return remembered(data.K, x, "abs", lambda: abs_matvec(data.K, x))
     kept = memo.get("abs_K")
     if kept is None or kept[0] is not data.K:
         K = data.K
         end = K.indptr[-1]
         kept = memo["abs_K"] = (K, sp.csc_matrix((np.abs(K.data[:end]), K.indices[:end], K.indptr), shape=K.shape,
                                                  copy=False))
-    return kept[1] @ x
+    return remembered(data.K, x, "abs", lambda: kept[1] @ x)
 
 
 def deflection_scale(data: Scaled, u: np.ndarray, w: np.ndarray | None = None) -> float:

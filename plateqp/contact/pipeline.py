@@ -20,6 +20,7 @@ from ..backends.base import RawSolution
 from ..errors import MechanismError, NoEquilibriumError, PlateQPWarning, ProblemError, SolverError
 from ..linalg import solve_saddle
 from ..linalg.keep import keeping, shared
+from ..linalg.products import remembering
 from ..results import Result
 from .answer import to_result
 from .formulations import ContactSolution, Formulation, formulate
@@ -177,10 +178,11 @@ class _Step:
         corrected where the formulation's own data explain a failing answer). ``depth``: the
         stack level of the user's call, for the warning."""
         b = get_backend(backend)
-        raw, t_predict, predicted, solve_s, t1 = self._first(form, b, backend, options)
-        res = finish(self.model, form, raw, self.acc, backend)
-        form, raw, res, corrections, iterations, failed, more = _corrections(
-            self.model, form, raw, res, b, backend, options, self.acc)
+        with remembering():  # K u on the final u: read by the backend, the KKT report and the Result
+            raw, t_predict, predicted, solve_s, t1 = self._first(form, b, backend, options)
+            res = finish(self.model, form, raw, self.acc, backend)
+            form, raw, res, corrections, iterations, failed, more = _corrections(
+                self.model, form, raw, res, b, backend, options, self.acc)
         solve_s += more
         if res.status != Status.OPTIMAL:
             why = ""

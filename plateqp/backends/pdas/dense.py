@@ -24,6 +24,7 @@ import scipy.linalg as sla
 
 from ...errors import SingularMatrixError
 from ...linalg import SchurFactor, bindings
+from ...linalg.products import times
 from ..base import Status
 from .options import (
     INNER_EXACT,
@@ -168,7 +169,7 @@ class DenseDual:
         tiny = np.finfo(float).tiny
         for k in range(INNER_EXACT):
             BtL = BA.T @ lam[idx]
-            r_u = pb.f - pb.K @ u - BtL
+            r_u = pb.f - times(pb.K, u) - BtL
             r_A = BA @ u - pb.g[idx] - pb.rho[idx] * lam[idx]
             delta = max(np.abs(pb.B @ u).max(initial=0.0), np.abs(pb.g).max(initial=0.0), tiny)
             res = max(np.abs(r_u).max() / max(np.abs(pb.f).max(), np.abs(BtL).max(initial=0.0), tiny),

@@ -11,6 +11,7 @@ import numpy as np
 
 from ...errors import ProblemError, SolverError
 from ...linalg.keep import kept, remember
+from ...linalg.products import times
 from ..base import QP, RawSolution, Status, preset
 from .dense import DenseDual, NotApplicable, anchored_set, run_dense
 from .factor import TrailingFactor
@@ -396,6 +397,7 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
     if status is Status.OPTIMAL and max(nat, st) > tol["accept_tol"]:
         status = Status.INACCURATE
     x = pb.x(out.u, lam)
-    obj = float(0.5 * x @ (pb.P @ x) + pb.q @ x)
+    # xᵀ P x = uᵀ K u + Σ p_j x_j² over the separable variables (each alone in its column of P)
+    obj = float(0.5 * (out.u @ times(pb.K, out.u) + pb.sep_p @ x[pb.sep] ** 2) + pb.q @ x)
     return RawSolution(status=status, x=x, z=lam, obj=obj, iterations=out.it,
                        solve_time=time.perf_counter() - t0, solver_status=out.message, extras=extras)

@@ -13,6 +13,7 @@ from ...accuracy import NO_WORK
 from ...errors import SolverError
 from ...linalg import row_stiffness
 from ...linalg.pattern import abs_matvec, leading
+from ...linalg.products import remembered, times
 from ..base import QP
 
 #: The QP's null-space hint is taken where K annihilates it to this fraction of |K||N| (a plate's
@@ -155,8 +156,8 @@ class ReducedQP:
         or where this problem was read again for another solve (:meth:`again`: a sweep) with
         ``|K|`` kept (its values only; K's index arrays shared)."""
         if self._abs_K is None:
-            return abs_matvec(self.K, x)
-        return self._abs_K @ x
+            return remembered(self.K, x, "abs", lambda: abs_matvec(self.K, x))
+        return remembered(self.K, x, "abs", lambda: self._abs_K @ x)
 
     def again(self, qp: QP, max_rows: int | None) -> ReducedQP | None:
         """This problem for ``qp`` where only its loads and gaps (``q``, ``h``) and the values of
@@ -318,5 +319,5 @@ def natural_residuals(pb: ReducedQP, u: np.ndarray, lam: np.ndarray, tol: float 
     nat = float(np.abs(np.minimum(lam, pb.c * gap)).max(initial=0.0) / force_scale(pb, lam, tol))
     BtL = pb.B.T @ lam
     force, heave = max(np.linalg.norm(pb.f), np.linalg.norm(BtL)), heave_force(pb)
-    st = float(np.linalg.norm(pb.K @ u - pb.f + BtL) / max(heave if force <= NO_WORK * heave else force, 1e-300))
+    st = float(np.linalg.norm(times(pb.K, u) - pb.f + BtL) / max(heave if force <= NO_WORK * heave else force, 1e-300))
     return nat, st
