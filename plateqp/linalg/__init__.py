@@ -19,6 +19,8 @@
                        read in place; cvxopt's binding where it does not load)
 :mod:`heap`            the C heap's freed memory returned to the system before a factor
                        is allocated (glibc's ``malloc_trim``)
+:mod:`products`        ``K x`` remembered inside one solve (the final ``u``'s product read
+                       by the backend, the KKT report and the Result is computed once)
 =====================  ===========================================================
 
 Errors are :class:`~plateqp.errors.SingularMatrixError`, in matrix words; a caller that
