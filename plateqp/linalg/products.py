@@ -10,9 +10,9 @@ A matrix is the same when its three stored arrays (values, indices, pointers) li
 memory, alive (SciPy's constructors hand a matrix made from another views of its arrays, not
 the same objects); a vector when its values are equal (compared, not hashed: a vector changed
 in place is a new vector). The products handed out are read-only, so that no caller can change
-what another reads. What is remembered holds weak references to the arrays it was computed
-from: while one of them is alive its memory cannot be another matrix's; it is dropped when the
-scope ends.
+what another reads. What is remembered holds weak references to the arrays that own the memory
+it was computed from (a view's base): while they are alive that memory cannot be another
+matrix's; it is dropped when the scope ends.
 """
 
 from __future__ import annotations
@@ -45,6 +45,13 @@ def _arrays(K) -> tuple:
     return K.data, K.indices, K.indptr
 
 
+def _owner(a: np.ndarray) -> np.ndarray:
+    """The array whose buffer ``a`` reads (``a`` itself, or the base of its views)."""
+    while isinstance(a.base, np.ndarray):
+        a = a.base
+    return a
+
+
 def _where(a: np.ndarray) -> tuple:
     """The memory an array reads: its first element's address, shape, strides and type."""
     return a.__array_interface__["data"][0], a.shape, a.strides, a.dtype.str
@@ -66,7 +73,7 @@ def remembered(K: sp.spmatrix, x: np.ndarray, kind: str, compute: Callable[[], n
             return y
     y = np.asarray(compute())
     y.flags.writeable = False
-    slots[key] = (tuple(weakref.ref(a) for a in arrays), np.array(x, copy=True), y)
+    slots[key] = (tuple(weakref.ref(_owner(a)) for a in arrays), np.array(x, copy=True), y)
     return y
 
 

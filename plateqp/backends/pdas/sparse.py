@@ -12,6 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ...linalg.products import times
 from .dense import first_set
 from .factor import SpringFactor
 from .motions import deflate, project, softest
@@ -76,7 +77,7 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     res = np.inf
     for k in range(n_max + 1):
         BtL = BA.T @ lamA
-        r_u = pb.f - pb.K @ u - BtL
+        r_u = pb.f - times(pb.K, u) - BtL
         r_A = BA @ u - gA - rhoA * lamA
         delta = max(np.abs(pb.B @ u).max(initial=0.0), gnorm, np.finfo(float).tiny)
         res = max(np.abs(r_u).max() / max(fnorm, np.abs(BtL).max(initial=0.0)),
