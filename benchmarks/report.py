@@ -293,7 +293,7 @@ def parts() -> dict[str, Part]:
         "goals", "bench_goals", "goals.csv", "goals.csv",
         ["--out", "OUT"],
         ["--meshes", "32", "--big", "", "--disc-sizes", "8", "--memory-meshes", "32", "--memory-disc", "8",
-         "--sweep-mesh", "32", "--values", "3", "--repeat", "1", "--out", "OUT"],
+         "--sweep-mesh", "32", "--values", "3", "--repeat", "1", "--memory-repeat", "1", "--out", "OUT"],
         goals_section, "Speed goals")
     p["work-precision"] = Part(
         "work-precision", "bench_work_precision", "work-precision.csv", "work_precision.csv",
