@@ -65,6 +65,7 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     the corrections leave them out, so the step is one of the (equally good) solutions."""
     idx = np.flatnonzero(A)
     BA = pb.B[idx]
+    absBA = abs(BA)
     WA, gA, rhoA = W[idx], pb.g[idx], pb.rho[idx]
     lamA = lam[idx].copy()
     u = u.copy()
@@ -79,7 +80,10 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
         BtL = BA.T @ lamA
         r_u = pb.f - times(pb.K, u) - BtL
         r_A = BA @ u - gA - rhoA * lamA
-        delta = max(np.abs(pb.B @ u).max(initial=0.0), gnorm, np.finfo(float).tiny)
+        # the rows' scale from the terms that make B u (|B_A||u|), not from B u itself: on a bed
+        # whose soil has unknowns, B u = w − v is rounding where the bed touches at zero gap
+        delta = max(np.abs(pb.B @ u).max(initial=0.0), (absBA @ np.abs(u)).max(initial=0.0), gnorm,
+                    np.finfo(float).tiny)
         res = max(np.abs(r_u).max() / max(fnorm, np.abs(BtL).max(initial=0.0)),
                   np.abs(r_A).max(initial=0.0) / delta)
         if res <= tol or k == n_max or (k >= 2 and res > 0.5 * best):
