@@ -130,16 +130,21 @@ def compressions(data: Scaled, R: np.ndarray) -> np.ndarray:
 def abs_K_times(data: Scaled, x: np.ndarray) -> np.ndarray:
     """``|K| x``: by blocks of K (no copy of it), or in a sweep (``data.memo``) with ``|K|`` kept
     for the solves of the same K (its values only; K's index arrays shared)."""
+    return remembered(data.K, x, "abs", lambda: _abs_K_product(data, x))
+
+
+def _abs_K_product(data: Scaled, x: np.ndarray) -> np.ndarray:
+    """The product :func:`abs_K_times` remembers."""
     memo = data.memo
     if memo is None:
-        return remembered(data.K, x, "abs", lambda: abs_matvec(data.K, x))
+        return abs_matvec(data.K, x)
     kept = memo.get("abs_K")
     if kept is None or kept[0] is not data.K:
         K = data.K
         end = K.indptr[-1]
         kept = memo["abs_K"] = (K, sp.csc_matrix((np.abs(K.data[:end]), K.indices[:end], K.indptr), shape=K.shape,
                                                  copy=False))
-    return remembered(data.K, x, "abs", lambda: kept[1] @ x)
+    return kept[1] @ x
 
 
 def deflection_scale(data: Scaled, u: np.ndarray, w: np.ndarray | None = None) -> float:

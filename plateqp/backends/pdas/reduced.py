@@ -155,9 +155,8 @@ class ReducedQP:
         """``|K| x``: by blocks of K (:func:`plateqp.linalg.pattern.abs_matvec`, no copy of K),
         or where this problem was read again for another solve (:meth:`again`: a sweep) with
         ``|K|`` kept (its values only; K's index arrays shared)."""
-        if self._abs_K is None:
-            return remembered(self.K, x, "abs", lambda: abs_matvec(self.K, x))
-        return remembered(self.K, x, "abs", lambda: self._abs_K @ x)
+        kept = self._abs_K
+        return remembered(self.K, x, "abs", lambda: abs_matvec(self.K, x) if kept is None else kept @ x)
 
     def again(self, qp: QP, max_rows: int | None) -> ReducedQP | None:
         """This problem for ``qp`` where only its loads and gaps (``q``, ``h``) and the values of
