@@ -168,6 +168,7 @@ def _sweep_exact(scene, values, opts, args, executor, workers):
 
 def cmd_sweep(args) -> int:
     from ..studies import SweepInterrupted, sweep
+    from ..studies.parallel import exit_if_left_running
 
     _set_memory_limit(args.max_memory)
     scene = _scene_or_builtin(args.scene)
@@ -208,7 +209,9 @@ def cmd_sweep(args) -> int:
                   f" {part.interrupted['done']} of {part.interrupted['of']} values done are on standard output"
                   f" ({where}); not done: {len(left)}"
                   + (f" (from {args.param} = {left[0]})" if left else ""), file=sys.stderr)
-            return 143 if seen.signals else 130
+            code = 143 if seen.signals else 130
+            exit_if_left_running(code)  # all is written: a stuck pool thread must not hold the exit
+            return code
         except KeyboardInterrupt:
             if res is None:
                 raise

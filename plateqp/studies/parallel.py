@@ -15,6 +15,7 @@ whole process group, and the sweep, not each worker, decides what happens (it st
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import os
 import pickle
 import signal
@@ -68,6 +69,66 @@ class Serial:
         pass
 
 
+class SignalGate:
+    """Holds SIGINT and SIGTERM back while the calling thread is inside concurrent.futures or
+    multiprocessing code, and acts on them when it leaves.
+
+    A KeyboardInterrupt raised there can land between a lock's acquire and the ``try`` that
+    releases it (``cf.wait`` takes every future's lock; a queue's ``get`` its reader lock).
+    The executor's manager thread then blocks for ever on that lock as it marks the futures
+    of the stopped workers, and the interpreter's exit blocks with it, as it joins that
+    thread. :meth:`open` puts a handler in front of every Python-level handler of the two
+    signals (in the main thread only: elsewhere Python runs no signal handlers); inside
+    :meth:`held` a signal is recorded, and on leaving it the first one recorded goes to the
+    handler that was in place (SIGINT's default raises KeyboardInterrupt there, outside the
+    library's locks). :meth:`close` puts the handlers back."""
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self):
+        self.old: dict = {}
+        self.holding = False
+        self.pending: list = []
+
+    def open(self) -> "SignalGate":
+        if threading.current_thread() is threading.main_thread():
+            for sig in self.SIGNALS:
+                handler = signal.getsignal(sig)
+                if callable(handler):
+                    self.old[sig] = handler
+                    signal.signal(sig, self._on_signal)
+        return self
+
+    def _on_signal(self, signum, frame):
+        if self.holding:
+            self.pending.append((signum, frame))
+        else:
+            self.old[signum](signum, frame)
+
+    @contextlib.contextmanager
+    def held(self, act: bool = True):
+        """The block runs with the signals held; on leaving it the first that came is handed
+        on (``act``) or dropped (``act=False``: the block is the stopping itself)."""
+        if not self.old or threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        self.holding = True
+        try:
+            yield
+        finally:
+            self.holding = False
+            got, self.pending = self.pending, []
+            if got and act:
+                signum, frame = got[0]
+                self.old[signum](signum, frame)
+
+    def close(self) -> None:
+        old, self.old = self.old, {}
+        for sig, handler in old.items():
+            if signal.getsignal(sig) == self._on_signal:
+                signal.signal(sig, handler)
+
+
 class Futures:
     """A concurrent.futures executor (ours or the user's) or a Dask distributed Client.
 
@@ -81,22 +142,27 @@ class Futures:
         self.kind = "dask" if dask else "futures"
         self.submitted: list = []
         self.rows = rows
+        self.gate = SignalGate() if dask else SignalGate().open()
 
     def drain(self):
         """The rows the workers have sent so far: a list of (token, index, row), without waiting."""
         import queue
 
         out = []
-        while self.rows is not None:
-            try:
-                out.append(self.rows.get_nowait())
-            except (queue.Empty, OSError, ValueError, EOFError):
-                break
+        with self.gate.held():  # a KeyboardInterrupt inside get() could leave the queue's lock held
+            while self.rows is not None:
+                try:
+                    out.append(self.rows.get_nowait())
+                except (queue.Empty, OSError, ValueError, EOFError):
+                    break
         return out
 
     def wait_any(self, futs, timeout: float = 0.1):
-        """The futures of ``futs`` done within ``timeout`` seconds (our own processes only)."""
-        done, _ = cf.wait(list(futs), timeout=timeout, return_when=cf.FIRST_COMPLETED)
+        """The futures of ``futs`` done within ``timeout`` seconds (not for Dask). A Ctrl-C or
+        SIGTERM that comes meanwhile is acted on once the wait has returned (see
+        :class:`SignalGate`)."""
+        with self.gate.held():
+            done, _ = cf.wait(list(futs), timeout=timeout, return_when=cf.FIRST_COMPLETED)
         return done
 
     def submit(self, fn, *args):
@@ -111,14 +177,20 @@ class Futures:
             # the client's own loop: without it Dask looks for a default client (there may be none)
             for f in as_completed(list(futs), loop=self.ex.loop):
                 yield f, f
-        else:
-            for f in cf.as_completed(list(futs)):
-                yield f, f
+        else:  # by short waits, each of which a signal does not interrupt (see wait_any)
+            pending = set(futs)
+            while pending:
+                for f in self.wait_any(pending):
+                    pending.discard(f)
+                    yield f, f
 
     def close(self):
-        if self.own:
-            self.ex.shutdown(wait=True)
-            self.rows.close()
+        try:
+            if self.own:
+                self.ex.shutdown(wait=True)
+                self.rows.close()
+        finally:
+            self.gate.close()
 
     def abort(self, grace: float = 2.0):
         """Cancel every task not yet started; stop our own worker processes (SIGTERM, then
@@ -130,6 +202,13 @@ class Futures:
         that the thread closes as it ends: left running, the two raced and an exit after
         SIGTERM printed ``OSError: [Errno 9] Bad file descriptor`` with a traceback
         (concurrent.futures in Python 3.11; seen in a CI run of the SIGTERM interrupt test)."""
+        try:
+            with self.gate.held(act=False):  # a second Ctrl-C does not cut the stopping short
+                self._abort(grace)
+        finally:
+            self.gate.close()
+
+    def _abort(self, grace: float):
         for fut in self.submitted:
             try:
                 fut.cancel()
@@ -151,6 +230,8 @@ class Futures:
                 p.join(grace)
         if manager is not None:
             manager.join(grace)
+            if manager.is_alive():
+                _forget_manager(manager)
         # the rows sent since (not where the first read is still stuck: it holds the queue)
         late = self._drain_within(grace) if first is not None else None
         self.drain_left = (first or []) + (late or [])
@@ -166,6 +247,44 @@ class Futures:
         reader.start()
         reader.join(grace)
         return None if reader.is_alive() else got
+
+
+#: Manager threads of our process pools that :meth:`Futures.abort` could not end.
+_LEFT_RUNNING: list = []
+
+
+def _forget_manager(thread) -> None:
+    """A pool's manager thread that did not end after :meth:`Futures.abort` (blocked reading a
+    result that a stopped worker left half written, say): the interpreter's exit would wait
+    for it for ever (it joins every non-daemon thread), so it is recorded for
+    :func:`exit_if_left_running` and taken off concurrent.futures' own list of threads to join."""
+    import concurrent.futures.process as cfp
+
+    logger.warning("the worker pool's manager thread did not end within the grace time; not waiting for it")
+    _LEFT_RUNNING.append(thread)
+    wakeups = getattr(cfp, "_threads_wakeups", None)
+    if wakeups is not None:
+        wakeups.pop(thread, None)
+
+
+def left_running() -> list:
+    """The manager threads of stopped pools still running (see :func:`exit_if_left_running`)."""
+    return [t for t in _LEFT_RUNNING if t.is_alive()]
+
+
+def exit_if_left_running(code: int) -> None:
+    """End the process now with ``code`` (standard output and error flushed) if a stopped
+    pool's manager thread still runs: the interpreter's own exit would wait for it for ever.
+    Returns (does nothing) otherwise. For a command that has written all it had to write."""
+    import sys
+
+    if left_running():
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(code)
 
 
 #: In a worker process of ours: the queue its rows go to as they are solved (see :class:`Futures`).
@@ -270,4 +389,5 @@ def make_runner(executor, n: int, max_workers: int, payload):
                        f"dask distributed Client (got {executor!r})")
 
 
-__all__ = ["CONNECT_TIMEOUT", "SERIAL_BELOW", "available_cores", "connect", "stream_row", "Futures", "Progress", "Serial", "is_dask", "make_runner", "mp_context"]
+__all__ = ["CONNECT_TIMEOUT", "SERIAL_BELOW", "available_cores", "connect", "exit_if_left_running", "left_running",
+           "stream_row", "Futures", "Progress", "Serial", "SignalGate", "is_dask", "make_runner", "mp_context"]

@@ -237,7 +237,12 @@ def sweep(scene: Scene, path: str, values: Iterable, backend: str = "auto", form
     ------
     SweepInterrupted
         on Ctrl-C (KeyboardInterrupt) while it runs: our worker processes are stopped at once
-        (not waited for), and the exception carries the rows done so far.
+        (not waited for), and the exception carries the rows done so far. While the sweep
+        waits on its workers, a Ctrl-C or SIGTERM is acted on when that wait returns (within
+        0.1 s; :class:`plateqp.studies.parallel.SignalGate`). Should the pool's manager thread
+        not end after the stop (a warning says so), the interpreter's exit would wait for it:
+        :func:`plateqp.studies.parallel.exit_if_left_running` ends the process once your output
+        is written (``plateqp sweep`` does this).
     """
     values = [v.item() if isinstance(v, np.generic) else v for v in values]
     if not values:

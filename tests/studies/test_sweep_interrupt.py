@@ -112,36 +112,49 @@ def run_and_interrupt(tmp_path: Path, workers: int, sig: int, extra=()):
             done = [int(k) for k in re.findall(rb"(\d+)/%d" % N, err)]
             if done and max(done) >= first:
                 break
+        # from here on standard error is read by a thread, all the time: a process that writes
+        # more than the terminal holds while nobody reads it would block (and look hung)
+        tail = bytearray()
+        stop_reading = threading.Event()
+
+        def pump():
+            try:
+                while not stop_reading.is_set():
+                    if select.select([master], [], [], 0.1)[0]:
+                        chunk = os.read(master, 4096)
+                        if not chunk:
+                            break
+                        tail.extend(chunk)
+            except (OSError, ValueError):  # every writer has closed the terminal (or the test its end)
+                pass
+
+        reader = threading.Thread(target=pump, daemon=True)
+        reader.start()
         if sig == signal.SIGINT:
             os.killpg(p.pid, sig)  # Ctrl-C at a terminal: the whole foreground process group
         else:
             p.send_signal(sig)  # `kill PID`
-        while b"interrupted" not in err:  # the one line is written after the workers are stopped
-            ready, _, _ = select.select([master], [], [], 120.0)
-            if not ready:
-                break
-            try:
-                err += os.read(master, 4096)
-            except OSError:
-                break
+        deadline = time.monotonic() + 120.0
+        while b"interrupted" not in bytes(tail) and reader.is_alive() and time.monotonic() < deadline:
+            time.sleep(0.02)  # the one line is written after the workers are stopped
         left_at_message = {q for q in seen_workers if alive(q)}
-        p.wait(timeout=120)
+        try:
+            p.wait(timeout=120)
+        except subprocess.TimeoutExpired:
+            tree = subprocess.run(["ps", "-o", "pid,ppid,stat,wchan:24,args", "-s", str(p.pid)],
+                                  capture_output=True, text=True).stdout
+            pytest.fail(f"the sweep did not end within 120 s of the signal; its processes:\n{tree}\n"
+                        f"the end of its standard error: {bytes(err + tail)[-1500:]!r}")
         drain.join(timeout=120)
         out = b"".join(chunks)
-        while True:
-            try:
-                ready, _, _ = select.select([master], [], [], 0.5)
-                if not ready:
-                    break
-                chunk = os.read(master, 4096)
-            except OSError:
-                break
-            if not chunk:
-                break
-            err += chunk
+        reader.join(timeout=2.0)  # the last lines (until every writer has closed the terminal)
+        stop_reading.set()
+        reader.join(timeout=2.0)
+        err += bytes(tail)
     finally:
         if p.poll() is None:
-            p.kill()
+            os.killpg(p.pid, signal.SIGKILL)  # the sweep and its workers (its process group)
+            p.wait()
         os.close(master)
     return p.returncode, out.decode(), err.decode(errors="replace"), seen_workers, left_at_message
 
