@@ -27,6 +27,7 @@ from .options import (
 )
 from .reduced import ReducedQP, force_scale, natural_residuals
 from .exact import run_sparse
+from .motions import rows_hold
 from .sparse import SpringFactor
 
 __all__ = ["pdas"]
@@ -193,6 +194,45 @@ def _spring_factor(pb: ReducedQP, sigma: float, method: str) -> tuple[SpringFact
     return fac, _KeptSprings(fac, pb.Kd.copy(), pb.B.copy(), np.array(pb.c, copy=True), sigma, method)
 
 
+def _unshifted(pb: ReducedQP, A: np.ndarray, sigma: float, method: str, feas_tol: float, max_iter: int, p: int,
+               steps, singular: bool):
+    """The sparse method on ``K + B_Aᵀ ρ_A⁻¹ B_A`` itself, with no proximal shift (σ = 0) and each
+    row's own spring (W = 1/ρ, no penalty in series), where that matrix is definite: every row
+    soft (ρ k ≥ 1), and the plate held by its two-sided supports or by the rows of the start
+    (``A``, a warm start, or every row on a cold one; :func:`.motions.rows_hold`, at the
+    shift's margin), and by those of the final set (then OPTIMAL is kept). The step of a set
+    is then one solve, exact to rounding: a warm start whose set is the answer's (the next
+    value of a sweep, or a set predicted right) costs one solve, where the shifted matrix
+    needed a second (the shift's σ D u and the penalty's share of each row left a residual
+    above rounding). ``(outcome, counts)``, or None where it does not apply or does not end
+    on a held set, OPTIMAL (the shifted method then runs from the same start)."""
+    if not np.all(pb.rho * pb.k >= 1.0):
+        return None
+    # a cold start: every row active, as the Newton phase starts (each spring bonded holds a plate)
+    A = np.ones(pb.m, dtype=bool) if A is None else A
+    if not A.any():
+        return None
+    W = 1.0 / pb.rho
+    if singular and not rows_hold(pb, W, A, sigma):
+        return None
+    mark = len(steps) if steps is not None else 0
+    fac, spring = _spring_factor(pb, 0.0, method)
+    info: dict = {}
+    try:
+        out = run_sparse(pb, fac, W, 0.0, A, feas_tol, max_iter, p, steps, None, info, False, False, False, False)
+    except SolverError:  # not definite after all (a set that lets the plate move)
+        out = None
+    if out is None or out.status is not Status.OPTIMAL or (singular and not rows_hold(pb, W, out.A, sigma)):
+        if steps is not None:
+            del steps[mark:]
+        return None
+    if singular:
+        info["hold_check"] = "rigid motions"  # the final set's hold, judged by rows_hold above
+    if spring is not None:
+        remember(kept(), spring)
+    return out, dict(fac.stats, factor=fac.method, **info)
+
+
 def _reduced(qp: QP, max_rows) -> ReducedQP:
     """``ReducedQP(qp, max_rows)``, or where the caller lent a list of kept factorisations
     (:func:`plateqp.linalg.keep.kept`: a sweep) and a solve before read the same Hessian, that
@@ -337,6 +377,11 @@ def pdas(qp: QP, active=None, trace=False, *, accuracy="default", **options) -> 
             extras.update(method="condensed", **stats)
             if keep is not None:
                 remember(kept(), keep)
+    if out is None and anchored is None:
+        got = _unshifted(pb, A, sigma, settings["factor"], tol["feas_tol"], max_iter, p, steps, singular)
+        if got is not None:
+            out, fac_stats = got
+            extras.update(method="sparse", shift=0.0, **fac_stats)
     if out is None:
         W = 1.0 / (pb.rho + 1.0 / (kappa * pb.k_penalty))  # κ times the row's softest unknown at most
         spring = None

@@ -88,8 +88,10 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
                   np.abs(r_A).max(initial=0.0) / delta)
         if res <= tol or k == n_max or (k >= 2 and res > 0.5 * best):
             break
-        if exact and k >= 1 and at_rounding(pb, u, idx, BA, lamA, r_u, r_A):
-            break  # another correction would not change the answer
+        # another correction would not change the answer; not before the first correction where
+        # the factor carries a shift (σ > 0): that correction is also the singular step's test
+        if exact and (k >= 1 or sigma == 0.0) and at_rounding(pb, u, idx, BA, lamA, r_u, r_A):
+            break
         best = min(best, res)
         du = project(null, pb.Kd, fac.solve(deflate(null, pb.Kd, r_u - BA.T @ (WA * r_A))))
         solves += 1
