@@ -19,7 +19,11 @@ solve a step:
   ``max_dense`` dofs under the rows.
 - ``method="sparse"`` (:mod:`.sparse`): a factor of ``K + σ diag(K) + B_Aᵀ W_A B_A`` (a spring on
   each active row), iterative refinement to the exact step, refactorisations, rank-k updates
-  or Woodbury corrections as the set changes; for beds, floating plates and many rows.
+  or Woodbury corrections as the set changes; for beds, floating plates and many rows. Where
+  every row is soft (ρ k ≥ 1) and the plate is held (by its two-sided supports, or by the
+  start's rows and the final set's), σ = 0 and ``W = 1/ρ``: the factor is the step's own
+  matrix, and a set's step one solve (``extras["shift"] = 0.0``); else, or where that run
+  does not end on a held set, the shifted factor above.
 
 First phases find the contact set before the exact steps where plain exchanges would be slow
 (Newton–PCG on soft rows, Lawson–Hanson and projected Newton on the dual for stiff ones, the
