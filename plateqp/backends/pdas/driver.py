@@ -222,7 +222,8 @@ def _unshifted(pb: ReducedQP, A: np.ndarray, sigma: float, method: str, feas_tol
         out = run_sparse(pb, fac, W, 0.0, A, feas_tol, max_iter, p, steps, None, info, False, False, False, False)
     except SolverError:  # not definite after all (a set that lets the plate move)
         out = None
-    if out is None or out.status is not Status.OPTIMAL or (singular and not rows_hold(pb, W, out.A, sigma)):
+    held = out is not None and (not singular or np.array_equal(out.A, A) or rows_hold(pb, W, out.A, sigma))
+    if out is None or out.status is not Status.OPTIMAL or not held:
         if steps is not None:
             del steps[mark:]
         return None
