@@ -168,6 +168,10 @@ class _KeptSprings:
     c: np.ndarray  # the rows' stiffnesses in series with their springs: each solve's own
     sigma: float
     method: str
+    #: the unshifted factor's (σ = 0) last final set, its springs and the margin at which the
+    #: rows were judged to hold the plate (:func:`_unshifted`): the next solve starting from
+    #: that set with those springs needs no new judgement
+    held: tuple | None = None
 
     def fits(self, pb: ReducedQP, sigma: float, method: str) -> bool:
         B = pb.B
@@ -213,7 +217,7 @@ def _unshifted(pb: ReducedQP, A: np.ndarray, sigma: float, method: str, feas_tol
     if not A.any():
         return None
     W = 1.0 / pb.rho
-    if singular and not rows_hold(pb, W, A, sigma):
+    if singular and not (_held_before(A, W, sigma) or rows_hold(pb, W, A, sigma)):
         return None
     mark = len(steps) if steps is not None else 0
     fac, spring = _spring_factor(pb, 0.0, method)
@@ -230,8 +234,21 @@ def _unshifted(pb: ReducedQP, A: np.ndarray, sigma: float, method: str, feas_tol
     if singular:
         info["hold_check"] = "rigid motions"  # the final set's hold, judged by rows_hold above
     if spring is not None:
+        spring.held = (out.A.copy(), W.copy(), sigma) if singular else None
         remember(kept(), spring)
     return out, dict(fac.stats, factor=fac.method, **info)
+
+
+def _held_before(A: np.ndarray, W: np.ndarray, sigma: float) -> bool:
+    """The kept unshifted factor (of this model's K and B: the list is the model's) ended its
+    last solve on the set ``A`` with the springs ``W``, judged then to hold the plate at the
+    margin of ``sigma`` (a sweep's next value, from that set)."""
+    for entry in kept() or ():
+        if isinstance(entry, _KeptSprings) and entry.sigma == 0.0 and entry.held is not None:
+            a, w, s = entry.held
+            if s == sigma and np.array_equal(a, A) and np.array_equal(w, W):
+                return True
+    return False
 
 
 def _reduced(qp: QP, max_rows) -> ReducedQP:
