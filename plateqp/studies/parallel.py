@@ -86,7 +86,8 @@ class SignalGate:
     SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
     def __init__(self):
-        self.old: dict = {}
+        self.old: dict = {}  # the handlers this gate stands in front of, while it is open
+        self._first: dict = {}  # the same, never cleared: a handler of ours left in place hands on
         self.holding = False
         self.pending: list = []
 
@@ -95,15 +96,15 @@ class SignalGate:
             for sig in self.SIGNALS:
                 handler = signal.getsignal(sig)
                 if callable(handler):
-                    self.old[sig] = handler
+                    self.old[sig] = self._first[sig] = handler
                     signal.signal(sig, self._on_signal)
         return self
 
     def _on_signal(self, signum, frame):
         if self.holding:
             self.pending.append((signum, frame))
-        else:
-            self.old[signum](signum, frame)
+        else:  # (after close() too, where another handler stood on ours then and put it back)
+            self._first[signum](signum, frame)
 
     @contextlib.contextmanager
     def held(self, act: bool = True):

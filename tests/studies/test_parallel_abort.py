@@ -108,3 +108,26 @@ def test_a_sigterm_handler_of_the_caller_gets_the_held_signal():
         assert signal.getsignal(signal.SIGTERM) is not gate._on_signal
     finally:
         signal.signal(signal.SIGTERM, old)
+
+
+def test_a_gate_handler_left_in_place_after_close_hands_on():
+    """Another handler set over the gate's while it was open is left alone by close(); where
+    that code later puts the gate's back, a signal still reaches the handler the gate stood
+    in front of (not a KeyError inside a signal handler)."""
+    import signal
+
+    from plateqp.studies.parallel import SignalGate
+
+    got = []
+    old = signal.signal(signal.SIGTERM, lambda signum, frame: got.append(signum))
+    try:
+        gate = SignalGate().open()
+        mine = signal.signal(signal.SIGTERM, lambda signum, frame: None)  # someone else's, on top
+        gate.close()
+        assert signal.getsignal(signal.SIGTERM) is not mine  # theirs stays: not ours to undo
+        signal.signal(signal.SIGTERM, mine)  # they put ours back
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(0.05)
+        assert got == [signal.SIGTERM]
+    finally:
+        signal.signal(signal.SIGTERM, old)
