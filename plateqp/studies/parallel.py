@@ -86,8 +86,10 @@ class SignalGate:
     SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
     def __init__(self):
-        self.old: dict = {}  # the handlers this gate stands in front of, while it is open
-        self._first: dict = {}  # the same, never cleared: a handler of ours left in place hands on
+        # the handlers this gate stands in front of (kept after close(): a handler of ours that
+        # other code put back then still hands the signal on)
+        self.before: dict = {}
+        self.is_open = False
         self.holding = False
         self.pending: list = []
 
@@ -96,21 +98,22 @@ class SignalGate:
             for sig in self.SIGNALS:
                 handler = signal.getsignal(sig)
                 if callable(handler):
-                    self.old[sig] = self._first[sig] = handler
+                    self.before[sig] = handler
                     signal.signal(sig, self._on_signal)
+            self.is_open = bool(self.before)
         return self
 
     def _on_signal(self, signum, frame):
         if self.holding:
             self.pending.append((signum, frame))
-        else:  # (after close() too, where another handler stood on ours then and put it back)
-            self._first[signum](signum, frame)
+        else:
+            self.before[signum](signum, frame)
 
     @contextlib.contextmanager
     def held(self, act: bool = True):
         """The block runs with the signals held; on leaving it the first that came is handed
         on (``act``) or dropped (``act=False``: the block is the stopping itself)."""
-        if not self.old or threading.current_thread() is not threading.main_thread():
+        if not self.is_open or threading.current_thread() is not threading.main_thread():
             yield
             return
         self.holding = True
@@ -121,11 +124,13 @@ class SignalGate:
             got, self.pending = self.pending, []
             if got and act:
                 signum, frame = got[0]
-                self.old[signum](signum, frame)
+                self.before[signum](signum, frame)
 
     def close(self) -> None:
-        old, self.old = self.old, {}
-        for sig, handler in old.items():
+        if not self.is_open:
+            return
+        self.is_open = False
+        for sig, handler in self.before.items():
             if signal.getsignal(sig) == self._on_signal:
                 signal.signal(sig, handler)
 
@@ -258,14 +263,9 @@ def _forget_manager(thread) -> None:
     """A pool's manager thread that did not end after :meth:`Futures.abort` (blocked reading a
     result that a stopped worker left half written, say): the interpreter's exit would wait
     for it for ever (it joins every non-daemon thread), so it is recorded for
-    :func:`exit_if_left_running` and taken off concurrent.futures' own list of threads to join."""
-    import concurrent.futures.process as cfp
-
+    :func:`exit_if_left_running`."""
     logger.warning("the worker pool's manager thread did not end within the grace time; not waiting for it")
     _LEFT_RUNNING.append(thread)
-    wakeups = getattr(cfp, "_threads_wakeups", None)
-    if wakeups is not None:
-        wakeups.pop(thread, None)
 
 
 def left_running() -> list:
