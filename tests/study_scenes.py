@@ -1,5 +1,6 @@
 """Scenes and the independent reference solve shared by the studies' tests (test_sweep,
-test_parallel, test_design, test_refinement, test_paths, test_reuse)."""
+test_parallel, test_design, test_refinement, test_paths, test_reuse, the bed sweeps and pdas's
+unshifted factor)."""
 
 from __future__ import annotations
 
@@ -39,3 +40,10 @@ def contour(n=4, stiffness="rigid", **kw) -> pq.Scene:
 
 def contact_set(active) -> list[int]:
     return [i for i, a in enumerate(active) if a]
+
+
+def bed(n: int = 10) -> pq.Scene:
+    """A free plate on a tensionless bed falling away towards (1, 1): part of it lifts off."""
+    return pq.Scene(name="bed", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
+                    edges={}, loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
+                    foundation=pq.Foundation(2.0e4, gap={"profile": "linear", "g0": 0.0, "gx": 0.004, "gy": 0.002}))

@@ -17,17 +17,11 @@ import plateqp.backends.pdas as pdas_backend
 from plateqp.backends.pdas import driver, factor
 from plateqp.model.paths import set_param
 from plateqp.studies.sweep import sweep
+from study_scenes import bed
 
 pytestmark = pytest.mark.skipif(not pq.linalg.bindings(), reason="no CHOLMOD binding")
 
 GAPS = [0.003, 0.0035, 0.004, 0.0045, 0.005]
-
-
-def bed(n: int = 24) -> pq.Scene:
-    """A free plate on a tensionless bed falling away towards (1, 1): part of it lifts off."""
-    return pq.Scene(name="bed", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
-                    edges={}, loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
-                    foundation=pq.Foundation(2.0e4, gap={"profile": "linear", "g0": 0.0, "gx": 0.004, "gy": 0.002}))
 
 
 def quiet(fn, *a, **kw):
@@ -58,7 +52,7 @@ def solves(monkeypatch):
 def bump(depth: float) -> pq.Scene:
     """bed() with a round heave of the soil (radius 0.2 m at (0.3, 0.3)) instead of the plane:
     its depth moves the contact set."""
-    sc = bed()
+    sc = bed(24)
     sc.foundation = pq.Foundation(2.0e4, gap={"profile": "bump", "x": 0.3, "y": 0.3, "radius": 0.2, "depth": depth})
     sc.validate()
     return sc
@@ -99,7 +93,7 @@ def test_a_planar_gap_sweep_pays_one_solve_per_value(solves):
     """The benchmark's bed sweep (bench_sweep_reuse: the gap's slope): a planar gap moves a free
     plate rigidly, so every value has the first one's reactions (statics and kinematics: no
     strain changes), and its step, on the kept factor of that set, is one solve."""
-    scene = bed()
+    scene = bed(24)
     res = quiet(sweep, scene, "foundation.gap.gx", GAPS, **SWEEP)
     assert all(r["status"] == "optimal" and r["kkt_worst"] <= 1e-10 for r in res.rows)
     assert len(solves) == len(GAPS)  # one solve of the problem a value

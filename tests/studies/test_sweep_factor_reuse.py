@@ -14,6 +14,7 @@ import pytest
 import plateqp as pq
 from plateqp.model.paths import set_param
 from plateqp.studies.sweep import sweep
+from study_scenes import bed
 
 pytestmark = pytest.mark.skipif(not pq.linalg.bindings(), reason="no CHOLMOD binding")
 
@@ -30,13 +31,6 @@ def posts(n: int = 12) -> pq.Scene:
             sup.append(pq.Support(x, y, stiffness=stiff, gap=1e-4 * ((i * 3 + j) % 4)))
     return pq.Scene(name="posts", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
                     edges=WALLS, loads=[pq.UniformLoad(2000.0)], supports=sup)
-
-
-def bed(n: int = 10) -> pq.Scene:
-    """A free plate on a tensionless bed falling away towards (1, 1): part of it lifts off."""
-    return pq.Scene(name="bed", plate=pq.Plate(1.0, 1.0, 0.02, 1e7, 0.3), mesh=pq.MeshSpec(n, n, "acm"),
-                    edges={}, loads=[pq.UniformLoad(20.0), pq.PointLoad(200.0, 0.6, 0.55)],
-                    foundation=pq.Foundation(2.0e4, gap={"profile": "linear", "g0": 0.0, "gx": 0.004, "gy": 0.002}))
 
 
 def run(scene, path, values, reuse):
