@@ -107,12 +107,15 @@ class Formulation:
 
 def _with_identity(K: sp.csc_matrix, k: int) -> sp.csc_matrix:
     """``block_diag(K, I_k)`` in CSC, K's entries as stored (zeros and order kept); its values
-    are K's own array, extended, where :func:`plateqp.linalg.pattern.scaled` left room for them."""
+    are K's own array, extended, where :func:`plateqp.linalg.pattern.scaled` left room for them,
+    and its indices too where the assembly did (:func:`plateqp.linalg.pattern.extended_indices`)."""
     n = K.shape[0]
     nnz = K.indptr[-1]
     idx = np.int64 if n + k > np.iinfo(np.int32).max or nnz + k > np.iinfo(np.int32).max else np.int32
     indptr = np.concatenate([K.indptr.astype(idx, copy=False), nnz + np.arange(1, k + 1, dtype=idx)])
-    indices = np.concatenate([K.indices[:nnz].astype(idx, copy=False), np.arange(n, n + k, dtype=idx)])
+    indices = pattern.extended_indices(K, k) if K.indices.dtype == idx else None
+    if indices is None:
+        indices = np.concatenate([K.indices[:nnz].astype(idx, copy=False), np.arange(n, n + k, dtype=idx)])
     data = pattern.extended_values(K, k) if K.data.dtype == float else None
     if data is None:
         data = np.concatenate([K.data[:nnz].astype(float, copy=False), np.ones(k)])

@@ -175,6 +175,7 @@ class Cholesky:
         self.F = None
         self.spent = False  # cvxopt: the numeric factor was handed to getfactor (no more solves)
         self.given = None  # scikit-sparse: an order given to analyse (applied to A and b here)
+        self.vorder = None  # the matrix came permuted (analyse_permuted): the order applied to b here
         self._last = (None, None)  # cvxopt: the last matrix converted, and its conversion
         seam = _seam() if lib == "cvxopt" else None
         self.direct = _Direct(seam) if seam is not None else None  # CHOLMOD's C API, no conversion
@@ -220,7 +221,7 @@ class Cholesky:
         order, exactly (no postordering): the factor is of ``A[order][:, order]`` while the
         solves take and give vectors in ``A``'s own order."""
         n = A.shape[0]
-        self.F, self.spent, self.given = None, False, None
+        self.F, self.spent, self.given, self.vorder = None, False, None, None
         if order is not None:
             order = np.asarray(order, dtype=np.int64)
         if self.direct is not None:
@@ -243,6 +244,50 @@ class Cholesky:
                 self.sym = _cvx_cholmod.symbolic(self._cvx(A), p=_cvx_matrix(p))
         else:
             self.sym = _cvx_cholmod.symbolic(self._cvx(A))
+
+    @property
+    def takes_permuted(self) -> bool:
+        """:meth:`analyse_permuted` is what this factor prefers: the seam, which then factorises
+        the matrix in place (no copy of it inside CHOLMOD)."""
+        return self.direct is not None
+
+    def analyse_permuted(self, A: sp.csc_matrix, order: np.ndarray) -> None:
+        """Symbolic analysis of ``A``, the lower triangle of a matrix ``M`` already permuted:
+        ``A = tril(M[order][:, order])`` (:func:`lower` with ``perm=order``), in that order
+        exactly. The solves still take and give vectors in ``M``'s order (permuted here);
+        :meth:`forward`, :meth:`backward` and :meth:`trailing` work in ``order``, as with
+        ``analyse(M, order=order)``. Through the seam CHOLMOD then factorises the triangle where
+        it lies: handed ``M``'s triangle and an order, it makes a permuted copy of it for the
+        numeric factorisation (45 MB at 256², beside a 254 MB factor)."""
+        if self.direct is None or _stype(A) != -1:
+            raise ValueError("analyse_permuted needs the seam and a lower triangle")
+        self.analyse(A, natural=True)  # (where the seam gives up, the binding analyses A as it comes)
+        self.vorder = np.asarray(order, dtype=np.int64)
+
+    def permuted_lower(self, A: sp.csc_matrix, order: np.ndarray, values: np.ndarray | None = None) -> sp.csc_matrix:
+        """``tril(M[order][:, order])`` from ``A``, the upper triangle of a symmetric ``M``
+        (``values``: in place of ``A``'s, one per stored entry), for :meth:`analyse_permuted`;
+        by CHOLMOD's own permuted transpose, through the seam only."""
+        if self.direct is None:
+            raise ValueError("permuted_lower needs the seam")
+        return self.direct.permuted_lower(A, order, A.data if values is None else values)
+
+    def forget_matrix(self) -> None:
+        """Let go of the last matrix handed to :meth:`order` (the seam keeps its widened
+        pattern for the analysis of the same matrix)."""
+        if self.direct is not None:
+            self.direct.forget()
+        self._last = (None, None)
+
+    def _to_factor(self, b: np.ndarray) -> np.ndarray:
+        return b if self.vorder is None else np.asarray(b, dtype=float)[self.vorder]
+
+    def _from_factor(self, x: np.ndarray) -> np.ndarray:
+        if self.vorder is None:
+            return x
+        out = np.empty_like(x)
+        out[self.vorder] = x
+        return out
 
     def factor(self, A: sp.csc_matrix) -> None:
         """Numeric factorisation with the analysis; SingularMatrixError if ``A`` is not
@@ -296,16 +341,24 @@ class Cholesky:
                 return x
             with _sk_quiet():
                 return self.F.solve_A(b)
-        return self._cvx_solve(b, (0,))
+        return self._from_factor(self._cvx_solve(self._to_factor(b), (0,)))
 
-    def forward(self, b: np.ndarray) -> np.ndarray:
-        """``y = L⁻¹ P b`` (``A = Pᵀ L Lᵀ P``): half a solve, ``y`` in the factor's order."""
+    def forward(self, b: np.ndarray, overwrite: bool = False) -> np.ndarray:
+        """``y = L⁻¹ P b`` (``A = Pᵀ L Lᵀ P``): half a solve, ``y`` in the factor's order.
+        ``overwrite``: ``b`` (float, (n, k) in Fortran order) may be permuted in place, a column
+        at a time, rather than copied (for a caller whose block is made for this solve)."""
         self._check()
         if self.lib == "sksparse":
             b = np.asarray(b, dtype=float)
             with _sk_quiet():
                 pb = self.F.apply_P(b if self.given is None else b[self.given])
                 return self.F.solve_L(pb, use_LDLt_decomposition=False)
+        if self.vorder is not None:  # CHOLMOD's own order is the natural one
+            if overwrite and b.ndim == 2 and b.dtype == np.float64 and b.flags.f_contiguous:
+                for j in range(b.shape[1]):
+                    b[:, j] = b[self.vorder, j]
+                return self._cvx_solve(b, (4,))
+            return self._cvx_solve(self._to_factor(b), (4,))
         return self._cvx_solve(b, (7, 4))  # cvxopt's sys: 7 P, 4 L
 
     def backward(self, y: np.ndarray) -> np.ndarray:
@@ -319,6 +372,8 @@ class Cholesky:
             out = np.empty_like(x)
             out[self.given] = x
             return out
+        if self.vorder is not None:
+            return self._from_factor(self._cvx_solve(y, (5,)))
         return self._cvx_solve(y, (5, 8))  # 5 Lᵀ, 8 Pᵀ
 
     def trailing(self, no: int) -> np.ndarray:

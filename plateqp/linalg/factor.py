@@ -148,7 +148,9 @@ class Factor(Refined):
         self._res = None
         self.s = equilibration(self.K)
         if self.chol is not None:
-            A = lower(self.K, self.s, self.order, upper=self.chol.upper)
+            # with an order, the triangle comes permuted and is analysed in its own (natural) order:
+            # the lower one is then factorised where it lies, the upper one through a copy
+            A = lower(self.K, self.s, self.order, upper=self.chol.upper and self.order is None)
             if self.chol.sym is None:
                 self.chol.analyse(A, natural=self.order is not None)
             self.chol.factor(A)

@@ -80,6 +80,23 @@ def extended_values(K: sp.spmatrix, extra: int) -> np.ndarray | None:
     return base[:nnz + extra]
 
 
+def extended_indices(K: sp.spmatrix, extra: int) -> np.ndarray | None:
+    """``K``'s stored indices followed by ``n, n + 1, …, n + extra − 1`` (``n`` its order: the
+    rows of an identity block appended after ``K``), sharing ``K``'s index array where it was
+    made with room after it (the grid's assembly leaves one entry a row), else None. The room
+    is written with those values, the same for every caller: nothing else reads it."""
+    idx, nnz, n = K.indices, int(K.indptr[-1]), K.shape[0]
+    base = idx.base
+    if (base is None or base.ndim != 1 or base.dtype != idx.dtype or not base.flags.c_contiguous
+            or not base.flags.writeable or not idx.flags.c_contiguous or idx.size != nnz
+            or base.size < nnz + extra or n + extra > np.iinfo(idx.dtype).max
+            or base.__array_interface__["data"][0] != idx.__array_interface__["data"][0]):
+        return None
+    out = base[:nnz + extra]
+    out[nnz:] = np.arange(n, n + extra, dtype=idx.dtype)
+    return out
+
+
 def csc_of_symmetric(K: sp.spmatrix, symmetric: bool) -> sp.csc_matrix:
     """``K`` as CSC. Where ``symmetric`` (the caller vouches that ``K`` is exactly symmetric,
     value for value) and ``K`` is CSR with sorted indices, its arrays are read as CSC: the CSR

@@ -57,6 +57,18 @@ def symmetric_from_lower(A: np.ndarray, block: int = 128) -> np.ndarray:
     return A
 
 
+def _plus_diagonal(A: sp.csc_matrix, d: np.ndarray) -> sp.csc_matrix:
+    """``A + diag(d)``, in place where each column of the triangle ``A`` holds its diagonal."""
+    n = A.shape[0]
+    for ends in (A.indptr[:-1], A.indptr[1:] - 1):  # a lower triangle starts, an upper one ends, at it
+        if A.has_sorted_indices and np.all(np.diff(A.indptr) > 0) and np.array_equal(A.indices[ends], np.arange(n)):
+            A.data[ends] += d
+            return A
+    out = A + sp.diags(d, format="csc")
+    out.sort_indices()
+    return out
+
+
 class _Solver(Refined):
     """``K`` (or ``K_oo``) with a raw solve function, refined on ``K`` itself."""
 
@@ -147,13 +159,22 @@ class SchurFactor:
     def _by_trailing_block(self, lib: str) -> None:
         t0 = time.perf_counter()
         chol = Cholesky(lib)
-        A = lower(self.K, self.s, upper=chol.upper)  # one pass over K; the order is given to CHOLMOD
+        A = lower(self.K, self.s, upper=chol.upper)  # one pass over K, for the order
         order = chol.order(A)
         self.perm = np.concatenate([order[~self._mask[order]], self.last])
-        if self.shift or self.prox:
-            A = A + sp.diags(np.where(self._mask, self.shift, 0.0) + self.prox, format="csc")
-            A.sort_indices()
-        chol.analyse(A, order=self.perm)
+        extra = np.where(self._mask, self.shift, 0.0) + self.prox if (self.shift or self.prox) else None
+        if chol.takes_permuted:  # the triangle made in the factor's order: CHOLMOD factorises it in place
+            Ap = chol.permuted_lower(A, self.perm)
+            chol.forget_matrix()
+            del A
+            A = Ap
+            if extra is not None:
+                A = _plus_diagonal(A, extra[self.perm])
+            chol.analyse_permuted(A, self.perm)
+        else:
+            if extra is not None:
+                A = _plus_diagonal(A, extra)
+            chol.analyse(A, order=self.perm)
         t1 = time.perf_counter()
         chol.factor(A)
         t2 = time.perf_counter()

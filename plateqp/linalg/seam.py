@@ -43,7 +43,7 @@ _COMMON_BYTES = 1 << 16  # CHOLMOD 3's cholmod_common is about 2.3 kB
 _OFF_SUPERNODAL, _OFF_PRINT, _OFF_NMETHODS, _OFF_POSTORDER = 48, 144, 168, 1864
 _OFF_METHOD0, _METHOD_BYTES, _OFF_ORDERING = 184, 168, 132
 _SUPERNODAL = 2  # CHOLMOD_AUTO (1) by default
-_GIVEN, _AMD = 1, 2  # CHOLMOD's ordering codes (NATURAL is 0)
+_NATURAL, _GIVEN, _AMD = 0, 1, 2  # CHOLMOD's ordering codes
 # the defaults cholmod_l_start writes (offset, type, value): dbound, grow0..2, maxrank,
 # supernodal_switch, supernodal, final_ll, zrelax[0], nrelax[0], nrelax[2], print, nmethods,
 # method[0].lnz, method[0].ordering, method[1].ordering, postorder
@@ -95,6 +95,7 @@ class _Seam:
                               ("cholmod_l_factorize", [vp, vp, vp], ctypes.c_int),
                               ("cholmod_l_solve", [ctypes.c_int, vp, vp, vp], vp),
                               ("cholmod_l_free_dense", [ctypes.POINTER(vp), vp], ctypes.c_int),
+                              ("cholmod_l_transpose_sym", [vp, ctypes.c_int, vp, vp, vp], ctypes.c_int),
                               ("cholmod_l_free_factor", [ctypes.POINTER(vp), vp], ctypes.c_int)):
             f = getattr(c, fn)
             f.argtypes, f.restype = args, res
@@ -186,6 +187,10 @@ class _Direct:
             A.indptr, A.indices = self._wide[1], self._wide[2]
         return self._wide[1], self._wide[2]
 
+    def forget(self) -> None:
+        """Drop the widened pattern of the last matrix (and with it that matrix)."""
+        self._wide = None
+
     def _sparse(self, A: sp.csc_matrix) -> _Sparse:
         n = A.shape[0]
         p, i = self._indices(A)
@@ -193,6 +198,41 @@ class _Direct:
         self._hold = (p, i, x)
         return _Sparse(n, n, int(p[-1]), p.ctypes.data, i.ctypes.data, None, x.ctypes.data, None, _stype(A),
                        _ITYPE_LONG, _XTYPE_REAL, _DTYPE_DOUBLE, int(bool(A.has_sorted_indices)), 1)
+
+    def permuted_lower(self, A: sp.csc_matrix, perm: np.ndarray, values: np.ndarray) -> sp.csc_matrix:
+        """``tril(M[perm][:, perm])`` for the symmetric ``M`` whose upper triangle ``A`` is, with
+        ``values`` (one per stored entry of ``A``) in place of ``A``'s own: CHOLMOD's
+        ``cholmod_l_transpose_sym``, the very copy its numeric factorisation makes of a triangle
+        handed with an order, made once here into NumPy's arrays; each column's rows then
+        sorted (a transpose with an order leaves some out of order)."""
+        n = A.shape[0]
+        counts = np.diff(A.indptr)
+        full = counts > 0
+        if A.has_sorted_indices:  # each column's last row at most its own
+            upper = np.all(A.indices[A.indptr[1:][full] - 1] <= np.flatnonzero(full))
+        else:
+            upper = np.all(A.indices <= np.repeat(np.arange(n), counts))
+        if not upper:
+            raise ValueError("permuted_lower takes an upper triangle")
+        p, i = self._indices(A)
+        nnz = int(p[-1])
+        x = np.ascontiguousarray(values, dtype=np.float64)
+        if x.size != nnz:
+            raise ValueError("one value a stored entry")
+        perm = np.ascontiguousarray(perm, dtype=np.int64)
+        S = _Sparse(n, n, nnz, p.ctypes.data, i.ctypes.data, None, x.ctypes.data, None, 1,
+                    _ITYPE_LONG, _XTYPE_REAL, _DTYPE_DOUBLE, int(bool(A.has_sorted_indices)), 1)
+        fp, fi, fx = np.empty(n + 1, dtype=np.int64), np.empty(nnz, dtype=np.int64), np.empty(nnz)
+        F = _Sparse(n, n, nnz, fp.ctypes.data, fi.ctypes.data, None, fx.ctypes.data, None, -1,
+                    _ITYPE_LONG, _XTYPE_REAL, _DTYPE_DOUBLE, 0, 1)
+        if not self.s.c.cholmod_l_transpose_sym(ctypes.byref(S), 1, perm.ctypes.data, ctypes.byref(F), self.cm) \
+                or fp[n] != nnz:
+            raise SingularMatrixError("CHOLMOD's permuted transpose failed (an order that is no permutation?)")
+        M = sp.csc_matrix((n, n))  # the arrays set, not passed: SciPy would narrow the indices (a copy)
+        M.data, M.indices, M.indptr = fx, fi, fp
+        M.has_sorted_indices = False
+        M.sort_indices()
+        return M
 
     def order(self, A: sp.csc_matrix) -> np.ndarray:
         n = A.shape[0]
@@ -206,27 +246,37 @@ class _Direct:
         return P
 
     def analyse(self, A: sp.csc_matrix, perm: np.ndarray | None) -> None:
+        """The symbolic analysis of ``A``: CHOLMOD's own ordering (``perm`` None), or exactly
+        ``perm``, not postordered. The identity is asked as CHOLMOD's natural ordering: a lower
+        triangle is then factorised where it lies, while a given order, even the identity, has
+        CHOLMOD factorise a permuted copy (two for a lower triangle)."""
         if self.L:
             self.s.c.cholmod_l_free_factor(ctypes.byref(self.L), self.cm)
         S = self._sparse(A)
+        n = A.shape[0]
         if perm is None:
             L = self.s.c.cholmod_l_analyze(ctypes.byref(S), self.cm)
-        else:  # exactly this order: one method, the given one, not postordered
+        else:  # exactly this order: one method, the given one (or the natural one), not postordered
             perm = np.ascontiguousarray(perm, dtype=np.int64)
+            natural = bool(np.array_equal(perm, np.arange(n)))
             off = _OFF_METHOD0 + _OFF_ORDERING
             _set_int(self.cm, _OFF_NMETHODS, 1)
-            _set_int(self.cm, off, _GIVEN)
+            _set_int(self.cm, off, _NATURAL if natural else _GIVEN)
             _set_int(self.cm, _OFF_POSTORDER, 0)
             try:
-                L = self.s.c.cholmod_l_analyze_p(ctypes.byref(S), perm.ctypes.data, None, 0, self.cm)
+                if natural:
+                    L = self.s.c.cholmod_l_analyze(ctypes.byref(S), self.cm)
+                else:
+                    L = self.s.c.cholmod_l_analyze_p(ctypes.byref(S), perm.ctypes.data, None, 0, self.cm)
             finally:
                 _set_int(self.cm, _OFF_NMETHODS, 0)
+                _set_int(self.cm, off, _GIVEN)
                 _set_int(self.cm, _OFF_POSTORDER, 1)
         self._hold = None  # CHOLMOD keeps no pointer into A
         if not L:
             raise SingularMatrixError("CHOLMOD's symbolic analysis failed (out of memory?)")
         self.L = ctypes.c_void_p(L)
-        if perm is not None and not np.array_equal(view(int(view(L, 3, np.uint64)[_PERM]), A.shape[0], np.int64), perm):
+        if perm is not None and not np.array_equal(view(int(view(L, 3, np.uint64)[_PERM]), n, np.int64), perm):
             raise OSError("CHOLMOD did not keep the given order")  # the layout is not what it was checked to be
 
     def factor(self, A: sp.csc_matrix) -> None:

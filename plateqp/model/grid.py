@@ -465,8 +465,11 @@ def _csr_from_blocks(V, cnode, pos, ncol):
     rowok = posn >= 0
     m = rowok[:, :, None] & colok[:, None, :]
     data = V.reshape(nn, nd, 9 * nd)[m]
-    indices = np.broadcast_to(G[:, None, :], m.shape)[m]
     counts = np.broadcast_to(colok.sum(axis=1)[:, None], rowok.shape)[rowok]
+    # the indices with room for one more a row after them (plateqp.linalg.pattern.extended_indices:
+    # the primal QP's block_diag(K, I) then shares them, not a copy of 21 MB at 256²)
+    indices = np.empty(data.size + counts.size, dtype=np.int32)[:data.size]
+    indices[:] = np.broadcast_to(G[:, None, :], m.shape)[m]
     indptr = np.zeros(counts.size + 1, dtype=np.int32)
     np.cumsum(counts, out=indptr[1:])
     A = sp.csr_matrix((data, indices, indptr), shape=(counts.size, ncol))

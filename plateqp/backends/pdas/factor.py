@@ -72,6 +72,9 @@ class SpringFactor:
         self.pattern_nnz = Ks.nnz  # entries of K + BᵀB's pattern (K's own, stored zeros too, where B lies in it)
         if self.chol is None or not self._triangle(Ks, Kd, sigma, pr, pair_r, pair_c, pair_val):
             self._whole(Ks, Kd, sigma, pr, pair_r, pair_c, pair_val)
+        self.order = None  # the triangle's order, where it is kept permuted (_permute)
+        if self.chol is not None and self.chol.takes_permuted:
+            self._permute()
         self._fresh()
 
     def _fresh(self) -> None:
@@ -210,6 +213,36 @@ class SpringFactor:
             self.pair_val = pair_val[inside] * scale[pl[inside]]
             self.nnz = low.size
 
+    def _permute(self) -> None:
+        """The kept triangle made, once, the lower triangle of ``P H Pᵀ`` (``P``: AMD's order of
+        its pattern, what CHOLMOD's own analysis starts from) by CHOLMOD's own permuted transpose
+        (:meth:`plateqp.linalg.Cholesky.permuted_lower`). CHOLMOD then factorises it where it
+        lies at every refactorisation; handed the triangle and an order, it made that permuted
+        copy beside the factor each time (45 MB at 256²: :meth:`plateqp.linalg.Cholesky.analyse_permuted`).
+        The values are moved, not recomputed: the same matrix, to the bit."""
+        n = self.s.size
+        T = self._on(self.base)
+        order = self.chol.order(T)
+        old_pos = self.pair_pos
+        diag = T.indptr[1:] - 1  # (an upper triangle's columns end at their diagonal)
+        col = np.searchsorted(T.indptr, old_pos, side="right") - 1
+        on_diag = np.array_equal(old_pos, diag[col])
+        if not on_diag:  # each entry's position as its value: where each new one came from
+            src = self.chol.permuted_lower(T, order, np.arange(self.nnz, dtype=float)).data.astype(np.int64)
+            where = np.empty(self.nnz, dtype=np.int64)
+            where[src] = np.arange(self.nnz)
+            del src
+        M = self.chol.permuted_lower(T, order)
+        self.chol.forget_matrix()
+        del T
+        inv = np.empty(n, dtype=np.int64)
+        inv[order] = np.arange(n)
+        self.base, self.indices, self.indptr = M.data, M.indices, M.indptr
+        # rows on one unknown each (a bed): on the diagonal, the first entry of a sorted lower column
+        self.pair_pos = M.indptr[inv[col]] if on_diag else where.take(old_pos)
+        self._touched = None
+        self.order = order
+
     def _matrix(self, w: np.ndarray) -> sp.csc_matrix:
         """``H(w)``: with CHOLMOD, one triangle of it, equilibrated; else the whole matrix."""
         data = self.base + np.bincount(self.pair_pos, weights=w[self.pair_row] * self.pair_val,
@@ -245,7 +278,10 @@ class SpringFactor:
         if self.chol is not None:
             with self._in_place(w) as H:
                 if self.chol.sym is None:
-                    self.chol.analyse(H)
+                    if self.order is None:
+                        self.chol.analyse(H)
+                    else:
+                        self.chol.analyse_permuted(H, self.order)
                     t1 = time.perf_counter()
                     self.stats["analyse_s"] += t1 - t0
                     t0 = t1
@@ -376,7 +412,7 @@ class SpringFactor:
         Yᵀ y)`` with ``y = L⁻¹ P D b`` (:meth:`solve`). Else ``Z = H(w₀)⁻¹ Uᵀ``."""
         if self.chol is not None:
             Ut *= self.s[:, None]  # in place: the caller's array is made for this
-            return self.chol.forward(Ut)
+            return self.chol.forward(Ut, overwrite=True)
         return self._solve(Ut)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
