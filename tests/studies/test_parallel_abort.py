@@ -61,7 +61,22 @@ def test_a_manager_thread_stuck_after_abort_does_not_hold_the_exit(tmp_path):
     assert "did not end within the grace time" in run.stderr  # and it says so
 
 
-def test_a_signal_inside_the_gate_is_acted_on_when_the_block_ends():
+@pytest.fixture
+def keyboard_interrupt():
+    """Python's own SIGINT handler (KeyboardInterrupt) in place for the test: a process started
+    with SIGINT ignored (``cmd &`` from a shell without job control) has none, and nothing there
+    would ever raise KeyboardInterrupt."""
+    import signal
+
+    before = signal.getsignal(signal.SIGINT)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+def test_a_signal_inside_the_gate_is_acted_on_when_the_block_ends(keyboard_interrupt):
     import signal
 
     from plateqp.studies.parallel import SignalGate

@@ -79,6 +79,12 @@ def alive(pid: int) -> bool:
     return state != "Z"
 
 
+def _default_signals() -> None:
+    """In the child before it runs the sweep: SIGINT and SIGTERM at their default dispositions."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 def run_and_interrupt(tmp_path: Path, workers: int, sig: int, extra=()):
     """Start the sweep, wait until its progress counter shows the first values done, send
     ``sig``; return (exit code, stdout, stderr text, the worker pids seen, those of them still
@@ -90,8 +96,10 @@ def run_and_interrupt(tmp_path: Path, workers: int, sig: int, extra=()):
     env = dict(os.environ, PYTHONPATH=str(Path(pq.__file__).parents[1]))
     env.pop("PLATEQP_DEBUG", None)
     env.pop("CI", None)  # an interactive terminal: CI=true hides the progress counter this waits for
+    # the sweep gets SIGINT's default disposition whatever this process inherited (a test run
+    # started with '&' by a shell without job control ignores SIGINT, and so would the sweep)
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=slave, stdin=subprocess.DEVNULL, env=env,
-                         start_new_session=True)
+                         start_new_session=True, preexec_fn=_default_signals)
     os.close(slave)
     # standard output drained as it comes: the rows done, printed after the interrupt, can be more
     # than a pipe holds, and the one line on standard error comes after them
