@@ -14,7 +14,9 @@ CHOLMOD inside cvxopt's wheels is called through its C API (ctypes, :mod:`plateq
 library and the layout of ``cholmod_common`` are the ones checked (CHOLMOD 3, as cvxopt 1.3
 ships it): CHOLMOD then reads the NumPy arrays of one triangle in place, with no cvxopt
 matrix built (0.15 s of a 1.3 s factorisation at 256²), and each factor has its own workspace.
-Elsewhere, or with :data:`plateqp.linalg.seam.SEAM` set False, cvxopt's own binding is used, as
+There a triangle can also be handed already permuted (:meth:`Cholesky.permuted_lower`, then
+:meth:`Cholesky.analyse_permuted`): CHOLMOD factorises it where it lies, where handed a triangle
+and an order it makes a permuted copy of it beside the factor. Elsewhere, or with :data:`plateqp.linalg.seam.SEAM` set False, cvxopt's own binding is used, as
 below.
 
 Reading the factor: cvxopt's only call for it, ``cholmod.getfactor``, hands the numeric factor
