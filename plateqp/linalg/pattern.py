@@ -68,16 +68,21 @@ def scaled(K: sp.spmatrix, s: np.ndarray, factor: float = 1.0, spare: int = 0) -
     return out
 
 
+def _with_room(arr: np.ndarray, nnz: int, extra: int) -> np.ndarray | None:
+    """``arr`` (its ``nnz`` entries) extended over the room after it in the array it is a view
+    of, where that array holds at least ``extra`` more entries; else None."""
+    base = arr.base
+    if (base is None or base.ndim != 1 or base.dtype != arr.dtype or not base.flags.c_contiguous
+            or not arr.flags.c_contiguous or arr.size != nnz or base.size < nnz + extra
+            or base.__array_interface__["data"][0] != arr.__array_interface__["data"][0]):
+        return None
+    return base[:nnz + extra]
+
+
 def extended_values(K: sp.spmatrix, extra: int) -> np.ndarray | None:
     """An array of ``K``'s stored values followed by room for ``extra`` more, sharing ``K``'s
     values where :func:`scaled` left that room after them (the room's entries unset), else None."""
-    data, nnz = K.data, int(K.indptr[-1])
-    base = data.base
-    if (base is None or base.ndim != 1 or base.dtype != data.dtype or not base.flags.c_contiguous
-            or not data.flags.c_contiguous or data.size != nnz or base.size < nnz + extra
-            or base.__array_interface__["data"][0] != data.__array_interface__["data"][0]):
-        return None
-    return base[:nnz + extra]
+    return _with_room(K.data, int(K.indptr[-1]), extra)
 
 
 def extended_indices(K: sp.spmatrix, extra: int) -> np.ndarray | None:
@@ -85,15 +90,11 @@ def extended_indices(K: sp.spmatrix, extra: int) -> np.ndarray | None:
     rows of an identity block appended after ``K``), sharing ``K``'s index array where it was
     made with room after it (the grid's assembly leaves one entry a row), else None. The room
     is written with those values, the same for every caller: nothing else reads it."""
-    idx, nnz, n = K.indices, int(K.indptr[-1]), K.shape[0]
-    base = idx.base
-    if (base is None or base.ndim != 1 or base.dtype != idx.dtype or not base.flags.c_contiguous
-            or not base.flags.writeable or not idx.flags.c_contiguous or idx.size != nnz
-            or base.size < nnz + extra or n + extra > np.iinfo(idx.dtype).max
-            or base.__array_interface__["data"][0] != idx.__array_interface__["data"][0]):
+    nnz, n = int(K.indptr[-1]), K.shape[0]
+    out = _with_room(K.indices, nnz, extra)
+    if out is None or not out.flags.writeable or n + extra > np.iinfo(out.dtype).max:
         return None
-    out = base[:nnz + extra]
-    out[nnz:] = np.arange(n, n + extra, dtype=idx.dtype)
+    out[nnz:] = np.arange(n, n + extra, dtype=out.dtype)
     return out
 
 

@@ -164,10 +164,8 @@ class SchurFactor:
         self.perm = np.concatenate([order[~self._mask[order]], self.last])
         extra = np.where(self._mask, self.shift, 0.0) + self.prox if (self.shift or self.prox) else None
         if chol.takes_permuted:  # the triangle made in the factor's order: CHOLMOD factorises it in place
-            Ap = chol.permuted_lower(A, self.perm)
+            A = chol.permuted_lower(A, self.perm)
             chol.forget_matrix()
-            del A
-            A = Ap
             if extra is not None:
                 A = _plus_diagonal(A, extra[self.perm])
             chol.analyse_permuted(A, self.perm)

@@ -4,27 +4,16 @@ its pattern, at that width, not a 32-bit copy beside a widened one; the factor i
 from __future__ import annotations
 
 import numpy as np
-import pytest
 import scipy.sparse as sp
 
 from plateqp.backends.pdas.factor import SpringFactor
-from plateqp.linalg import Cholesky, bindings
 from plateqp.linalg.cholmod import lower
 from plateqp.model.assembly import build_model
 from plateqp.scenes import families
 
 
-def _direct() -> Cholesky:
-    if "cvxopt" not in bindings():
-        pytest.skip("cvxopt's CHOLMOD is not installed")
-    chol = Cholesky("cvxopt")
-    if chol.direct is None:
-        pytest.skip("CHOLMOD's C API is not reachable here")
-    return chol
-
-
-def test_triangle_holds_the_wide_pattern_after_analysis():
-    chol = _direct()
+def test_triangle_holds_the_wide_pattern_after_analysis(seam_cholesky):
+    chol = seam_cholesky
     model = build_model(families.grid_rigid(10, 3))
     K = sp.csc_matrix(model.K)
     s = 1.0 / np.sqrt(K.diagonal())
@@ -42,8 +31,8 @@ def test_triangle_holds_the_wide_pattern_after_analysis():
     np.testing.assert_allclose(Ssym @ x, b, rtol=1e-9, atol=1e-9 * np.abs(b).max())
 
 
-def test_spring_factor_hands_cholmod_its_own_wide_pattern():
-    chol = _direct()
+def test_spring_factor_hands_cholmod_its_own_wide_pattern(seam_cholesky):
+    chol = seam_cholesky
     model = build_model(families.grid_rigid(10, 3))
     K = sp.csc_matrix(model.K)
     B = sp.csr_matrix(model.contacts.B)

@@ -10,7 +10,7 @@ import scipy.sparse as sp
 
 from plateqp.backends.pdas.factor import SpringFactor
 from plateqp.contact.formulations import _with_identity
-from plateqp.linalg import Cholesky, SchurFactor, bindings
+from plateqp.linalg import Cholesky, SchurFactor
 from plateqp.linalg.cholmod import _header, lower
 from plateqp.linalg.pattern import csc_of_symmetric
 from plateqp.linalg.seam import view
@@ -18,15 +18,6 @@ from plateqp.model.assembly import build_model
 from plateqp.scenes import families
 
 _NATURAL = 0  # CHOLMOD's code of the natural ordering (cholmod.h)
-
-
-def _direct() -> Cholesky:
-    if "cvxopt" not in bindings():
-        pytest.skip("cvxopt's CHOLMOD is not installed")
-    chol = Cholesky("cvxopt")
-    if chol.direct is None:
-        pytest.skip("CHOLMOD's C API is not reachable here")
-    return chol
 
 
 def _plate():
@@ -39,8 +30,8 @@ def _ordering(chol: Cholesky) -> int:
     return int(view(chol.direct.L.value + 22 * 8, 1, np.int32)[0])
 
 
-def test_permuted_lower_is_the_permuted_matrix_lower_triangle():
-    chol = _direct()
+def test_permuted_lower_is_the_permuted_matrix_lower_triangle(seam_cholesky):
+    chol = seam_cholesky
     K, s = _plate()
     A = lower(K, s, upper=True)
     U = A.toarray()
@@ -56,8 +47,8 @@ def test_permuted_lower_is_the_permuted_matrix_lower_triangle():
         chol.permuted_lower(lower(K, s), p)
 
 
-def test_a_factor_analysed_permuted_is_natural_and_solves_in_the_matrix_order():
-    chol = _direct()
+def test_a_factor_analysed_permuted_is_natural_and_solves_in_the_matrix_order(seam_cholesky):
+    chol = seam_cholesky
     K, s = _plate()
     n = K.shape[0]
     full = (s[:, None] * K.toarray()) * s[None, :]
@@ -85,8 +76,7 @@ def test_a_factor_analysed_permuted_is_natural_and_solves_in_the_matrix_order():
     np.testing.assert_allclose(chol.forward(B, overwrite=True), np.linalg.solve(L, b[order]), rtol=1e-10, atol=1e-12)
 
 
-def test_the_contacts_last_factor_takes_its_triangle_permuted():
-    _direct()
+def test_the_contacts_last_factor_takes_its_triangle_permuted(seam_cholesky):
     K, _ = _plate()
     last = np.random.default_rng(2).permutation(K.shape[0])[:7]
     fac = SchurFactor(K, last, method="cvxopt")
@@ -107,11 +97,10 @@ def test_the_contacts_last_factor_takes_its_triangle_permuted():
 
 
 @pytest.mark.parametrize("rows", ["one unknown", "several unknowns"])
-def test_the_spring_factor_keeps_its_triangle_permuted(rows):
+def test_the_spring_factor_keeps_its_triangle_permuted(rows, seam_cholesky):
     """The kept triangle, its rows' positions moved with it: on the diagonal (a bed's rows) or
     off it (rows that read several unknowns of one element), each ``H(w)`` is the permuted
     matrix's lower triangle and its factor solves ``K + σ diag(K) + Bᵀ diag(w) B``."""
-    _direct()
     model = build_model(families.grid_rigid(8, 3))
     K = sp.csc_matrix(model.K)
     n = K.shape[0]

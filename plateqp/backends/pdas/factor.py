@@ -223,23 +223,24 @@ class SpringFactor:
         n = self.s.size
         T = self._on(self.base)
         order = self.chol.order(T)
-        old_pos = self.pair_pos
-        diag = T.indptr[1:] - 1  # (an upper triangle's columns end at their diagonal)
-        col = np.searchsorted(T.indptr, old_pos, side="right") - 1
-        on_diag = np.array_equal(old_pos, diag[col])
-        if not on_diag:  # each entry's position as its value: where each new one came from
-            src = self.chol.permuted_lower(T, order, np.arange(self.nnz, dtype=float)).data.astype(np.int64)
+        col = np.searchsorted(T.indptr, self.pair_pos, side="right") - 1
+        on_diag = np.array_equal(self.pair_pos, T.indptr[1:][col] - 1)  # (an upper column ends at its diagonal)
+        if on_diag:  # rows on one unknown each (a bed): the values moved, the rows' positions read off below
+            M = self.chol.permuted_lower(T, order)
+            self.base = M.data
+        else:  # each entry's position as its value: where each new one came from
+            M = self.chol.permuted_lower(T, order, np.arange(self.nnz, dtype=float))
+            src = M.data.astype(np.int64)
             where = np.empty(self.nnz, dtype=np.int64)
             where[src] = np.arange(self.nnz)
-            del src
-        M = self.chol.permuted_lower(T, order)
+            self.base = self.base.take(src)
         self.chol.forget_matrix()
         del T
         inv = np.empty(n, dtype=np.int64)
         inv[order] = np.arange(n)
-        self.base, self.indices, self.indptr = M.data, M.indices, M.indptr
-        # rows on one unknown each (a bed): on the diagonal, the first entry of a sorted lower column
-        self.pair_pos = M.indptr[inv[col]] if on_diag else where.take(old_pos)
+        self.indices, self.indptr = M.indices, M.indptr
+        # on the diagonal: the first entry of a sorted lower column
+        self.pair_pos = M.indptr[inv[col]] if on_diag else where.take(self.pair_pos)
         self._touched = None
         self.order = order
 
