@@ -60,6 +60,17 @@ def test_registry():
     assert BFS().ndof == 16 and BFS().ndof_node == 4 and BFS().dof_names == ("w", "wx", "wy", "wxy")
 
 
+def test_coefficients_worked_out_once_and_read_only():
+    """Every instance of an element class shares one array of shape-function coefficients (built
+    once a process), and nothing can write into it: a change would reach every model after it."""
+    for cls in (ACM, BFS):
+        a, b = cls(), cls()
+        assert a._coef is b._coef and not a._coef.flags.writeable
+        with pytest.raises(ValueError):
+            a._coef[0, 0] = 1.0
+    assert ACM()._coef is not BFS()._coef
+
+
 def test_kronecker_property(el):
     """Dof k of shape function j is δ_kj (physical dofs, non-square cell)."""
     rows = [el.shape(cx, cy, HX, HY, dx, dy)[0] for cx, cy in CORNERS for dx, dy in el.node_dofs]

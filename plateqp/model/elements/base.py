@@ -53,6 +53,11 @@ def bending_matrix(D: float, nu: float) -> np.ndarray:
     return D * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - nu)]])
 
 
+#: each element class's shape-function coefficients, worked out once per process (0.8 ms a
+#: model: a Python loop over its monomials; a solve with a coarse prediction builds two models)
+_COEF: dict[type, np.ndarray] = {}
+
+
 class RectElement:
     """Base class: subclasses set ``name``, ``monomials`` and ``node_dofs``."""
 
@@ -67,14 +72,19 @@ class RectElement:
     holds_tangent_slope: bool = True
 
     def __init__(self) -> None:
-        # A[k, m]: dof k evaluated on monomial m, in reference coordinates
-        nd = len(self.node_dofs)
-        A = np.zeros((4 * nd, len(self.monomials)))
-        for c, (xi, eta) in enumerate(CORNERS):
-            for d, (dx, dy) in enumerate(self.node_dofs):
-                A[c * nd + d] = self._monomial_values(np.array([xi]), np.array([eta]), dx, dy)[0]
-        # coefficients of shape function k: column k of inv(A)
-        self._coef = np.linalg.inv(A)
+        coef = _COEF.get(type(self))
+        if coef is None:
+            # A[k, m]: dof k evaluated on monomial m, in reference coordinates
+            nd = len(self.node_dofs)
+            A = np.zeros((4 * nd, len(self.monomials)))
+            for c, (xi, eta) in enumerate(CORNERS):
+                for d, (dx, dy) in enumerate(self.node_dofs):
+                    A[c * nd + d] = self._monomial_values(np.array([xi]), np.array([eta]), dx, dy)[0]
+            # coefficients of shape function k: column k of inv(A)
+            coef = np.linalg.inv(A)
+            coef.setflags(write=False)
+            _COEF[type(self)] = coef
+        self._coef = coef
 
     @property
     def ndof_node(self) -> int:
