@@ -28,7 +28,10 @@ def row_stiffness(K, B, kind: str = "rayleigh", rho: np.ndarray | None = None) -
     if kind not in KINDS:
         raise ValueError(f"unknown kind {kind!r}; choose one of {KINDS}")
     B = sp.csr_matrix(B)
-    if kind == "diagonal":
+    counts = np.diff(B.indptr)
+    if counts.size and counts.max() <= 1:
+        k = _one_unknown(K, B, counts, kind)
+    elif kind == "diagonal":
         k = np.asarray(B.multiply(B) @ K.diagonal()).ravel()
     else:
         bb = np.asarray(B.multiply(B).sum(axis=1)).ravel()
@@ -41,3 +44,21 @@ def row_stiffness(K, B, kind: str = "rayleigh", rho: np.ndarray | None = None) -
     if rho is not None:
         k = k / (1.0 + rho * k)
     return k
+
+
+def _one_unknown(K, B: sp.csr_matrix, counts: np.ndarray, kind: str) -> np.ndarray:
+    """:func:`row_stiffness` where every row of ``B`` reads one unknown ``j`` at most (a bed's
+    rows, posts at nodes): ``b² K_jj`` or ``b² K_jj / (b²)²`` from ``K``'s diagonal alone, the
+    very products the general forms make for such a row (the same bits), without the product
+    ``K Bᵀ`` (21 ms of a 256² bed's KKT check)."""
+    rows = np.flatnonzero(counts)
+    b = B.data  # CSR: one entry per row that has one, in the order of the rows
+    d = np.asarray(K.diagonal()).ravel()[B.indices]
+    out = np.zeros(counts.size)
+    if kind == "diagonal":
+        out[rows] = (b * b) * d
+        return out
+    bKb, bb = out, np.zeros(counts.size)
+    bKb[rows] = (d * b) * b
+    bb[rows] = b * b
+    return bKb / np.maximum(bb, 1e-300) ** 2

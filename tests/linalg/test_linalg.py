@@ -325,6 +325,26 @@ def test_row_stiffness_closed_forms_and_bound():
         row_stiffness(K, B, "trace")
 
 
+def test_row_stiffness_rows_on_one_unknown():
+    """Rows that read one unknown each take the diagonal alone: the closed forms, worked out
+    densely here, and to the bit what the general products give."""
+    K = spd()
+    n = K.shape[0]
+    B = sp.csr_matrix((np.array([1.0, -0.6, 2.5]), ([0, 1, 2], [4, 20, 33])), shape=(3, n))
+    Bd, Kd = B.toarray(), K.toarray()
+    diag = (Bd**2) @ np.diag(Kd)
+    ray = np.einsum("ij,jk,ik->i", Bd, Kd, Bd) / (Bd**2).sum(axis=1) ** 2
+    np.testing.assert_allclose(row_stiffness(K, B, "diagonal"), diag, rtol=1e-15)
+    np.testing.assert_allclose(row_stiffness(K, B), ray, rtol=1e-15)
+    exact = 1.0 / np.diag(Bd @ np.linalg.inv(Kd) @ Bd.T)
+    assert np.all(row_stiffness(K, B) >= exact * (1 - 1e-12))
+    # the general products, forced by a second (zero) entry in one row
+    wide = sp.csr_matrix((np.array([1.0, -0.6, 2.5, 0.0]), ([0, 1, 2, 0], [4, 20, 33, 5])), shape=(3, n))
+    for kind in ("diagonal", "rayleigh"):
+        assert np.array_equal(row_stiffness(K, B, kind), row_stiffness(K, wide, kind))
+    assert np.array_equal(row_stiffness(sp.diags(K.diagonal()), B, "diagonal"), row_stiffness(K, B, "diagonal"))
+
+
 def test_cvxopt_options_are_not_left_changed_by_two_threads():
     """cvxopt's CHOLMOD options are one global dict. Two threads in ``_cvx_options`` at once
     left it changed (nmethods=1: every later analysis without a given order failed in that

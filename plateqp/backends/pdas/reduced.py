@@ -91,9 +91,10 @@ class ReducedQP:
         P = sp.csc_matrix(qp.P, dtype=float)  # stored zeros kept: the ordering reads them (linalg.pattern)
         G = sp.csc_matrix(qp.G, dtype=float)
         G.eliminate_zeros()
-        v, w = np.random.default_rng(0).standard_normal((2, n))
-        Pv = P @ v
-        if abs(v @ (P @ w) - w @ Pv) > 1e-10 * np.sqrt((Pv @ Pv) * (w @ w)) + 1e-300:
+        vw = np.random.default_rng(0).standard_normal((n, 2))
+        Pvw = P @ vw  # both products in one pass over P
+        v, w, Pv, Pw = vw[:, 0], vw[:, 1], Pvw[:, 0], Pvw[:, 1]
+        if abs(v @ Pw - w @ Pv) > 1e-10 * np.sqrt((Pv @ Pv) * (w @ w)) + 1e-300:
             raise SolverError("the pdas backend needs a symmetric P")  # a randomised check, O(nnz)
         d = P.diagonal()
         # separable: a positive diagonal, one row of G, no other non-zero in its column; the
