@@ -460,6 +460,14 @@ def test_a_wrong_null_space_hint_is_refused():
     wrong = QP(P=qp.P, q=qp.q, G=qp.G, h=qp.h, singular=True,
                null=np.random.default_rng(0).standard_normal(qp.null.shape))
     assert ReducedQP(wrong, 10**6).rigid() is None
+    for j in range(3):  # two rigid motions and one that is none: refused whichever column it is
+        one_off = qp.null.copy()
+        one_off[:, j] = np.random.default_rng(j).standard_normal(qp.null.shape[0])
+        assert ReducedQP(QP(P=qp.P, q=qp.q, G=qp.G, h=qp.h, singular=True, null=one_off), 10**6).rigid() is None
+    # a rigid motion off by more than rounding in one entry: refused too
+    near = qp.null.copy()
+    near[near.shape[0] // 2, 1] *= 1 + 1e-6
+    assert ReducedQP(QP(P=qp.P, q=qp.q, G=qp.G, h=qp.h, singular=True, null=near), 10**6).rigid() is None
     ref = pdas(_primal_qp(sc, True), accuracy=1e-10)
     out = pdas(wrong, accuracy=1e-10)
     assert out.status == ref.status == pq.Status.OPTIMAL
