@@ -287,6 +287,43 @@ def goals_section(df, figdir):
     return f"Goals met today: {hit} of {len(short)}.\n\n" + table(d[cols].astype(object).fillna(""))
 
 
+def floors_section(df, figdir):
+    d = df.copy()
+
+    def get(scene, mesh, quantity, col="value"):
+        hit = d[(d["scene"] == scene) & (d["mesh"] == mesh) & (d["quantity"] == quantity)]
+        return float(hit[col].iloc[0]) if len(hit) else float("nan")
+
+    lines = []
+    for mesh in sorted(d[d["scene"] == "grid"]["mesh"].unique(), key=lambda m: int(str(m).rstrip("²"))):
+        more = get("grid", mesh, "multiply-adds, posts last") / get("grid", mesh, "multiply-adds, CHOLMOD's order")
+        lines.append(
+            f"- Grid {mesh}: with the posts last, the one factorisation does {more:.1f}× the multiply-adds of "
+            f"CHOLMOD's own order and takes {get('grid', mesh, 'numeric factorisation, posts last', 'per_raw'):.2f} "
+            f"raw alone (in CHOLMOD's order: "
+            f"{get('grid', mesh, 'numeric factorisation, CHOLMOD' + chr(39) + 's order', 'per_raw'):.2f}); "
+            f"{get('grid', mesh, 'posts carrying the answer'):.0f} of {get('grid', mesh, 'posts'):.0f} posts carry "
+            "the answer.")
+    for mesh in d[d["scene"] == "bed"]["mesh"].unique():
+        q = d[(d["scene"] == "bed") & (d["mesh"] == mesh)]["quantity"]
+        load = next((x for x in q if "loads" in x and "(median)" in x), None)
+        modulus = next((x for x in q if "foundation.k" in x and "(median)" in x), None)
+        if load is None or modulus is None:
+            continue
+        lines.append(
+            f"- Bed {mesh}: a load value moves {get('bed', mesh, load):.0f} springs (median; up to "
+            f"{get('bed', mesh, load.replace('(median)', '(largest)')):.0f}), a modulus value changes "
+            f"{get('bed', mesh, modulus):.0f} (every spring in contact). One numeric refactorisation costs "
+            f"{get('bed', mesh, 'numeric refactorisation (analysis kept)', 'per_raw'):.2f} raw and one solve "
+            f"{get('bed', mesh, 'one solve, supernodal factor', 'per_raw'):.3f}; CHOLMOD's own update of 256 "
+            f"springs {get('bed', mesh, 'in-place downdate of 256 springs (simplicial factor)', 'per_raw'):.2f}, "
+            f"after {get('bed', mesh, 'in-place downdate of 1 spring on a fresh factor (its conversion)', 'per_raw'):.2f} "
+            "to make its factor simplicial, on which a solve costs "
+            f"{get('bed', mesh, 'one solve, simplicial factor (after an update)', 'per_raw'):.3f}.")
+    cols = ["floor", "mesh", "quantity", "value", "unit", "raw_s", "per_raw"]
+    return "\n".join(lines) + "\n\n" + table(d[cols].astype(object).fillna(""))
+
+
 def parts() -> dict[str, Part]:
     p = {}
     p["goals"] = Part(
@@ -295,6 +332,10 @@ def parts() -> dict[str, Part]:
         ["--meshes", "32", "--big", "", "--disc-sizes", "8", "--memory-meshes", "32", "--memory-disc", "8",
          "--sweep-mesh", "32", "--values", "3", "--repeat", "1", "--memory-repeat", "1", "--out", "OUT"],
         goals_section, "Speed goals")
+    p["floors"] = Part(
+        "floors", "bench_floors", "floors.csv", "floors.csv", ["--out", "OUT"],
+        ["--grid-meshes", "64", "--bed-mesh", "32", "--repeat", "1", "--out", "OUT"],
+        floors_section, "What the goals not met are up against")
     p["work-precision"] = Part(
         "work-precision", "bench_work_precision", "work-precision.csv", "work_precision.csv",
         ["--sizes", "16", "--timeout", "60"],

@@ -1,0 +1,224 @@
+"""What the speed goals not met are up against: the floors, measured.
+
+Three goals of the table in bench_goals.py stay out of reach; this script measures what bounds
+each from below, against the same "raw" (one cvxopt CHOLMOD symbolic analysis + numeric
+factorisation + solve of the plate's matrix, bench_fast.raw_cholmod; CPU time, one BLAS thread,
+medians of ``--repeat``):
+
+* ``grid`` (bench_fast's slab on four walls and 30 × 30 rigid posts, at ``--grid-meshes``): the
+  condensed method factorises K once with the posts' deflections ordered last (the trailing block
+  is the Schur complement on the posts, from which the flexibility follows). Rows: the numeric
+  factorisation of K in CHOLMOD's own order, and with the posts last (time, and multiply-adds
+  counted from the factor's supernodes), and how many posts carry the answer (pq.solve's
+  active set).
+* ``bed`` (bench_fast's free plate on a tensionless bed, at ``--bed-mesh``): a sweep of the
+  column's load or of the bed's modulus, 11 values as bench_sweep_reuse's. Rows: the springs
+  that change between two values (their median and largest count: a load step moves the contact
+  line, a modulus step changes every spring in contact), one numeric refactorisation of the
+  plate with every spring bonded on its kept analysis, and CHOLMOD's own in-place update of
+  ``k`` springs (``cholmod_l_updown`` in cvxopt's CHOLMOD, called through ctypes: scikit-sparse's
+  route, which cvxopt's binding does not expose), the first on a fresh factor apart (CHOLMOD turns
+  its supernodal factor into a simplicial one then).
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_floors.py [--grid-meshes 64,128] [--bed-mesh 128]
+
+Writes benchmarks/results/floors.csv (one row a quantity: value, unit, and value ÷ raw where
+it is a time) and prints it.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # before NumPy loads
+    os.environ.setdefault(_var, "1")
+
+import argparse
+import csv
+import ctypes
+import statistics
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+from bench_fast import ACCURACY, make_scene, plate_matrix, raw_cholmod, to_cvxopt  # noqa: E402
+from bench_sweep_reuse import values_for  # noqa: E402
+
+import plateqp as pq  # noqa: E402
+from plateqp.linalg import Cholesky, SchurFactor  # noqa: E402
+from plateqp.linalg import seam  # noqa: E402
+from plateqp.linalg.cholmod import lower  # noqa: E402
+from plateqp.model.assembly import build_model  # noqa: E402
+from plateqp.studies.sweep import sweep  # noqa: E402
+
+
+def cpu(fn) -> float:
+    t0 = time.process_time()
+    fn()
+    return time.process_time() - t0
+
+
+def median_raw(A, f, repeat: int) -> float:
+    Ac = to_cvxopt(A)
+    raw_cholmod(Ac, f)
+    return statistics.median(cpu(lambda: raw_cholmod(Ac, f)) for _ in range(repeat))
+
+
+def row(floor, scene, mesh, quantity, value, unit, raw=None) -> dict:
+    return {"floor": floor, "scene": scene, "mesh": f"{mesh}²", "quantity": quantity, "value": value, "unit": unit,
+            "raw_s": raw if raw is not None else "", "per_raw": value / raw if (raw and unit == "s") else ""}
+
+
+def grid_rows(n: int, repeat: int) -> list[dict]:
+    scene = make_scene("grid", n)
+    model = build_model(scene)
+    A, f = plate_matrix("grid", model)
+    raw = median_raw(A, f, repeat)
+    K = sp.csc_matrix(model.K)
+    posts = np.unique(model.contacts.B.tocsr().indices)
+
+    def plain():
+        ch = Cholesky("cvxopt")
+        T = lower(K, None, upper=ch.upper)
+        ch.analyse(T)
+        return ch, T
+
+    times, flops = [], None
+    for _ in range(repeat):
+        ch, T = plain()
+        times.append(cpu(lambda: ch.factor(T)))
+        flops = ch.flops()
+    last_t, last_flops = [], None
+    for _ in range(repeat):
+        S = SchurFactor(K, posts)
+        last_t.append(S.stats["factor_s"])  # its numeric factorisation alone (wall time; one BLAS thread)
+        last_flops = S.chol.flops()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = pq.solve(scene, accuracy=ACCURACY)
+    active = int(np.asarray(res.extras["active"]).sum())
+    return [row("grid", "grid", n, "numeric factorisation, CHOLMOD's order", statistics.median(times), "s", raw),
+            row("grid", "grid", n, "numeric factorisation, posts last", statistics.median(last_t), "s", raw),
+            row("grid", "grid", n, "multiply-adds, CHOLMOD's order", flops, "flop"),
+            row("grid", "grid", n, "multiply-adds, posts last", last_flops, "flop"),
+            row("grid", "grid", n, "posts", float(posts.size), "count"),
+            row("grid", "grid", n, "posts carrying the answer", float(active), "count")]
+
+
+def _updown(ch: Cholesky, C: sp.csc_matrix, update: bool) -> None:
+    """``L Lᵀ ± C Cᵀ`` in place by CHOLMOD's cholmod_l_updown (C's rows in the factor's order)."""
+    d = ch.direct
+    fn = d.s.c.cholmod_l_updown
+    fn.argtypes = [ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
+    fn.restype = ctypes.c_int
+    C = sp.csc_matrix(C)
+    C.sort_indices()
+    p, i = C.indptr.astype(np.int64), C.indices.astype(np.int64)
+    x = np.ascontiguousarray(C.data, dtype=float)
+    S = seam._Sparse(C.shape[0], C.shape[1], int(p[-1]), p.ctypes.data, i.ctypes.data, None, x.ctypes.data, None, 0,
+                     seam._ITYPE_LONG, seam._XTYPE_REAL, seam._DTYPE_DOUBLE, 1, 1)
+    if not fn(1 if update else 0, ctypes.byref(S), d.L, d.cm):
+        raise RuntimeError("cholmod_l_updown failed")
+
+
+def bed_rows(n: int, repeat: int) -> list[dict]:
+    scene = make_scene("bed", n)
+    model = build_model(scene)
+    A, f = plate_matrix("bed", model)
+    raw = median_raw(A, f, repeat)
+    out = []
+    for kind in ("load", "stiffness"):
+        path, vals = values_for("bed", scene, 11, kind)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = sweep(scene, path, vals, accuracy=ACCURACY, executor="serial", progress=False,
+                        refine_breakpoints=False)
+        sets = [np.asarray(r["active"], dtype=bool) for r in res.rows]
+        if kind == "load":
+            moved = [int((a ^ b).sum()) for a, b in zip(sets, sets[1:])]
+        else:  # every spring in contact at either value changes its stiffness
+            moved = [int((a | b).sum()) for a, b in zip(sets, sets[1:])]
+        out += [row("bed", "bed", n, f"springs changed a value, {path} (median)", float(np.median(moved)), "count"),
+                row("bed", "bed", n, f"springs changed a value, {path} (largest)", float(max(moved)), "count")]
+    T = sp.triu(A, format="csc")
+    T.sort_indices()
+    ch = Cholesky("cvxopt")
+    if ch.direct is None:
+        raise SystemExit("bench_floors needs cvxopt's CHOLMOD through plateqp's seam")
+    ch.analyse(T)
+    ch.factor(T)
+    out.append(row("bed", "bed", n, "numeric refactorisation (analysis kept)",
+                   statistics.median(cpu(lambda: ch.factor(T)) for _ in range(repeat)), "s", raw))
+    # springs along a ring (a contact line), in the factor's order
+    c = model.contacts
+    perm = seam.view(int(seam.view(ch.direct.L.value, 3, np.uint64)[seam._PERM]), A.shape[0], np.int64)
+    where = np.empty_like(perm)
+    where[perm] = np.arange(perm.size)
+    centre = c.xy.mean(axis=0)
+    radius = np.hypot(*(c.xy - centre).T)
+    ring = np.argsort(np.abs(radius - 0.3 * radius.max()))
+    Bc = c.B.tocsr()
+
+    def springs(k):
+        rows = np.sort(ring[:k])
+        Br = Bc[rows].tocoo()
+        w = np.sqrt(1.0 / c.rho[rows])
+        return sp.csc_matrix((w[Br.row] * Br.data, (where[Br.col], Br.row)), shape=(A.shape[0], k))
+
+    first = []
+    for _ in range(repeat):
+        ch.analyse(T)  # a factor CHOLMOD updated is simplicial: a new analysis makes it supernodal again
+        ch.factor(T)
+        first.append(cpu(lambda: _updown(ch, springs(1), False)))
+        _updown(ch, springs(1), True)
+    out.append(row("bed", "bed", n, "in-place downdate of 1 spring on a fresh factor (its conversion)",
+                   statistics.median(first), "s", raw))
+    for k in (16, 64, 256):
+        C = springs(k)
+        t = []
+        for _ in range(repeat):
+            t.append(cpu(lambda: _updown(ch, C, False)))
+            _updown(ch, C, True)
+        out.append(row("bed", "bed", n, f"in-place downdate of {k} springs (simplicial factor)",
+                       statistics.median(t), "s", raw))
+    simplicial = statistics.median(cpu(lambda: ch.solve(f)) for _ in range(repeat))
+    ch.analyse(T)
+    ch.factor(T)
+    supernodal = statistics.median(cpu(lambda: ch.solve(f)) for _ in range(repeat))
+    out += [row("bed", "bed", n, "one solve, supernodal factor", supernodal, "s", raw),
+            row("bed", "bed", n, "one solve, simplicial factor (after an update)", simplicial, "s", raw)]
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--grid-meshes", default="64,128")
+    ap.add_argument("--bed-mesh", type=int, default=128)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--out", default=str(HERE / "results" / "floors.csv"))
+    a = ap.parse_args()
+    rows = []
+    for n in (int(x) for x in a.grid_meshes.split(",") if x.strip()):
+        rows += grid_rows(n, a.repeat)
+    if a.bed_mesh:
+        rows += bed_rows(a.bed_mesh, a.repeat)
+    print("| floor | mesh | quantity | value | unit | ÷ raw |")
+    print("|---|---|---|---|---|---|")
+    for r in rows:
+        ratio = f"{r['per_raw']:.3g}" if r["per_raw"] != "" else ""
+        print(f"| {r['floor']} | {r['mesh']} | {r['quantity']} | {r['value']:.4g} | {r['unit']} | {ratio} |", flush=True)
+    with open(a.out, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print(f"wrote {a.out}")
+
+
+if __name__ == "__main__":
+    main()
