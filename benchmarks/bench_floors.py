@@ -34,11 +34,9 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # b
     os.environ.setdefault(_var, "1")
 
 import argparse
-import csv
 import ctypes
 import statistics
 import sys
-import time
 import warnings
 from pathlib import Path
 
@@ -47,8 +45,9 @@ import scipy.sparse as sp
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
-from bench_fast import ACCURACY, make_scene, plate_matrix, raw_cholmod, to_cvxopt  # noqa: E402
+from bench_fast import ACCURACY, make_scene, plate_matrix, raw_cholmod, to_cvxopt, write_csv  # noqa: E402
 from bench_sweep_reuse import values_for  # noqa: E402
+from timing import cpu  # noqa: E402
 
 import plateqp as pq  # noqa: E402
 from plateqp.linalg import Cholesky, SchurFactor  # noqa: E402
@@ -58,20 +57,19 @@ from plateqp.model.assembly import build_model  # noqa: E402
 from plateqp.studies.sweep import sweep  # noqa: E402
 
 
-def cpu(fn) -> float:
-    t0 = time.process_time()
-    fn()
-    return time.process_time() - t0
+def median_cpu(fn, repeat: int) -> float:
+    """The median CPU time of ``repeat`` calls of ``fn``."""
+    return statistics.median(cpu(fn)[0] for _ in range(repeat))
 
 
 def median_raw(A, f, repeat: int) -> float:
     Ac = to_cvxopt(A)
     raw_cholmod(Ac, f)
-    return statistics.median(cpu(lambda: raw_cholmod(Ac, f)) for _ in range(repeat))
+    return median_cpu(lambda: raw_cholmod(Ac, f), repeat)
 
 
-def row(floor, scene, mesh, quantity, value, unit, raw=None) -> dict:
-    return {"floor": floor, "scene": scene, "mesh": f"{mesh}²", "quantity": quantity, "value": value, "unit": unit,
+def row(scene, mesh, quantity, value, unit, raw=None) -> dict:
+    return {"scene": scene, "mesh": f"{mesh}²", "quantity": quantity, "value": value, "unit": unit,
             "raw_s": raw if raw is not None else "", "per_raw": value / raw if (raw and unit == "s") else ""}
 
 
@@ -92,7 +90,7 @@ def grid_rows(n: int, repeat: int) -> list[dict]:
     times, flops = [], None
     for _ in range(repeat):
         ch, T = plain()
-        times.append(cpu(lambda: ch.factor(T)))
+        times.append(cpu(lambda: ch.factor(T))[0])
         flops = ch.flops()
     last_t, last_flops = [], None
     for _ in range(repeat):
@@ -103,16 +101,17 @@ def grid_rows(n: int, repeat: int) -> list[dict]:
         warnings.simplefilter("ignore")
         res = pq.solve(scene, accuracy=ACCURACY)
     active = int(np.asarray(res.extras["active"]).sum())
-    return [row("grid", "grid", n, "numeric factorisation, CHOLMOD's order", statistics.median(times), "s", raw),
-            row("grid", "grid", n, "numeric factorisation, posts last", statistics.median(last_t), "s", raw),
-            row("grid", "grid", n, "multiply-adds, CHOLMOD's order", flops, "flop"),
-            row("grid", "grid", n, "multiply-adds, posts last", last_flops, "flop"),
-            row("grid", "grid", n, "posts", float(posts.size), "count"),
-            row("grid", "grid", n, "posts carrying the answer", float(active), "count")]
+    return [row("grid", n, "numeric factorisation, CHOLMOD's order", statistics.median(times), "s", raw),
+            row("grid", n, "numeric factorisation, posts last", statistics.median(last_t), "s", raw),
+            row("grid", n, "multiply-adds, CHOLMOD's order", flops, "flop"),
+            row("grid", n, "multiply-adds, posts last", last_flops, "flop"),
+            row("grid", n, "posts", float(posts.size), "count"),
+            row("grid", n, "posts carrying the answer", float(active), "count")]
 
 
-def _updown(ch: Cholesky, C: sp.csc_matrix, update: bool) -> None:
-    """``L Lᵀ ± C Cᵀ`` in place by CHOLMOD's cholmod_l_updown (C's rows in the factor's order)."""
+def _updown(ch: Cholesky, C: sp.csc_matrix):
+    """``updown(update)``: ``L Lᵀ ± C Cᵀ`` in place by CHOLMOD's cholmod_l_updown (C's rows in
+    the factor's order), C handed to CHOLMOD once, before any call is timed."""
     d = ch.direct
     fn = d.s.c.cholmod_l_updown
     fn.argtypes = [ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
@@ -123,8 +122,12 @@ def _updown(ch: Cholesky, C: sp.csc_matrix, update: bool) -> None:
     x = np.ascontiguousarray(C.data, dtype=float)
     S = seam._Sparse(C.shape[0], C.shape[1], int(p[-1]), p.ctypes.data, i.ctypes.data, None, x.ctypes.data, None, 0,
                      seam._ITYPE_LONG, seam._XTYPE_REAL, seam._DTYPE_DOUBLE, 1, 1)
-    if not fn(1 if update else 0, ctypes.byref(S), d.L, d.cm):
-        raise RuntimeError("cholmod_l_updown failed")
+
+    def updown(update: bool, arrays=(p, i, x)) -> None:  # the arrays S points into, held as long as it
+        if not fn(1 if update else 0, ctypes.byref(S), d.L, d.cm):
+            raise RuntimeError("cholmod_l_updown failed")
+
+    return updown
 
 
 def bed_rows(n: int, repeat: int) -> list[dict]:
@@ -144,8 +147,8 @@ def bed_rows(n: int, repeat: int) -> list[dict]:
             moved = [int((a ^ b).sum()) for a, b in zip(sets, sets[1:])]
         else:  # every spring in contact at either value changes its stiffness
             moved = [int((a | b).sum()) for a, b in zip(sets, sets[1:])]
-        out += [row("bed", "bed", n, f"springs changed a value, {path} (median)", float(np.median(moved)), "count"),
-                row("bed", "bed", n, f"springs changed a value, {path} (largest)", float(max(moved)), "count")]
+        out += [row("bed", n, f"springs changed a value, {path} (median)", float(np.median(moved)), "count"),
+                row("bed", n, f"springs changed a value, {path} (largest)", float(max(moved)), "count")]
     T = sp.triu(A, format="csc")
     T.sort_indices()
     ch = Cholesky("cvxopt")
@@ -153,8 +156,8 @@ def bed_rows(n: int, repeat: int) -> list[dict]:
         raise SystemExit("bench_floors needs cvxopt's CHOLMOD through plateqp's seam")
     ch.analyse(T)
     ch.factor(T)
-    out.append(row("bed", "bed", n, "numeric refactorisation (analysis kept)",
-                   statistics.median(cpu(lambda: ch.factor(T)) for _ in range(repeat)), "s", raw))
+    out.append(row("bed", n, "numeric refactorisation (analysis kept)", median_cpu(lambda: ch.factor(T), repeat),
+                   "s", raw))
     # springs along a ring (a contact line), in the factor's order
     c = model.contacts
     perm = seam.view(int(seam.view(ch.direct.L.value, 3, np.uint64)[seam._PERM]), A.shape[0], np.int64)
@@ -175,24 +178,25 @@ def bed_rows(n: int, repeat: int) -> list[dict]:
     for _ in range(repeat):
         ch.analyse(T)  # a factor CHOLMOD updated is simplicial: a new analysis makes it supernodal again
         ch.factor(T)
-        first.append(cpu(lambda: _updown(ch, springs(1), False)))
-        _updown(ch, springs(1), True)
-    out.append(row("bed", "bed", n, "in-place downdate of 1 spring on a fresh factor (its conversion)",
+        one = _updown(ch, springs(1))
+        first.append(cpu(lambda: one(False))[0])
+        one(True)
+    out.append(row("bed", n, "in-place downdate of 1 spring on a fresh factor (its conversion)",
                    statistics.median(first), "s", raw))
     for k in (16, 64, 256):
-        C = springs(k)
+        updown = _updown(ch, springs(k))
         t = []
         for _ in range(repeat):
-            t.append(cpu(lambda: _updown(ch, C, False)))
-            _updown(ch, C, True)
-        out.append(row("bed", "bed", n, f"in-place downdate of {k} springs (simplicial factor)",
-                       statistics.median(t), "s", raw))
-    simplicial = statistics.median(cpu(lambda: ch.solve(f)) for _ in range(repeat))
+            t.append(cpu(lambda: updown(False))[0])
+            updown(True)
+        out.append(row("bed", n, f"in-place downdate of {k} springs (simplicial factor)", statistics.median(t), "s",
+                       raw))
+    simplicial = median_cpu(lambda: ch.solve(f), repeat)
     ch.analyse(T)
     ch.factor(T)
-    supernodal = statistics.median(cpu(lambda: ch.solve(f)) for _ in range(repeat))
-    out += [row("bed", "bed", n, "one solve, supernodal factor", supernodal, "s", raw),
-            row("bed", "bed", n, "one solve, simplicial factor (after an update)", simplicial, "s", raw)]
+    supernodal = median_cpu(lambda: ch.solve(f), repeat)
+    out += [row("bed", n, "one solve, supernodal factor", supernodal, "s", raw),
+            row("bed", n, "one solve, simplicial factor (after an update)", simplicial, "s", raw)]
     return out
 
 
@@ -208,15 +212,12 @@ def main():
         rows += grid_rows(n, a.repeat)
     if a.bed_mesh:
         rows += bed_rows(a.bed_mesh, a.repeat)
-    print("| floor | mesh | quantity | value | unit | ÷ raw |")
+    print("| scene | mesh | quantity | value | unit | ÷ raw |")
     print("|---|---|---|---|---|---|")
     for r in rows:
         ratio = f"{r['per_raw']:.3g}" if r["per_raw"] != "" else ""
-        print(f"| {r['floor']} | {r['mesh']} | {r['quantity']} | {r['value']:.4g} | {r['unit']} | {ratio} |", flush=True)
-    with open(a.out, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+        print(f"| {r['scene']} | {r['mesh']} | {r['quantity']} | {r['value']:.4g} | {r['unit']} | {ratio} |", flush=True)
+    write_csv(rows, a.out)
     print(f"wrote {a.out}")
 
 

@@ -320,7 +320,7 @@ def floors_section(df, figdir):
             f"after {get('bed', mesh, 'in-place downdate of 1 spring on a fresh factor (its conversion)', 'per_raw'):.2f} "
             "to make its factor simplicial, on which a solve costs "
             f"{get('bed', mesh, 'one solve, simplicial factor (after an update)', 'per_raw'):.3f}.")
-    cols = ["floor", "mesh", "quantity", "value", "unit", "raw_s", "per_raw"]
+    cols = ["scene", "mesh", "quantity", "value", "unit", "raw_s", "per_raw"]
     return "\n".join(lines) + "\n\n" + table(d[cols].astype(object).fillna(""))
 
 
