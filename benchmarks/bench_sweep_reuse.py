@@ -42,7 +42,7 @@ import numpy as np
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
-from bench_fast import ACCURACY, make_scene, plate_matrix, raw_cholmod, to_cvxopt  # noqa: E402
+from bench_fast import ACCURACY, accuracy_above, make_scene, plate_matrix, raw_cholmod, to_cvxopt  # noqa: E402
 
 from plateqp.model.assembly import build_model  # noqa: E402
 from plateqp.studies.sweep import sweep  # noqa: E402
@@ -70,16 +70,35 @@ def values_for(scene_kind: str, scene, count: int, kind: str):
     return "foundation.k", list(np.geomspace(1.0e4, 4.0e4, count))
 
 
-def run_sweep(scene, path, vals):
+def run_sweep(scene, path, vals, accuracy=ACCURACY, check=True):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         t0 = time.process_time()
-        r = sweep(scene, path, vals, accuracy=ACCURACY, executor="serial", progress=False, refine_breakpoints=False)
+        r = sweep(scene, path, vals, accuracy=accuracy, executor="serial", progress=False, refine_breakpoints=False)
         dt = time.process_time() - t0
     bad = [row for row in r.rows if row["status"] != "optimal"]
-    if bad:
-        raise SystemExit(f"{scene.name} {path}: {len(bad)} rows not OPTIMAL: {bad[0]['status']} {bad[0]['error']}")
+    if bad and check:
+        raise SystemExit(f"{scene.name} {path}: {len(bad)} rows not OPTIMAL at {accuracy:g}: {bad[0]['status']} "
+                         f"{bad[0]['error']}")
     return dt, r
+
+
+def reachable(scene, path, vals) -> float:
+    """The accuracy asked of the timed sweeps: 1e-10, or where a value's answer is not OPTIMAL
+    there only because 1e-10 lies below its rounding floor (the bed from 96²: the statics of the
+    plate sinking into it), the step above three times the largest floor of the sweep
+    (:func:`bench_fast.accuracy_above`). Any other failure stops the run."""
+    _, r = run_sweep(scene, path, vals, check=False)
+    floors = []
+    for row in r.rows:
+        if row["status"] == "optimal":
+            continue
+        k = row.get("kkt") or {}
+        others = [k.get(n, float("inf")) for n in ("spring", "primal", "dual", "complementarity", "natural")]
+        if not k or k["stationarity"] > k["floor"] or max(others) > k["tol"]:  # not at its floor: a failure
+            raise SystemExit(f"{scene.name} {path}: a value not OPTIMAL above its floor: {row['status']} {row['error']}")
+        floors.append(k["floor"])
+    return accuracy_above(max(floors)) if floors else ACCURACY
 
 
 def row_for(kind: str, n: int, values: int, repeats: int, sweep_kind: str) -> dict:
@@ -87,22 +106,22 @@ def row_for(kind: str, n: int, values: int, repeats: int, sweep_kind: str) -> di
     A, f = plate_matrix(kind, build_model(scene))
     Ac = to_cvxopt(A)
     path, vals = values_for(kind, scene, values, sweep_kind)
-    run_sweep(scene, path, vals[:2])  # imports and first-use costs out of the clock
+    acc = reachable(scene, path, vals)  # also pays imports and first-use costs out of the clock
     times = {"raw": [], "one": [], "all": []}
     kkt, route = [], None
     for _ in range(repeats):
         t0 = time.process_time()
         raw_cholmod(Ac, f)
         times["raw"].append(time.process_time() - t0)
-        times["one"].append(run_sweep(scene, path, vals[:1])[0])
-        dt, r = run_sweep(scene, path, vals)
+        times["one"].append(run_sweep(scene, path, vals[:1], acc)[0])
+        dt, r = run_sweep(scene, path, vals, acc)
         times["all"].append(dt)
         kkt += [row["kkt_worst"] for row in r.rows]
         route = f"{r.rows[-1]['backend']}/{r.rows[-1]['formulation']}"
     med = {k: statistics.median(v) for k, v in times.items()}
     per = (med["all"] - med["one"]) / (values - 1)
     return {"scene": kind, "mesh": n, "sweep": sweep_kind, "path": path, "values": values, "repeats": repeats,
-            "route": route, "raw_s": med["raw"], "first_value_s": med["one"], "sweep_s": med["all"],
+            "route": route, "accuracy": acc, "raw_s": med["raw"], "first_value_s": med["one"], "sweep_s": med["all"],
             "per_value_s": per, "per_value_ratio": per / med["raw"], "first_ratio": med["one"] / med["raw"],
             "goal_met": per / med["raw"] <= GOAL, "kkt_worst": max(kkt), "all_optimal": True}
 

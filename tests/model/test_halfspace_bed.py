@@ -31,14 +31,16 @@ def test_a_rigid_circular_punch_settles_as_boussinesq_says():
     """A disc 1e3 times stiffer than the soil (E_p h³ / (E_s a³) = 1e3) under a central P: it
     settles P (1 − ν²)/(2 a E) within 2 % on R/16 triangles, the error falling as the mesh
     halves; every node in contact, Σ R = P; the pressure rises towards the edge (the punch's
-    1/√(a² − r²))."""
+    1/√(a² − r²)). Asked 1e-6: the stiff disc sinks into the soil as a body, and the statics of
+    that motion have a rounding floor of 2.5e-7 at R/16 (plateqp.contact.kkt): at 1e-8 its
+    total reaction was 9e-9 off, on the edge of the accuracy asked."""
     P, a = 1e5, 1.0
     errs = []
     for n in (8, 16):
         res = pq.solve(disc(a, a / n, 0.5, 1e3 * E_SOIL * a**3 / 0.5**3, [pq.PointLoad(P=P, x=0.0, y=0.0)]),
-                       accuracy=1e-8)
+                       accuracy=1e-6)
         assert res.status == pq.Status.OPTIMAL and res.kkt.ok and res.active.all()
-        assert res.reactions.sum() == pytest.approx(P, rel=1e-8)
+        assert res.reactions.sum() == pytest.approx(P, rel=1e-6)
         ref = P * (1 - NU_SOIL**2) / (2 * a * E_SOIL)
         errs.append(abs(res.deflection(0.0, 0.0) / ref - 1))
         r = np.hypot(*res.model.contacts.xy.T)
