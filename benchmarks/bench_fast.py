@@ -147,9 +147,9 @@ def accuracy_above(floor: float) -> float:
 
 def reachable(scene, model) -> float:
     """The accuracy asked of the timed solves: 1e-10, or, where the plate's rounding floor lies
-    above it (the bed from 96²: its statics along the rigid motions, the sinking plate's; no
-    answer in double precision shows 1e-10 there, and the solve says so), the first step of 1,
-    2, 5 × 10ᵏ at or above three times that floor (:func:`accuracy_above`)."""
+    above it (the bed from 256²: the norm of its stationarity residual over every dof; no answer
+    in double precision shows 1e-10 there, and the solve says so), the first step of 1, 2, 5 ×
+    10ᵏ at or above three times that floor (:func:`accuracy_above`)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", pq.PlateQPWarning)
         r = pq.solve(scene, accuracy=ACCURACY, model=model)

@@ -5,8 +5,8 @@ CHOLMOD symbolic analysis + numeric factorisation + solve of the same plate matr
 directly (``bench_fast.raw_cholmod``), the steps interleaved in one process, medians of
 ``--repeat`` (one run from 512²). Every timed solve must pass its KKT check at accuracy 1e-10
 (a failed check stops the run), or, where the plate's rounding floor lies above 1e-10 (the bed
-from 96²: the statics of the plate sinking into it), at the first step of 1, 2, 5 × 10ᵏ at or
-above three times that floor (column ``accuracy``). The rows:
+from 256²), at the first step of 1, 2, 5 × 10ᵏ at or above three times that floor (column
+``accuracy``). The rows:
 
 * ``solve``: the whole ``pq.solve(scene, accuracy=1e-10)`` (assembly included) on bench_fast's
   grid (a slab on four walls, 30 × 30 rigid posts) and bed (a free plate on a tensionless bed)

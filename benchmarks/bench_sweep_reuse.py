@@ -85,8 +85,8 @@ def run_sweep(scene, path, vals, accuracy=ACCURACY, check=True):
 
 def reachable(scene, path, vals) -> float:
     """The accuracy asked of the timed sweeps: 1e-10, or where a value's answer is not OPTIMAL
-    there only because 1e-10 lies below its rounding floor (the bed from 96²: the statics of the
-    plate sinking into it), the step above three times the largest floor of the sweep
+    there only because 1e-10 lies below its rounding floor (the bed from 256²), the step above
+    three times the largest floor of the sweep
     (:func:`bench_fast.accuracy_above`). Any other failure stops the run."""
     _, r = run_sweep(scene, path, vals, check=False)
     floors = []

@@ -32,9 +32,8 @@ from .scaling import Scaled
 #   on families.floating(n, k), 9–81 posts, CPU medians of 3, accuracy 1e-10, PDAS took
 #   1.05–1.4× BPP's time then (0.04–0.05 s at 32², 0.13–0.15 s at 64², 0.76–1.0 s at 128²),
 #   but at 128² BPP's answers were INACCURATE (KKT 1–2e-10: the condensation of a singular K,
-#   shifted and unshifted, costs digits) where PDAS's were at 1–2e-11 (stationarity's norm; the
-#   statics along the slab's rigid motions, checked since, put both at 3–16e-10 there, under
-#   their rounding floor of 1.6–4.1e-9). Now
+#   shifted and unshifted, costs digits) where PDAS's were at 1–2e-11 (the statics along the
+#   slab's rigid motions, checked since, put BPP's at 4–16e-10 there, PDAS's at 3e-13). Now
 #   PDAS's exact steps run on the anchored factorisation itself (pdas.factor.TrailingFactor):
 #   0.67–0.96× BPP's time (benchmarks/bench_floating.py, interleaved).
 # * which backend, read from the declared capabilities (plateqp.backends.base.Backend): an

@@ -56,7 +56,8 @@ def test_the_matrix_free_route_answers_as_the_soil_unknowns_route(n, edges, regi
         assert res.model.soil_flexibility is not None
         if res.status != pq.Status.OPTIMAL:
             return
-        # (1e-9: a plate on the soil moves as a body; its statics' rounding floor reaches 2e-10)
+        # (1e-9: a plate on the soil moves as a body, and the condensed route's reactions carry
+        # K u's rounding along that motion, up to 2e-10 of the load here)
         ref = pq.solve(scene, model=build_model(scene, soil_operator=False), accuracy=1e-9)
     if ref.status != pq.Status.OPTIMAL:
         return

@@ -53,14 +53,13 @@ def formulas(d: Scaled, u: np.ndarray, R: np.ndarray, s: np.ndarray, tol: float)
     delta = max(np.abs(w).max(), np.abs(d.g0).max(), np.abs(u[d.is_w]).max())
     delta = max(delta, min(floor / tol, 1.0) * d.w_load)
     st = max(st, (st - 10.0 * floor) * d.w_load / delta)
-    # statics along each rigid motion the two-sided supports leave free, and its own floor
-    KU, BR = np.abs(K) @ np.abs(u), np.abs(B).T @ np.abs(R)
+    # statics along each rigid motion the two-sided supports leave free
+    BR = np.abs(B).T @ np.abs(R)
     for j in range(d.modes.shape[1]):
         V = d.modes[:, j]
         size = max(sum(abs(V[i] * d.f[i]) for i in range(d.n)), sum(abs(V[i]) * BR[i] for i in range(d.n)),
                    force * np.abs(V).max())
         st = max(st, abs(sum(V[i] * (d.f[i] - BtR[i]) for i in range(d.n))) / size)
-        floor = max(floor, EPS * sum(abs(V[i]) * KU[i] for i in range(d.n)) / size)
     load = np.abs(d.f).sum()
     rho_R = np.abs(R).max() if np.abs(R).max() > tol * load else load
     gap = [d.g0[i] + s[i] - w[i] for i in range(d.m)]

@@ -31,9 +31,9 @@ def test_a_rigid_circular_punch_settles_as_boussinesq_says():
     """A disc 1e3 times stiffer than the soil (E_p h³ / (E_s a³) = 1e3) under a central P: it
     settles P (1 − ν²)/(2 a E) within 2 % on R/16 triangles, the error falling as the mesh
     halves; every node in contact, Σ R = P; the pressure rises towards the edge (the punch's
-    1/√(a² − r²)). Asked 1e-6: the stiff disc sinks into the soil as a body, and the statics of
-    that motion have a rounding floor of 2.5e-7 at R/16 (plateqp.contact.kkt): at 1e-8 its
-    total reaction was 9e-9 off, on the edge of the accuracy asked."""
+    1/√(a² − r²)). Asked 1e-6: the stiff disc sinks into the soil as a body, and the condensed
+    route's reactions carry K u's rounding along that motion (up to ε Vᵀ|K||u| = 2.5e-7 of the
+    load at R/16): at 1e-8 the total reaction was 9e-9 off, on the edge of the accuracy asked."""
     P, a = 1e5, 1.0
     errs = []
     for n in (8, 16):

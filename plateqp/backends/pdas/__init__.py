@@ -45,7 +45,9 @@ Contract:
 - **Accuracy.** A direct method: at every preset the final set is solved to rounding; the
   presets set only ``feas_tol`` (a negative reaction or gap counted as zero) and
   ``accept_tol``, the residual (relative natural and stationarity) above which the answer is
-  ``INACCURATE``.
+  ``INACCURATE``. Where the QP names the plate's rigid motions (``QP.null``), the sparse
+  method's residual leaves out K u's part along them (its rounding, where the plate moves far
+  as a body): the reactions balance the load along them to rounding of the load.
 
 Layout: :mod:`.reduced` (the contact problem, the exchange rule), :mod:`.dense`,
 :mod:`.sparse`, :mod:`.motions` (free rigid motions), :mod:`.factor` (the sparse method's

@@ -76,9 +76,18 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     n_max = INNER_EXACT if exact else INNER_LOOSE
     solves = 0
     res = np.inf
+    # the plate's rigid motions V (a floating plate's, a hinged one's turn): K's rounding, ε|K||u|
+    # and more where the plate moves far as a body, would pass into the reactions' balance along
+    # them (Vᵀ(f − BᵀΛ) = VᵀKu = 0 exactly in the model); the residual's V-part is taken without
+    # it, (I − V(VᵀV)⁻¹Vᵀ)K u, so the refinement ends on reactions that balance the load along V
+    V = pb.rigid()
+    lift = None if V is None or V.shape[1] == 0 else V @ np.linalg.inv(V.T @ V)
     for k in range(n_max + 1):
         BtL = BA.T @ lamA
-        r_u = pb.f - times(pb.K, u) - BtL
+        Ku = times(pb.K, u)
+        if lift is not None:
+            Ku = Ku - lift @ (V.T @ Ku)
+        r_u = pb.f - Ku - BtL
         r_A = BA @ u - gA - rhoA * lamA
         # the rows' scale from the terms that make B u (|B_A||u|), not from B u itself: on a bed
         # whose soil has unknowns, B u = w − v is rounding where the bed touches at zero gap
