@@ -92,12 +92,16 @@ def test_a_sweep_of_the_soils_heave_is_the_condensed_lcps():
 def test_a_planar_gap_sweep_pays_one_solve_per_value(solves):
     """The benchmark's bed sweep (bench_sweep_reuse: the gap's slope): a planar gap moves a free
     plate rigidly, so every value has the first one's reactions (statics and kinematics: no
-    strain changes), and its step, on the kept factor of that set, is one solve."""
+    strain changes), and its step, on the kept factor of that set, is one solve. (That solve
+    leaves the reactions' balance along the plate's rigid motions at K u's rounding: the
+    correction along them takes the three columns H⁻¹V, solved once on the kept factor, at the
+    second value: one block solve more, then none.)"""
     scene = bed(24)
     res = quiet(sweep, scene, "foundation.gap.gx", GAPS, **SWEEP)
     assert all(r["status"] == "optimal" and r["kkt_worst"] <= 1e-10 for r in res.rows)
     assert len(solves) == len(GAPS)  # one solve of the problem a value
-    assert solves[1:] == [1] * (len(GAPS) - 1), f"solves per value: {solves}"  # (the first is a cold solve)
+    # (the first is a cold solve)
+    assert solves[1] <= 2 and solves[2:] == [1] * (len(GAPS) - 2), f"solves per value: {solves}"
     R0 = np.array(res.rows[0]["reactions"])
     for row in res.rows[1:]:
         assert row["active"] == res.rows[0]["active"]

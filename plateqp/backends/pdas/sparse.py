@@ -45,7 +45,7 @@ from .options import (
     PCG_TOL,
     SINGULAR_QUOTIENT,
 )
-from .reduced import ReducedQP, at_rounding, infeasible
+from .reduced import ROUNDING_STOP, ReducedQP, at_rounding, infeasible
 
 __all__ = ["SpringFactor", "solve_active"]
 
@@ -81,7 +81,12 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     # them (Vᵀ(f − BᵀΛ) = VᵀKu = 0 exactly in the model); the residual's V-part is taken without
     # it, (I − V(VᵀV)⁻¹Vᵀ)K u, so the refinement ends on reactions that balance the load along V
     V = pb.rigid()
-    lift = None if V is None or V.shape[1] == 0 else V @ np.linalg.inv(V.T @ V)
+    lift = None
+    if V is not None and V.shape[1]:
+        kept = getattr(pb, "_lift", None)  # one V(VᵀV)⁻¹ a problem (and its sweep's copies)
+        if kept is None or kept[0] is not V:
+            kept = pb._lift = (V, V @ np.linalg.inv(V.T @ V))
+        lift = kept[1]
     for k in range(n_max + 1):
         BtL = BA.T @ lamA
         Ku = times(pb.K, u)
@@ -100,7 +105,15 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
         # another correction would not change the answer; not before the first correction where
         # the factor carries a shift (σ > 0): that correction is also the singular step's test
         if exact and (k >= 1 or sigma == 0.0) and at_rounding(pb, u, idx, BA, lamA, r_u, r_A):
-            break
+            if lift is None or balanced(pb, V, BtL, absBA, lamA):
+                break
+            # (not on a shifted factor: σD is all that holds it along V there, and H⁻¹V is 1/σ)
+            Z = None if (len(null) or sigma != 0.0) else lift_columns(fac, lift)
+            if Z is not None:  # the rest at rounding: only the part along V is left to correct
+                du = Z @ (V.T @ (r_u - BA.T @ (WA * r_A)))
+                lamA += WA * (r_A + BA @ du)
+                u += du
+                continue
         best = min(best, res)
         du = project(null, pb.Kd, fac.solve(deflate(null, pb.Kd, r_u - BA.T @ (WA * r_A))))
         solves += 1
@@ -115,6 +128,31 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     out = np.zeros_like(lam)
     out[idx] = lamA
     return Step(u, out, res, solves)
+
+
+def lift_columns(fac, lift: np.ndarray) -> np.ndarray | None:
+    """``H⁻¹ V(VᵀV)⁻¹`` on the factor in hand (k solves), kept on it while its springs stay (a
+    sweep's values on the kept factor: the correction along V then costs no solve); None where
+    the factor does not say what it holds (``target``)."""
+    target = getattr(fac, "target", None)
+    if target is None:
+        return None
+    kept = getattr(fac, "_lift", None)
+    if kept is not None and kept[1] is lift and np.array_equal(kept[0], target):
+        return kept[2]
+    Z = fac.solve(lift)
+    fac._lift = (np.array(target, copy=True), lift, Z)
+    return Z
+
+
+def balanced(pb: ReducedQP, V: np.ndarray, BtL: np.ndarray, absBA, lamA: np.ndarray) -> bool:
+    """The reactions balance the load along the rigid motions ``V`` to rounding of the sums:
+    ``|Vᵀ(f − BᵀΛ)| ≤ ROUNDING_STOP · 16 ε |V|ᵀ(|f| + |B_A|ᵀ|Λ_A|)``. The residual's other parts
+    are at rounding long before that where the plate moves far as a body (a sweep's next value
+    from the kept factor: its first solve left the bed's reactions 1e-10 short of the load)."""
+    aV = np.abs(V)
+    size = aV.T @ (np.abs(pb.f) + absBA.T @ np.abs(lamA))
+    return bool(np.all(np.abs(V.T @ (pb.f - BtL)) <= ROUNDING_STOP * 16 * np.finfo(float).eps * size))
 
 
 def line_search(pb: ReducedQP, W: np.ndarray, u: np.ndarray, du: np.ndarray) -> float:
