@@ -12,6 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ...linalg.keep import kept
 from ...linalg.products import times
 from .dense import first_set
 from .factor import SpringFactor
@@ -83,10 +84,10 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     V = pb.rigid()
     lift = None
     if V is not None and V.shape[1]:
-        kept = getattr(pb, "_lift", None)  # one V(VᵀV)⁻¹ a problem (and its sweep's copies)
-        if kept is None or kept[0] is not V:
-            kept = pb._lift = (V, V @ np.linalg.inv(V.T @ V))
-        lift = kept[1]
+        memo = getattr(pb, "_lift", None)  # one V(VᵀV)⁻¹ a problem (and its sweep's copies)
+        if memo is None or memo[0] is not V:
+            memo = pb._lift = (V, V @ np.linalg.inv(V.T @ V))
+        lift = memo[1]
     for k in range(n_max + 1):
         BtL = BA.T @ lamA
         Ku = times(pb.K, u)
@@ -107,8 +108,10 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
         if exact and (k >= 1 or sigma == 0.0) and at_rounding(pb, u, idx, BA, lamA, r_u, r_A):
             if lift is None or balanced(pb, V, BtL, absBA, lamA):
                 break
-            # (not on a shifted factor: σD is all that holds it along V there, and H⁻¹V is 1/σ)
-            Z = None if (len(null) or sigma != 0.0) else lift_columns(fac, lift)
+            # (not on a shifted factor: σD is all that holds it along V there, and H⁻¹V is 1/σ;
+            # and only where the factor is kept for the solves to come, a sweep's: in a single
+            # solve one correction costs less than the k columns)
+            Z = None if (len(null) or sigma != 0.0 or kept() is None) else lift_columns(fac, lift)
             if Z is not None:  # the rest at rounding: only the part along V is left to correct
                 du = Z @ (V.T @ (r_u - BA.T @ (WA * r_A)))
                 lamA += WA * (r_A + BA @ du)
@@ -137,9 +140,9 @@ def lift_columns(fac, lift: np.ndarray) -> np.ndarray | None:
     target = getattr(fac, "target", None)
     if target is None:
         return None
-    kept = getattr(fac, "_lift", None)
-    if kept is not None and kept[1] is lift and np.array_equal(kept[0], target):
-        return kept[2]
+    memo = getattr(fac, "_lift", None)
+    if memo is not None and memo[1] is lift and np.array_equal(memo[0], target):
+        return memo[2]
     Z = fac.solve(lift)
     fac._lift = (np.array(target, copy=True), lift, Z)
     return Z
