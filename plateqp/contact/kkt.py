@@ -49,9 +49,8 @@ A result is ``ok`` when the worst residual is at most the tolerance of its accur
 ``KKT_TOL``, or the number given). The report also holds the stationarity residual's rounding
 floor, ``floor`` = ε‖|K||u| + |f| + |Bᵀ||R|‖ / max(‖f‖, ‖Bᵀ R‖) (Oettli–Prager): an answer exact
 to double precision can show a residual up to about that, and it grows with the mesh (the 2-norm
-over every dof: 4e-10 on a 256² bed, whose exact answer then fails 1e-10).
-A report that fails only there is ``at_floor``, and the solve's warning says so and which
-accuracy to ask. Unlike
+over every dof: 4e-10 on a 256² bed, whose exact answer then fails 1e-10). A report that fails
+only there is ``at_floor``, and the solve's warning says so and which accuracy to ask. Unlike
 qpsolvers' own check, this tests the sign of every reaction and complementarity support by
 support.
 """

@@ -148,7 +148,7 @@ class ReducedQP:
         self.c = self.k / (1.0 + self.rho * self.k)  # in series with the row's spring
         self.k_penalty = penalty_stiffness(self.B, Kd, self.k)
         self.P, self.q = P, qp.q
-        self._null, self._null_checked = qp.null, False
+        self._null, self._null_checked, self._lift = qp.null, False, None  # (:meth:`rigid`, :meth:`lift`)
         self._src = (qp.P, qp.G, G, max_rows, qp.null)  # what :meth:`again` compares
         self._abs_K = None  # |K|, kept where the problem is read again (:meth:`abs_K_times`)
 
@@ -224,6 +224,17 @@ class ReducedQP:
                 N = Nk if ok else None
             self._null = N
         return self._null
+
+    def lift(self) -> np.ndarray | None:
+        """``V(VᵀV)⁻¹`` for the rigid motions ``V`` of :meth:`rigid` (``VᵀV(VᵀV)⁻¹ = I``: it
+        carries a part along V back onto the dofs), made once and shared with the copies of
+        :meth:`again`; None where :meth:`rigid` is."""
+        V = self.rigid()
+        if V is None or V.shape[1] == 0:
+            return None
+        if self._lift is None:
+            self._lift = V @ np.linalg.inv(V.T @ V)
+        return self._lift
 
     def x(self, u: np.ndarray, lam: np.ndarray) -> np.ndarray:
         x = np.empty(self.n)

@@ -81,13 +81,7 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     # and more where the plate moves far as a body, would pass into the reactions' balance along
     # them (Vᵀ(f − BᵀΛ) = VᵀKu = 0 exactly in the model); the residual's V-part is taken without
     # it, (I − V(VᵀV)⁻¹Vᵀ)K u, so the refinement ends on reactions that balance the load along V
-    V = pb.rigid()
-    lift = None
-    if V is not None and V.shape[1]:
-        memo = getattr(pb, "_lift", None)  # one V(VᵀV)⁻¹ a problem (and its sweep's copies)
-        if memo is None or memo[0] is not V:
-            memo = pb._lift = (V, V @ np.linalg.inv(V.T @ V))
-        lift = memo[1]
+    V, lift = pb.rigid(), pb.lift()
     for k in range(n_max + 1):
         BtL = BA.T @ lamA
         Ku = times(pb.K, u)
