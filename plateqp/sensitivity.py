@@ -48,7 +48,7 @@ import numpy as np
 from .accuracy import Status
 from .contact.scaling import Scaled
 from .errors import MechanismError, PlateQPWarning, ProblemError
-from .linalg import solve_saddle  # the one linear-algebra import of the active-set calculus
+from .linalg import SingularMatrixError, solve_saddle  # the linear algebra of the active-set calculus
 
 WRT = ("gaps", "stiffness", "loads")
 #: Most degenerate supports whose one-sided derivative is found by enumeration (2^n sets).
@@ -66,7 +66,7 @@ class Piece:
 
 
 def held_solve(data: Scaled, held: np.ndarray, R: np.ndarray, df: np.ndarray, dg: np.ndarray,
-               drho: np.ndarray, extra: np.ndarray | None = None):
+               drho: np.ndarray, extra: np.ndarray | None = None, solver=None):
     """Solve the KKT system of the plate held at ``held`` for several right-hand sides at once.
 
     Parameters
@@ -76,6 +76,10 @@ def held_solve(data: Scaled, held: np.ndarray, R: np.ndarray, df: np.ndarray, dg
     R : (m,) current scaled reactions (enter through the derivative of ρ)
     df, dg, drho : (n, p), (m, p), (m, p) derivatives of the load, gaps and flexibilities
     extra : indices of held points whose unit gap responses are wanted too (columns appended)
+    solver : a callable ``(H, F, G) -> (u, R_H)`` that solves the held system on the rows ``H``
+        (:class:`plateqp.studies.held.HeldFactor`: one factorisation kept between the pieces of
+        an exact path); where it raises SingularMatrixError, or where none is given, the
+        saddle-point system is solved by sparse LU (:func:`plateqp.linalg.solve_saddle`)
 
     Returns
     -------
@@ -92,12 +96,17 @@ def held_solve(data: Scaled, held: np.ndarray, R: np.ndarray, df: np.ndarray, dg
     rhs_g[pos, p + np.arange(q)] = 1.0
     rhs_f = np.zeros((data.n, p + q))
     rhs_f[:, :p] = df
-    B = data.B.tocsr()[H]
     if p + q == 0:
         z = np.zeros((data.n, 0))
         return Piece(z, np.zeros((data.m, 0)), np.zeros((data.m, 0))), Piece(z, np.zeros((data.m, 0)), np.zeros((data.m, 0)))
     try:
-        du, dRH = solve_saddle(data.K, B, data.rho[H], rhs_f, rhs_g)
+        got = None
+        if solver is not None:
+            try:
+                got = solver(H, rhs_f, rhs_g)
+            except SingularMatrixError:
+                got = None  # the saddle-point system decides (its answer, or its own error)
+        du, dRH = got if got is not None else solve_saddle(data.K, data.B.tocsr()[H], data.rho[H], rhs_f, rhs_g)
     except MechanismError as exn:
         raise MechanismError(f"the supports in contact do not hold the plate ({exn}): the answer is not unique") from exn
     du = du.reshape(data.n, p + q)

@@ -37,13 +37,15 @@ import numpy as np
 from ..model.assembly import Model, build_model
 from ..contact.routing import repeated_solves
 from ..contact.scaling import Scaled
-from ..errors import MechanismError, ProblemError
+from ..errors import MechanismError, ProblemError, SolverError
+from ..linalg import SingularMatrixError
 from ..linalg.keep import sharing
 from ..model.paths import as_number, get_param, set_param
 from ..progress import Progress
 from ..model.scene import Scene
 from ..sensitivity import MAX_DEGENERATE, classify, held_solve, one_direction
 from ..solving import solve
+from .held import HeldFactor
 from .reuse import adapt_model
 from .sweep import SweepResult, numbered, sweep
 
@@ -223,6 +225,7 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
     prev_contact = None
     steps_taken = 0
     bar = Progress(100, f"exact path of {path}, % of the range")
+    solver = _held_factor(data)  # one factorisation kept current along the pieces
     while True:
         steps_taken += 1
         if steps_taken > limit:  # counts every step (pieces that change nothing are merged)
@@ -234,7 +237,7 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
         g_t = data.g0 + (t - x0) * dg
         try:
             cols, unit = held_solve(data, held, np.zeros(m), np.column_stack([f_t, df]),
-                                    np.column_stack([g_t, dg]), np.zeros((m, 2)), extra=D)
+                                    np.column_stack([g_t, dg]), np.zeros((m, 2)), extra=D, solver=solver)
         except MechanismError as exn:
             if not pieces:
                 raise ProblemError(f"exact path of {path}: at the start {t:g} the supports in contact leave a rigid "
@@ -297,6 +300,15 @@ def exact_path(scene: Scene, path: str, start, stop, backend: str = "auto", form
     bar.close()
     logger.info("exact path of %s from %g to %g: %d piece(s), %d step(s)", path, x0, x1, len(pieces), steps_taken)
     return ExactPath(path, x0, x1, breaks, pieces, _data=data, _model=model, _affine=affine, _dshift=dshift)
+
+
+def _held_factor(data: Scaled):
+    """The held systems' solver of the path (:class:`plateqp.studies.held.HeldFactor`), or None
+    where its factor cannot be built (each piece is then solved by sparse LU)."""
+    try:
+        return HeldFactor(data)
+    except (SingularMatrixError, SolverError):
+        return None
 
 
 @dataclass

@@ -1,6 +1,7 @@
 """sweep --exact (plateqp.studies.exact_sweep) factorises the plate once: the exact path's start
-solve and the sweep's values share the model and its factorisation of K; the answers are those
-of cold solves and of the exact path followed on its own."""
+solve and the sweep's values share the model and its factorisation of K (the path's held systems
+keep a factor of their own, :mod:`plateqp.studies.held`, at most one factorisation a piece); the
+answers are those of cold solves and of the exact path followed on its own."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from plateqp.linalg import cholmod
 from plateqp.model.paths import set_param
 from plateqp.scenes.families import grid_rigid
 from plateqp.studies import exact_path, exact_sweep
+from plateqp.studies.held import HeldFactor
 
 CASES = {
     "condensed route": (lambda: grid_rigid(12, 3), "supports.1.gap", [-1e-3, 0.0, 1e-3, 2e-3]),
@@ -23,14 +25,26 @@ CASES = {
 
 @pytest.fixture
 def factorisations(monkeypatch):
-    count = [0]
-    real = cholmod.Cholesky.factor
+    """[factorisations by the solves, by the path's held factors, the held factors' calls]"""
+    count = [0, 0, 0]
+    real, held_init, held_call = cholmod.Cholesky.factor, HeldFactor.__init__, HeldFactor.__call__
+    of_held: list = []
 
     def counting(self, A):
-        count[0] += 1
+        count[1 if any(self is c for c in of_held) else 0] += 1
         return real(self, A)
 
+    def init(self, data):
+        held_init(self, data)
+        of_held.append(self.fac.chol)
+
+    def call(self, *args):
+        count[2] += 1
+        return held_call(self, *args)
+
     monkeypatch.setattr(cholmod.Cholesky, "factor", counting)
+    monkeypatch.setattr(HeldFactor, "__init__", init)
+    monkeypatch.setattr(HeldFactor, "__call__", call)
     return count
 
 
@@ -42,6 +56,7 @@ def test_sweep_exact_factorises_k_once_and_answers_as_cold_solves(case, factoris
         warnings.simplefilter("ignore", pq.PlateQPWarning)
         r = exact_sweep(scene, path, values, executor="serial", progress=False)
     assert factorisations[0] == 1, f"{factorisations[0]} factorisations of K for one K"
+    assert 1 <= factorisations[1] <= factorisations[2], "more than one factorisation a held system"
     alone = exact_path(scene, path, values[0], values[-1])
     assert [b["at"] for b in r.exact.breakpoints] == pytest.approx([b["at"] for b in alone.breakpoints], rel=1e-12)
     assert [b["after"] for b in r.exact.breakpoints] == [b["after"] for b in alone.breakpoints]
