@@ -8,15 +8,23 @@ its contact set H (:func:`plateqp.sensitivity.held_solve`),
     K u + B_H^T R_H = f, \qquad B_H u - \rho_H R_H = g,
 
 and the sets of two pieces in a row differ by the one or few points of the event between
-them. :class:`HeldFactor` solves them on one symbolic analysis of ``K + BᵀB``: the factor of
-``K + B_Hᵀ diag(W_H) B_H`` (:class:`plateqp.backends.pdas.factor.SpringFactor`: a few changed
-rows by a Woodbury correction on the factor in hand, else a numeric refactorisation), ``W`` a
-row's own spring ``1/ρ`` where it is softer than the plate under it, else a penalty spring in
-series with it, and iterative refinement on the held system itself until each residual is
-rounding of the norms of the terms that make it (a normwise backward error at rounding). A sparse
-LU of the whole saddle-point system a piece (what :func:`plateqp.linalg.solve_saddle` does) cost
-16 factorisations of K a piece at 128²; here a piece costs a correction or one factorisation
-and a few solves.
+them. :class:`HeldFactor` solves them on one symbolic analysis of ``K + BᵀB``
+(:class:`plateqp.backends.pdas.factor.SpringFactor`), in one of two modes:
+
+- springs (a floating plate, or rows no stiffer than the plate under them): the factor of
+  ``K + B_Hᵀ diag(W_H) B_H``, a few changed rows by a Woodbury correction on the factor in hand,
+  else a numeric refactorisation; ``W`` a row's own spring ``1/ρ`` where it is softer than the
+  plate under it (then one solve is the answer), else a penalty spring in series with it;
+- condensed (a plate its two-sided supports hold, with a row stiffer than it, at most
+  CONDENSED_MAX rows): ``K`` alone, factorised once; ``(B_H K⁻¹ B_Hᵀ + ρ_H) R_H = B_H K⁻¹ F − G``
+  on the rows' flexibility, whose column a row gets the first time it is held (one solve) and
+  keeps; no penalty and no refactorisation, two solves a correction.
+
+Either is refined on the held system itself until each residual is rounding of the norms of the
+terms that make it (a normwise backward error at rounding). A sparse LU of the whole
+saddle-point system a piece (what :func:`plateqp.linalg.solve_saddle` does) cost 16 times
+a factorise-and-solve of K a piece (grid, 128²); here a piece costs a correction or a
+factorisation and a few solves.
 
 Where the factor fails (the held points do not hold the plate: a singular matrix) or the
 refinement does not reach rounding, :meth:`HeldFactor.__call__` raises
@@ -27,6 +35,7 @@ instead (its answer, or its own error, stands).
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..errors import SolverError
@@ -42,6 +51,10 @@ PENALTY = 1e8
 #: A refinement that stops short of rounding is accepted at most this backward error (else the
 #: caller solves the saddle-point system).
 ACCEPT = 1e-13
+
+#: The condensed mode (a held plate, some row stiffer than the plate under it) keeps the rows'
+#: flexibility B K⁻¹ Bᵀ dense (m × m): at most this many rows.
+CONDENSED_MAX = 2000
 
 __all__ = ["HeldFactor"]
 
@@ -68,6 +81,12 @@ class HeldFactor:
         self.fac = SpringFactor(self.K, self.B, Kd, k / (1.0 + self.rho * k), 0.0, "auto")
         self.steps = 0  # refinement steps taken over every call (a count for the benchmarks)
         self.calls = 0
+        # a plate its two-sided supports hold, with a row stiffer than the plate under it: K
+        # itself factorised once, the held rows condensed onto it (no penalty, no refactorisation)
+        self.condensed = (not data.floating and not np.all(soft) and self.rho.size <= CONDENSED_MAX)
+        if self.condensed:
+            self.M = np.zeros((self.rho.size, self.rho.size))  # B K⁻¹ Bᵀ, its columns filled as rows are held
+            self.filled = np.zeros(self.rho.size, dtype=bool)
 
     @staticmethod
     def col_sums(BH) -> float:
@@ -79,15 +98,10 @@ class HeldFactor:
         ``G`` (|H| × p), each exact to rounding; SingularMatrixError where this factor cannot give
         them (see the module docstring)."""
         self.calls += 1
-        w = np.zeros(self.rho.size)
-        w[H] = self.W[H]
-        try:
-            self.fac.set(w)
-        except (SolverError, SingularMatrixError) as exn:
-            raise SingularMatrixError(f"the held set's matrix could not be factorised ({exn})") from exn
         BH = self.B[H]
+        correct = self._condensed(H, BH) if self.condensed else self._springs(H, BH)
         BH_norm = max(self.row_sums[H].max(initial=0.0), self.col_sums(BH))
-        WH, rhoH = self.W[H][:, None], self.rho[H][:, None]
+        rhoH = self.rho[H][:, None]
         u = np.zeros_like(F)
         R = np.zeros_like(G)
         r_u, r_H = F, -G
@@ -115,10 +129,55 @@ class HeldFactor:
                         return u, R
                     break
                 best = min(best, omega)
-            du = self.fac.solve(r_u - BH.T @ (WH * r_H))
-            if not np.all(np.isfinite(du)):
+            du, dR = correct(r_u, -r_H)
+            if not (np.all(np.isfinite(du)) and np.all(np.isfinite(dR))):
                 break
-            R = R + WH * (r_H + BH @ du)
-            u = u + du
+            u, R = u + du, R + dR
             self.steps += 1
         raise SingularMatrixError("the refinement of the held system did not reach rounding")
+
+    def _springs(self, H: np.ndarray, BH):
+        """The correction of the springs' mode: ``(du, dR)`` with ``(K + B_Hᵀ W_H B_H) du =
+        F + B_Hᵀ W_H G`` and ``dR = W_H (B_H du − G)`` (exact for a row's own spring, W = 1/ρ;
+        a penalty's share is left to the next step)."""
+        w = np.zeros(self.rho.size)
+        w[H] = self.W[H]
+        try:
+            self.fac.set(w)
+        except (SolverError, SingularMatrixError) as exn:
+            raise SingularMatrixError(f"the held set's matrix could not be factorised ({exn})") from exn
+        WH = self.W[H][:, None]
+
+        def correct(F, G):
+            du = self.fac.solve(F + BH.T @ (WH * G))
+            return du, WH * (BH @ du - G)
+        return correct
+
+    def _condensed(self, H: np.ndarray, BH):
+        """The correction of the condensed mode, exact: ``X = K⁻¹F``, ``(B_H K⁻¹ B_Hᵀ + ρ_H) dR =
+        B_H X − G``, ``du = X − K⁻¹ B_Hᵀ dR`` (two solves with K's factor; a row held for the
+        first time costs one more, its column of B K⁻¹ Bᵀ, kept)."""
+        if self.fac.w is None:  # K's factorisation, on the first call
+            try:
+                self.fac.set(np.zeros(self.rho.size))
+            except (SolverError, SingularMatrixError) as exn:
+                raise SingularMatrixError(f"the plate's stiffness could not be factorised ({exn})") from exn
+        new = H[~self.filled[H]]
+        if new.size:
+            Z = self.fac.solve(self.B[new].T.toarray())
+            cols = np.asarray(self.B @ Z)
+            self.M[:, new] = cols
+            self.M[new, :] = cols.T
+            self.filled[new] = True
+        C = self.M[np.ix_(H, H)]
+        C[np.diag_indices(H.size)] += self.rho[H]
+        try:
+            cho = sla.cho_factor(C, lower=True, check_finite=False)
+        except np.linalg.LinAlgError as exn:  # rows that do not bind independently (ρ = 0)
+            raise SingularMatrixError(f"the held rows' flexibility is singular ({exn})") from exn
+
+        def correct(F, G):
+            X = self.fac.solve(F)
+            dR = sla.cho_solve(cho, BH @ X - G, check_finite=False)
+            return X - self.fac.solve(BH.T @ dR), dR
+        return correct

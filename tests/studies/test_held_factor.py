@@ -3,8 +3,9 @@ independent formulation: the whole saddle-point system [K Bᵀ; B −diag(ρ)] f
 (plateqp.linalg.solve_saddle, what every piece took before).
 
 - Random held sets on a free plate on a tensionless bed (soft rows: the spring 1/ρ itself, a
-  few changed rows by Woodbury), on rigid posts (penalty springs, refinement) and on stiff elastic
-  posts: the same (u, R_H) as LU, and the held system's residual at rounding.
+  few changed rows by Woodbury), on elastic posts (soft: their springs too), on a floating slab's
+  rigid posts (penalty springs, refinement), and on rigid posts under a slab its edges hold (K
+  alone, the rows condensed): the same (u, R_H) as LU, and the held system's residual at rounding.
 - A held set that leaves a rigid motion free: the factor refuses it (SingularMatrixError), so the
   caller's LU and its MechanismError decide.
 - Whole exact paths (a bed's load, with hundreds of pieces; a post's gap): the same breakpoints,
@@ -44,12 +45,15 @@ def residual(data, H, u, R, F, G) -> float:
     return float(max(np.abs(r_u).max(), np.abs(r_H).max()) / size)
 
 
-@pytest.mark.parametrize("make, size", [(lambda: bed(12), 0.6), (lambda: grid_rigid(12, 4), 0.5),
-                                        (lambda: grid_elastic(12, 4), 0.5)], ids=["bed", "rigid posts", "elastic posts"])
-def test_held_systems_are_those_of_the_saddle_point_system(make, size):
+@pytest.mark.parametrize("make, size, condensed", [
+    (lambda: bed(12), 0.6, False), (lambda: grid_rigid(12, 4), 0.5, True),
+    (lambda: grid_elastic(12, 4), 0.5, False), (lambda: floating(12, 4), 0.9, False),
+], ids=["bed", "rigid posts", "elastic posts", "floating on rigid posts"])
+def test_held_systems_are_those_of_the_saddle_point_system(make, size, condensed):
     data = Scaled.from_model(build_model(make()))
     rng = np.random.default_rng(3)
     held = HeldFactor(data)
+    assert held.condensed is condensed  # a held plate with stiff rows: K alone; else springs on the rows
     H0 = np.flatnonzero(rng.random(data.m) < size)
     sets = [H0]
     for _ in range(4):  # a few rows in and out at a time: the Woodbury corrections or refactorisations
