@@ -257,6 +257,23 @@ def reuse_section(df, figdir):
             + verdict + "\n\n" + table(df))
 
 
+def exact_section(df, figdir):
+    at = df[df["mesh"] == 128]
+    verdict = ""
+    if len(at):
+        verdict = ("At 128²: " + ", ".join(
+            f"{r.scene} {r.path} {int(r.pieces)} pieces, {r.per_piece_ratio:.2f} a piece, {r.per_value_ratio:.2f} a value"
+            for r in at.itertuples()) + f" (the sweep goal, {REUSE_GOAL} a value, met by "
+            f"{int((at['per_value_ratio'] <= REUSE_GOAL).sum())} of {len(at)}). ")
+    return ("`sweep --exact` (plateqp.studies.exact_sweep): the exact path over the range, each piece's held "
+            "system on one kept factorisation (plateqp.studies.held: `held_mode` springs or condensed), then the "
+            "values on the model the path shares. `per_piece_ratio`: the path's CPU time (its start solve "
+            "included) a held system, ÷ one raw CHOLMOD factorise-and-solve of the same K; `per_value_ratio`: "
+            "(the exact sweep of V values − of one) / (V − 1) ÷ raw, which carries the path: its pieces count "
+            "the contact set's changes over the range (a bed's load moves its lift-off line node by node), "
+            "not the values. " + verdict + "\n\n" + table(df))
+
+
 def soils_section(df, figdir):
     hs = df[(df["soil"] == "halfspace") & df["raw_s"].notna()]
     timed = hs[~hs["route"].astype(str).str.contains("fresh process")]
@@ -377,6 +394,11 @@ def parts() -> dict[str, Part]:
         p["sweep-reuse"] = Part("sweep-reuse", "bench_sweep_reuse", "sweep-reuse.csv", "sweep-reuse.csv",
                                 [], ["--meshes", "32", "--scenes", "grid", "--values", "3", "--repeats", "1"],
                                 reuse_section, "Sweeps reusing the factorisation")
+    p["exact-sweep"] = Part("exact-sweep", "bench_exact_sweep", "exact-sweep.csv", "exact-sweep.csv",
+                            ["--out", "OUT"],
+                            ["--meshes", "32", "--scenes", "grid", "--kinds", "gap", "--values", "3", "--repeats", "1",
+                             "--out", "OUT"],
+                            exact_section, "Exact sweeps")
     p["soils"] = Part("soils", "bench_soils", "soils.csv", "soils.csv",
                       ["--hs-memory", "512", "--out", "OUT"],
                       ["--meshes", "16", "--hs-meshes", "8,32", "--repeats", "1", "--out", "OUT"],
