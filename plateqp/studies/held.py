@@ -18,7 +18,8 @@ them. :class:`HeldFactor` solves them on one symbolic analysis of ``K + BᵀB``
 - condensed (a plate its two-sided supports hold, with a row stiffer than it, at most
   CONDENSED_MAX rows): ``K`` alone, factorised once; ``(B_H K⁻¹ B_Hᵀ + ρ_H) R_H = B_H K⁻¹ F − G``
   on the rows' flexibility, whose column a row gets the first time it is held (one solve) and
-  keeps; no penalty and no refactorisation, two solves a correction.
+  keeps; no penalty and no refactorisation, two solves a correction (one where the first
+  equation already holds to rounding).
 
 Either is refined on the held system itself until each residual is rounding of the norms of the
 terms that make it (a normwise backward error at rounding). A sparse LU of the whole
@@ -105,6 +106,7 @@ class HeldFactor:
         u = np.zeros_like(F)
         R = np.zeros_like(G)
         r_u, r_H = F, -G
+        settled = False  # the first equation's residual at rounding (the last step's check)
         best = np.inf
         eps = ROUNDING * np.finfo(float).eps
         for step in range(MAX_STEPS + 1):
@@ -118,7 +120,8 @@ class HeldFactor:
                     + (rhoH * np.abs(R)).max(axis=0, initial=0.0)
                 err_u = np.abs(r_u).max(axis=0)
                 err_H = np.abs(r_H).max(axis=0, initial=0.0)
-                if np.all(err_u <= eps * size_u) and np.all(err_H <= eps * size_H):
+                settled = bool(np.all(err_u <= eps * size_u))
+                if settled and np.all(err_H <= eps * size_H):
                     return u, R
                 omega = float(max((err_u / np.maximum(size_u, 1e-300)).max(initial=0.0),
                                   (err_H / np.maximum(size_H, 1e-300)).max(initial=0.0)))
@@ -129,7 +132,7 @@ class HeldFactor:
                         return u, R
                     break
                 best = min(best, omega)
-            du, dR = correct(r_u, -r_H)
+            du, dR = correct(r_u, -r_H, settled)
             if not (np.all(np.isfinite(du)) and np.all(np.isfinite(dR))):
                 break
             u, R = u + du, R + dR
@@ -148,15 +151,16 @@ class HeldFactor:
             raise SingularMatrixError(f"the held set's matrix could not be factorised ({exn})") from exn
         WH = self.W[H][:, None]
 
-        def correct(F, G):
+        def correct(F, G, settled):
             du = self.fac.solve(F + BH.T @ (WH * G))
             return du, WH * (BH @ du - G)
         return correct
 
     def _condensed(self, H: np.ndarray, BH):
         """The correction of the condensed mode, exact: ``X = K⁻¹F``, ``(B_H K⁻¹ B_Hᵀ + ρ_H) dR =
-        B_H X − G``, ``du = X − K⁻¹ B_Hᵀ dR`` (two solves with K's factor; a row held for the
-        first time costs one more, its column of B K⁻¹ Bᵀ, kept)."""
+        B_H X − G``, ``du = K⁻¹(F − B_Hᵀ dR)`` (two solves with K's factor; a row held for the
+        first time costs one more, its column of B K⁻¹ Bᵀ, kept). Where ``F`` is rounding
+        (``settled``: the first equation holds), ``X`` is left out: one solve."""
         if self.fac.w is None:  # K's factorisation, on the first call
             try:
                 self.fac.set(np.zeros(self.rho.size))
@@ -176,8 +180,13 @@ class HeldFactor:
         except np.linalg.LinAlgError as exn:  # rows that do not bind independently (ρ = 0)
             raise SingularMatrixError(f"the held rows' flexibility is singular ({exn})") from exn
 
-        def correct(F, G):
+        def correct(F, G, settled):
+            if settled:  # F is rounding: only the rows' residual is left to correct (one solve)
+                dR = sla.cho_solve(cho, -G, check_finite=False)
+                return -self.fac.solve(BH.T @ dR), dR
             X = self.fac.solve(F)
             dR = sla.cho_solve(cho, BH @ X - G, check_finite=False)
-            return X - self.fac.solve(BH.T @ dR), dR
+            # K du = F − B_Hᵀ dR solved as it stands (not X − K⁻¹B_Hᵀ dR, which cancels where
+            # the supports carry most of the load): the first equation then holds to rounding
+            return self.fac.solve(F - BH.T @ dR), dR
         return correct
