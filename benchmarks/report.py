@@ -262,7 +262,8 @@ def exact_section(df, figdir):
     verdict = ""
     if len(at):
         verdict = ("At 128²: " + ", ".join(
-            f"{r.scene} {r.path} {int(r.pieces)} pieces, {r.per_piece_ratio:.2f} a piece, {r.per_value_ratio:.2f} a value"
+            f"{r.scene} {r.path} {int(r.pieces)} piece{'s' if int(r.pieces) != 1 else ''}, {r.per_piece_ratio:.2f} a piece, "
+            f"{r.per_value_ratio:.2f} a value"
             for r in at.itertuples()) + f" (the sweep goal, {REUSE_GOAL} a value, met by "
             f"{int((at['per_value_ratio'] <= REUSE_GOAL).sum())} of {len(at)}). ")
     return ("`sweep --exact` (plateqp.studies.exact_sweep): the exact path over the range, each piece's held "
