@@ -11,7 +11,8 @@ set H is fixed and (u, R_H) solve the held system of :mod:`plateqp.sensitivity`
 
 :func:`exact_path` follows it (an active-set homotopy, the parametric LCP of Murty, *Linear
 complementarity, linear and nonlinear programming*, ch. 5): at the start of a piece one
-factorisation gives both the state and its slope; it moves along the piece until a reaction
+solve of the held system gives both the state and its slope (on one factorisation kept along
+the whole path, :mod:`plateqp.studies.held`); it moves along the piece until a reaction
 in contact falls to zero (lift-off) or an open gap closes (a support comes into contact), at
 a parameter value found exactly (a ratio of two numbers, to rounding); there the contact
 points at the event are degenerate, the one-sided slope onward is the solution of the small
