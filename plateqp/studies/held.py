@@ -19,7 +19,8 @@ them. :class:`HeldFactor` solves them on one symbolic analysis of ``K + BᵀB``
   CONDENSED_MAX rows): ``K`` alone, factorised once; ``(B_H K⁻¹ B_Hᵀ + ρ_H) R_H = B_H K⁻¹ F − G``
   on the rows' flexibility, whose column a row gets the first time it is held (one solve) and
   keeps; no penalty and no refactorisation, two solves a correction (one where the first
-  equation already holds to rounding).
+  equation already holds to rounding, or where the load is a combination of loads solved
+  before, as a path's f + t df is).
 
 Either is refined on the held system itself until each residual is rounding of the norms of the
 terms that make it (a normwise backward error at rounding). A sparse LU of the whole
