@@ -29,8 +29,6 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):  # before NumPy loads
     os.environ.setdefault(_var, "1")
 
-import argparse
-import csv
 import statistics
 import sys
 import time
@@ -40,7 +38,7 @@ from pathlib import Path
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 from bench_fast import ACCURACY, make_scene, plate_matrix, raw_cholmod, to_cvxopt  # noqa: E402
-from bench_sweep_reuse import GOAL, values_for  # noqa: E402
+from bench_sweep_reuse import GOAL, parse_args, values_for, write_rows  # noqa: E402
 
 from plateqp.model.assembly import build_model  # noqa: E402
 from plateqp.studies import exact_path, exact_sweep, homotopy  # noqa: E402
@@ -112,19 +110,7 @@ def row_for(kind: str, n: int, values: int, repeats: int, sweep_kind: str, watch
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--meshes", default="64,128")
-    ap.add_argument("--scenes", default="grid,bed")
-    ap.add_argument("--values", type=int, default=11)
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--kinds", default=",".join(KINDS), help="parameters to follow: gap, load")
-    ap.add_argument("--out", default=str(HERE / "results" / "exact-sweep.csv"))
-    args = ap.parse_args()
-    kinds = args.kinds.split(",")
-    if not set(kinds) <= set(KINDS):
-        raise SystemExit(f"--kinds: some of {', '.join(KINDS)} (got {args.kinds})")
-    if args.values < 2 or args.repeats < 1:
-        raise SystemExit("--values must be at least 2 and --repeats at least 1")
+    args, kinds = parse_args(__doc__, KINDS, 3, "exact-sweep.csv")
     watch = Watch()
     rows = []
     print("| scene | mesh | path | pieces | held | raw s | path s | per piece ÷ raw | **per value ÷ raw** "
@@ -138,12 +124,7 @@ def main():
                 print(f"| {kind} | {n}² | {row['path']} | {row['pieces']} | {row['held_mode']} | {row['raw_s']:.3f} "
                       f"| {row['path_s']:.2f} | {row['per_piece_ratio']:.2f} | **{row['per_value_ratio']:.2f}** "
                       f"| {row['goal_met']} | {row['kkt_worst']:.1e} |", flush=True)
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    with open(args.out, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    print(f"wrote {args.out}")
+    write_rows(rows, args.out)
 
 
 if __name__ == "__main__":

@@ -128,18 +128,37 @@ def row_for(kind: str, n: int, values: int, repeats: int, sweep_kind: str) -> di
             "goal_met": per / med["raw"] <= GOAL, "kkt_worst": max(kkt), "all_optimal": True}
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def parse_args(doc: str, kinds: tuple, repeats: int, out: str):
+    """The arguments of a sweep benchmark (this one, bench_exact_sweep): meshes, scenes, values,
+    repeats, the kinds of sweep among ``kinds``, the CSV ``out``; (args, the kinds asked)."""
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
     ap.add_argument("--meshes", default="64,128")
     ap.add_argument("--scenes", default="grid,bed")
     ap.add_argument("--values", type=int, default=11)
-    ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--kinds", default=",".join(KINDS), help="sweeps to time: gap, load, stiffness")
-    ap.add_argument("--out", default=str(HERE / "results" / "sweep-reuse.csv"))
+    ap.add_argument("--repeats", type=int, default=repeats)
+    ap.add_argument("--kinds", default=",".join(kinds), help=f"sweeps to time: {', '.join(kinds)}")
+    ap.add_argument("--out", default=str(HERE / "results" / out))
     args = ap.parse_args()
-    kinds = args.kinds.split(",")
-    if not set(kinds) <= set(KINDS):
-        raise SystemExit(f"--kinds: some of {', '.join(KINDS)} (got {args.kinds})")
+    asked = args.kinds.split(",")
+    if not set(asked) <= set(kinds):
+        raise SystemExit(f"--kinds: some of {', '.join(kinds)} (got {args.kinds})")
+    if args.values < 2 or args.repeats < 1:
+        raise SystemExit("--values must be at least 2 and --repeats at least 1")
+    return args, asked
+
+
+def write_rows(rows: list, out: str) -> None:
+    """The rows as CSV at ``out`` (its folder made)."""
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
+    with open(out, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print(f"wrote {out}")
+
+
+def main():
+    args, kinds = parse_args(__doc__, KINDS, 5, "sweep-reuse.csv")
     rows = []
     print("| scene | mesh | path | route | raw s | first value ÷ raw | **per value after the first ÷ raw** "
           f"| ≤ {GOAL} | KKT worst |")
@@ -152,11 +171,7 @@ def main():
                 print(f"| {kind} | {n}² | {row['path']} | {row['route']} | {row['raw_s']:.3f} "
                       f"| {row['first_ratio']:.2f} | **{row['per_value_ratio']:.2f}** | {row['goal_met']} "
                       f"| {row['kkt_worst']:.1e} |", flush=True)
-    with open(args.out, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    print(f"wrote {args.out}")
+    write_rows(rows, args.out)
 
 
 if __name__ == "__main__":
