@@ -15,7 +15,7 @@ import scipy.sparse as sp
 from ...errors import ProblemError, SingularMatrixError, SolverError
 from ...linalg import Cholesky, Factor, bindings
 from ...linalg.pattern import SCALE_BLOCK
-from .options import DOWNDATE_LOSS, LOWRANK_COND, LOWRANK_COST, LOWRANK_MAX
+from .options import DOWNDATE_LOSS, LOWRANK_COND, LOWRANK_COST, LOWRANK_MAX, SPAN_KEEP, SPAN_TOL
 
 __all__ = ["SpringFactor", "TrailingFactor"]
 
@@ -93,9 +93,10 @@ class SpringFactor:
         # row -> its column of Z (kept while the factor is): with CHOLMOD the forward half
         # L⁻¹ P D B_rᵀ (see :meth:`_columns`), else H(self.w)⁻¹ B_rᵀ
         self._zcols: dict = {}
+        self._span = None  # (:meth:`solve_in_span`) the w it holds for, Q, H(w)⁻¹Q
         self.stats = {"analyse_s": 0.0, "factorisations": 0, "factor_s": 0.0, "updates": 0, "updated_rows": 0,
                       "update_s": 0.0, "lowrank": 0, "lowrank_rows": 0, "lowrank_s": 0.0, "solves": 0,
-                      "solve_s": 0.0}
+                      "solve_s": 0.0, "span_solves": 0}
 
     def again(self, c: np.ndarray) -> None:
         """Start a new solve on this factor (kept from a solve before on the same K and B:
@@ -415,6 +416,35 @@ class SpringFactor:
             Ut *= self.s[:, None]  # in place: the caller's array is made for this
             return self.chol.forward(Ut, overwrite=True)
         return self._solve(Ut)
+
+    def solve_in_span(self, b: np.ndarray) -> np.ndarray:
+        """``H(target)⁻¹ b`` (one right-hand side), recycling the solves before it on the same
+        ``H``: the right-hand sides solved are kept as an orthonormal basis ``Q`` (at most
+        SPAN_KEEP columns) with ``H⁻¹Q``; ``b``'s part in their span costs no solve, the rest one
+        solve, whose direction joins the basis. A sweep's values on a kept factor ask for
+        ``f + t df`` or ``f + Bᵀ diag(w)(g + t dg)``: after two solves, none (the span is two
+        vectors). On an orthonormal basis the combination cannot cancel (its coefficients are at
+        most ‖b‖₂), so it is as accurate as a solve: each column's error is a solve's, summed
+        with weights of at most ‖b‖₂. The basis is dropped when ``H`` changes (``target``)."""
+        b = np.asarray(b, dtype=float)
+        span = self._span
+        if span is None or span[0] is not self.target or span[1].shape[1] >= SPAN_KEEP:
+            span = self._span = (self.target, np.zeros((b.size, 0)), np.zeros((b.size, 0)))
+        _, Q, X = span
+        alpha = Q.T @ b
+        r = b - Q @ alpha
+        extra = Q.T @ r  # twice is enough (Gram–Schmidt's loss of orthogonality)
+        r -= Q @ extra
+        alpha += extra
+        x = X @ alpha
+        size = float(np.linalg.norm(r))
+        if size <= SPAN_TOL * np.linalg.norm(b):
+            self.stats["span_solves"] += 1
+            return x
+        q = r / size
+        xq = self.solve(q)
+        self._span = (self.target, np.column_stack([Q, q]), np.column_stack([X, xq]))
+        return x + size * xq
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         t0 = time.perf_counter()
