@@ -114,3 +114,29 @@ def test_stiffness_design_factorises_K_once(factorisations):
         warnings.simplefilter("ignore")
         cold = pq.solve(set_param(scene, "supports.*.stiffness", got.c), backend="pdas", accuracy=1e-10)
     assert np.allclose(got.reactions, cold.reactions, rtol=1e-8, atol=1e-9 * np.abs(cold.reactions).max())
+
+
+def test_a_bed_gap_sweep_takes_each_values_first_solve_from_the_span_of_those_before(monkeypatch):
+    """A gap field's values ask for f + Bᵀ W (g + t dg) on the same factor while the contact
+    set stays: after two solves, each value's first solve is their combination (no solve), and
+    every value is still the cold solve's."""
+    from plateqp.backends.pdas.factor import SpringFactor
+
+    calls = []
+    orig = SpringFactor.solve_in_span
+
+    def counted(self, b):
+        before = self.stats["solves"]
+        x = orig(self, b)
+        calls.append(self.stats["solves"] - before)
+        return x
+
+    monkeypatch.setattr(SpringFactor, "solve_in_span", counted)
+    scene = bed()
+    path, values = "foundation.gap.gx", [0.002, 0.0025, 0.003, 0.0035, 0.004, 0.005]
+    hot = run(scene, path, values, reuse=True)
+    # one first solve a value: the first value's on every row's matrix (a cold start), the next
+    # two on the contact set's (they span f + Bᵀ W (g + t dg)), then none
+    assert calls == [1, 1, 1] + [0] * (len(values) - 3), calls
+    cold = run(scene, path, values, reuse=False)
+    same_as_cold(hot, cold)

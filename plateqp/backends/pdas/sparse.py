@@ -82,6 +82,18 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     # them (Vᵀ(f − BᵀΛ) = VᵀKu = 0 exactly in the model); the residual's V-part is taken without
     # it, (I − V(VᵀV)⁻¹Vᵀ)K u, so the refinement ends on reactions that balance the load along V
     V, lift = pb.rigid(), pb.lift()
+    # a sweep's next value on the kept factor: its first solve leaves the reactions short of the
+    # load along V (the plate moved as a body); that part is corrected before the first check,
+    # which then reads K once, not once before and once after it (where the columns H⁻¹V are at
+    # hand: a load's value that moves many springs, the factor made anew, may not need them).
+    # The lifted residual's V-part
+    # needs no product with K: Vᵀ(I − V(VᵀV)⁻¹Vᵀ)K u = 0, so Vᵀ r_u = Vᵀ(f − BᵀΛ)
+    Z = _lift_at_hand(pb, fac, lift, sigma, exact, null, solve=False)
+    if Z is not None and not balanced(pb, V, BA.T @ lamA, absBA, lamA):
+        r_A = BA @ u - gA - rhoA * lamA
+        du = Z @ (V.T @ (pb.f - BA.T @ (lamA + WA * r_A)))
+        lamA += WA * (r_A + BA @ du)
+        u += du
     for k in range(n_max + 1):
         BtL = BA.T @ lamA
         Ku = times(pb.K, u)
@@ -102,10 +114,7 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
         if exact and (k >= 1 or sigma == 0.0) and at_rounding(pb, u, idx, BA, lamA, r_u, r_A):
             if lift is None or balanced(pb, V, BtL, absBA, lamA):
                 break
-            # (not on a shifted factor: σD is all that holds it along V there, and H⁻¹V is 1/σ;
-            # and only where the factor is kept for the solves to come, a sweep's: in a single
-            # solve one correction costs less than the k columns)
-            Z = None if (len(null) or sigma != 0.0 or kept() is None) else lift_columns(fac, lift)
+            Z = _lift_at_hand(pb, fac, lift, sigma, exact, null)
             if Z is not None:  # the rest at rounding: only the part along V is left to correct
                 du = Z @ (V.T @ (r_u - BA.T @ (WA * r_A)))
                 lamA += WA * (r_A + BA @ du)
@@ -127,16 +136,30 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     return Step(u, out, res, solves)
 
 
-def lift_columns(fac, lift: np.ndarray) -> np.ndarray | None:
+def _lift_at_hand(pb: ReducedQP, fac, lift, sigma: float, exact: bool, null, solve: bool = True) -> np.ndarray | None:
+    """:func:`lift_columns` where the correction along V may be taken on them: an exact step
+    with rigid motions, no free ones among them (``null``), on an unshifted factor (σD is all that
+    holds a shifted one along V: H⁻¹V is 1/σ there) kept for the solves to come (a sweep's: in a
+    single solve one correction costs less than the k columns); else None. ``solve`` False: only
+    where they are kept on this factor already."""
+    if lift is None or not exact or len(null) or sigma != 0.0 or kept() is None:
+        return None
+    return lift_columns(fac, lift, solve)
+
+
+def lift_columns(fac, lift: np.ndarray, solve: bool = True) -> np.ndarray | None:
     """``H⁻¹ V(VᵀV)⁻¹`` on the factor in hand (k solves), kept on it while its springs stay (a
     sweep's values on the kept factor: the correction along V then costs no solve); None where
-    the factor does not say what it holds (``target``)."""
+    the factor does not say what it holds (``target``), or, ``solve`` False, where they are not
+    kept on it."""
     target = getattr(fac, "target", None)
     if target is None:
         return None
     memo = getattr(fac, "_lift", None)
     if memo is not None and memo[1] is lift and np.array_equal(memo[0], target):
         return memo[2]
+    if not solve:
+        return None
     Z = fac.solve(lift)
     fac._lift = (np.array(target, copy=True), lift, Z)
     return Z
@@ -250,7 +273,10 @@ def _first_minimiser(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: flo
             u = None
     if u is None:
         fac.set(first)
-        u = fac.solve(f + B.T @ (first * g))  # the minimiser with the rows of the first set held
+        b = f + B.T @ (first * g)
+        # the minimiser with the rows of the first set held (a sweep's values: b = f + t df or
+        # f + Bᵀ diag(w)(g + t dg), in the span of the values' before on the same factor)
+        u = fac.solve_in_span(b) if kept() is not None else fac.solve(b)
         A = B @ u - g > 0
     return u, A, start
 
