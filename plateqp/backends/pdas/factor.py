@@ -438,6 +438,8 @@ class SpringFactor:
         alpha += extra
         x = X @ alpha
         size = float(np.linalg.norm(r))
+        if not np.isfinite(size):  # nothing to keep: solved as it is
+            return self.solve(b)
         if size <= SPAN_TOL * np.linalg.norm(b):
             self.stats["span_solves"] += 1
             return x

@@ -123,8 +123,9 @@ DOWNDATE_LOSS = 1e-10
 LOWRANK_MAX, LOWRANK_COST, LOWRANK_COND = 16, 0.5, 1e-10
 #: (sparse) A sweep's first solve of a value on the kept factor: a right-hand side within
 #: SPAN_TOL (relative, 2-norm) of the span of those solved before on the same matrix (at most
-#: SPAN_KEEP) is their combination, no solve (:meth:`.factor.SpringFactor.solve_in_span`).
-SPAN_KEEP, SPAN_TOL = 4, 1e-14
+#: SPAN_KEEP) is their combination, no solve (:meth:`.factor.SpringFactor.solve_in_span`; a
+#: gap's or a load's values span two; 2 · SPAN_KEEP vectors of the plate's size kept beside it).
+SPAN_KEEP, SPAN_TOL = 3, 1e-14
 #: (sparse, soft rows) Phase 1: at most this many Newton steps, PCG to this relative tolerance
 #: (at most PCG_MAX iterations each); it ends when a step changes at most
 #: max(NEWTON_SETTLED, NEWTON_SETTLED_FRACTION · m) rows, or when its solves have cost

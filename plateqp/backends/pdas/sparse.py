@@ -276,7 +276,8 @@ def _first_minimiser(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: flo
         b = f + B.T @ (first * g)
         # the minimiser with the rows of the first set held (a sweep's values: b = f + t df or
         # f + Bᵀ diag(w)(g + t dg), in the span of the values' before on the same factor)
-        u = fac.solve_in_span(b) if kept() is not None else fac.solve(b)
+        span = getattr(fac, "solve_in_span", None) if kept() is not None else None  # (TrailingFactor: none)
+        u = fac.solve(b) if span is None else span(b)
         A = B @ u - g > 0
     return u, A, start
 
