@@ -121,18 +121,22 @@ def _no_equilibrium(data: Scaled, acc: Accuracy) -> None:
 
 
 def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray | None, str]:
-    """The deflection of the coarse model's answer (pdas on the primal, accuracy "default") at
-    the points (x, y), −inf at a point off the coarse plate; (None, why) where the backend's
-    answer is not OPTIMAL. NoEquilibriumError where the solve stops short and statics says the
-    coarse supports cannot carry the load. Started, as the pipeline would, from the set of its
-    own coarse mesh where :func:`wanted` says so. The answer in the user's units as
+    """The deflection of the coarse model's answer at the points (x, y), −inf at a point off the
+    coarse plate; (None, why) where the backend's answer is not OPTIMAL. NoEquilibriumError where
+    the solve stops short and statics says the coarse supports cannot carry the load. Where every
+    row is a spring, by :func:`spring_deflections` (Newton's steps on the contact set, started
+    from the set of the coarse mesh's own coarse mesh where it is large enough for one: one
+    factorisation, a few changed rows by Woodbury, no refinement: only the set is read from it);
+    else, or where that gives none, pdas on the primal (accuracy "default"), started, as the
+    pipeline would, from that set where :func:`wanted` says so. The answer in the user's units as
     :func:`plateqp.contact.answer.to_result` makes it (a floating plate's canonical deflection:
-    :func:`plateqp.contact.statics.settle`). A coarse mesh too small for a prediction of its own
-    whose rows are all springs is solved by :func:`spring_deflections` instead (a few small
-    factorisations against pdas's cold start; a larger one keeps pdas started from its own
-    coarse set: one factorisation, where Newton's steps would each take one)."""
-    if _too_small_to_predict(coarse):
-        u = spring_deflections(coarse)
+    :func:`plateqp.contact.statics.settle`)."""
+    springs = _springs_only(coarse)
+    start, asked = None, False
+    if springs and not _too_small_to_predict(coarse):
+        start, asked = predicted_set(coarse)[0], True
+    if springs:
+        u = spring_deflections(coarse, start)
         if u is not None:
             return _at_points(coarse, coarse.expand(u), x, y), ""
     acc = Accuracy.parse("default")
@@ -141,7 +145,7 @@ def coarse_deflections(coarse: Model, x: np.ndarray, y: np.ndarray) -> tuple[np.
     b = get_backend("pdas")
     options = {}
     if wanted(coarse, data, "pdas", "primal", options, "auto") is None:  # a coarse mesh large enough starts
-        A0 = predicted_set(coarse)[0]                                    # from its own coarse mesh's set
+        A0 = start if asked else predicted_set(coarse)[0]                # from its own coarse mesh's set
         if A0 is not None:
             options["active"] = A0
     try:
@@ -180,23 +184,30 @@ def _at_points(coarse: Model, u: np.ndarray, x: np.ndarray, y: np.ndarray) -> np
     return w
 
 
-def spring_deflections(coarse: Model) -> np.ndarray | None:
+def _springs_only(coarse: Model) -> bool:
+    """Every contact row of ``coarse`` is a spring (ρ > 0) and no soil has unknowns of its own."""
+    c = coarse.contacts
+    return not coarse.n_soil and c is not None and bool(np.all(c.rho > 0))
+
+
+def spring_deflections(coarse: Model, start: np.ndarray | None = None) -> np.ndarray | None:
     r"""The coarse model's answer (its free dofs) where every contact row is a spring (ρ > 0, no
     soil with unknowns of its own), by Newton's method on the contact set: the minimiser of
 
     .. math:: \tfrac12 u^T K u - f^T u + \tfrac12 \sum_i \max(0, B_i u - g_i)^2 / \rho_i
 
     is the solution of :math:`(K + B_A^T \rho_A^{-1} B_A) u = f + B_A^T \rho_A^{-1} g_A` on the set
-    :math:`A = \{i : B_i u > g_i\}` it gives; starting from every row pressed, each step solves
-    for its set and takes the rows that press, until the set repeats (the answer, exact to
-    rounding). None where a row is rigid, the plate is not held by a set (a singular matrix) or
+    :math:`A = \{i : B_i u > g_i\}` it gives; starting from ``start`` (default: every row
+    pressed), each step solves for its set and takes the rows that press, until the set repeats
+    (the answer, exact to rounding). None where a row is rigid, the plate is not held by a set (a singular matrix) or
     the set does not repeat within NEWTON_STEPS steps: the caller then solves with pdas. Only the
     contact set is read from it (the fine solve's exact steps and KKT check decide the answer);
     no scaling, formulation or backend is built around so small a problem."""
-    c = coarse.contacts
-    if coarse.n_soil or c is None or not np.all(c.rho > 0):
+    if not _springs_only(coarse):
         return None
     from ..backends.pdas.factor import SpringFactor
+
+    c = coarse.contacts
 
     B, g, k = c.B.tocsr(), c.g0, 1.0 / c.rho
     K = sp.csc_matrix(coarse.K)
@@ -206,7 +217,7 @@ def spring_deflections(coarse: Model) -> np.ndarray | None:
     Bt = B.T.tocsr()
     # K + Bᵀ diag(k_A) B on one analysis whatever the set (a few changed rows by Woodbury)
     F = SpringFactor(K, B, Kd, k, 0.0, "auto")
-    A = np.ones(c.m, dtype=bool)
+    A = np.ones(c.m, dtype=bool) if start is None else np.array(start, dtype=bool)
     for _ in range(NEWTON_STEPS):
         kA = np.where(A, k, 0.0)
         try:

@@ -61,7 +61,7 @@ def test_the_prediction_on_springs_asks_no_backend(name, monkeypatch):
     A, info = P.predicted_set(model)
     assert A is not None and info["rows"] == int(A.sum())
     monkeypatch.undo()
-    monkeypatch.setattr(P, "spring_deflections", lambda coarse: None)  # the pdas route instead
+    monkeypatch.setattr(P, "spring_deflections", lambda coarse, start=None: None)  # the pdas route instead
     A_pdas, _ = P.predicted_set(model)
     assert np.array_equal(A, A_pdas)
 
@@ -71,20 +71,58 @@ def test_rigid_rows_are_left_to_pdas():
     assert P.spring_deflections(build_model(F.grid_rigid(16, 3))) is None
 
 
-def test_a_coarse_mesh_large_enough_keeps_pdas_from_its_own_set(monkeypatch):
-    """Where the coarse mesh is large enough for a prediction of its own, pdas solves it from
-    that set (one factorisation) and Newton's steps solve only the coarsest mesh."""
+def test_a_coarse_mesh_large_enough_is_solved_by_newton_from_its_own_set(monkeypatch):
+    """Where the coarse mesh is large enough for a prediction of its own, Newton's steps solve it
+    from that set (a warm start: one factorisation, the few rows it gets wrong by Woodbury), the
+    coarsest mesh from every row pressed, and no backend is asked; the set is the one the pdas
+    route predicts from the same start (an independent solver of the coarse problem)."""
     monkeypatch.setattr(P, "ROWS_MIN", 100)
     monkeypatch.setattr(P, "COARSE_MIN", 4)
     model = build_model(SCENES["tilted bed"](64))  # coarse 16² (289 rows), its own coarse 4²
     solved = []
     real = P.spring_deflections
 
-    def spy(coarse):
-        solved.append(coarse.scene.mesh.nx)
-        return real(coarse)
+    def spy(coarse, start=None):
+        solved.append((coarse.scene.mesh.nx, start is None))
+        return real(coarse, start)
+
+    def refused(*a, **k):
+        raise AssertionError("the coarse prediction asked a backend")
 
     monkeypatch.setattr(P, "spring_deflections", spy)
+    monkeypatch.setattr(P, "get_backend", refused)
     A, info = P.predicted_set(model)
     assert A is not None and info["mesh"] == [16, 16]
-    assert solved == [4]
+    assert solved == [(4, True), (16, False)]
+    monkeypatch.undo()
+    monkeypatch.setattr(P, "ROWS_MIN", 100)
+    monkeypatch.setattr(P, "COARSE_MIN", 4)
+    monkeypatch.setattr(P, "spring_deflections", lambda coarse, start=None: real(coarse) if coarse.scene.mesh.nx == 4
+                        else None)  # 16² by pdas, from the 4² mesh's set
+    A_pdas, _ = P.predicted_set(model)
+    assert np.array_equal(A, A_pdas)
+
+
+def test_newton_from_a_start_factorises_once_and_ends_where_the_cold_start_ends(monkeypatch):
+    """Started from the coarser mesh's set, Newton's steps on springs factorise fewer times than
+    from every row pressed (a few rows the start gets wrong go by Woodbury) and end at the cold
+    start's answer."""
+    from plateqp.backends.pdas.factor import SpringFactor
+
+    monkeypatch.setattr(P, "ROWS_MIN", 100)
+    monkeypatch.setattr(P, "COARSE_MIN", 4)
+    coarse = build_model(SCENES["tilted bed"](16))
+    start, _ = P.predicted_set(coarse)  # the 4² mesh's set
+    count = {"n": 0}
+    real = SpringFactor.refactor
+
+    def counted(self, w):
+        count["n"] += 1
+        return real(self, w)
+
+    monkeypatch.setattr(SpringFactor, "refactor", counted)
+    warm = P.spring_deflections(coarse, start)
+    once, count["n"] = count["n"], 0
+    cold = P.spring_deflections(coarse)
+    assert once < count["n"], (once, count["n"])
+    assert np.max(np.abs(warm - cold)) <= 1e-10 * np.max(np.abs(cold))
