@@ -277,10 +277,37 @@ def _first_minimiser(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: flo
         # the minimiser with the rows of the first set held (a sweep's values: b = f + t df or
         # f + Bᵀ diag(w)(g + t dg), in the span of the values' before on the same factor)
         span = getattr(fac, "solve_in_span", None) if kept() is not None else None  # (TrailingFactor: none)
+        body = _body_motion(pb, first, b)
+        if body is not None:  # the plate's move as a rigid body on the held springs, then the rest
+            b = b - B.T @ (first * (B @ body))
         u = fac.solve(b) if span is None else span(b)
+        if body is not None:
+            u = u + body
         A = B @ u - g > 0
     return u, A, start
 
+
+def _body_motion(pb: ReducedQP, w: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """Where the plate has rigid motions ``V`` (a floating plate), the rigid motion ``V c`` the
+    springs ``w`` hold it at under ``b``: ``Vᵀ Bᵀ diag(w) B V c = Vᵀ b`` (K V = 0). The minimiser
+    is then ``V c + H⁻¹(b − Bᵀ diag(w) B V c)``: the solve's rounding, about ε |H||u|, is that of
+    the plate's deformation alone, not of its move as a body (a bed's plate that sinks or tilts
+    far beside its bending: its reactions' balance along V then needed a correction of its own,
+    one solve more). None where there is no V or the springs do not hold it (a singular 3 × 3)."""
+    V = pb.rigid()
+    if V is None or V.shape[1] == 0:
+        return None
+    BV = pb.B @ V
+    M = BV.T @ (w[:, None] * BV)
+    ev = np.linalg.eigvalsh(M)
+    if not ev[0] > BODY_HELD * ev[-1]:
+        return None
+    return V @ np.linalg.solve(M, V.T @ b)
+
+
+#: the held springs hold the plate as a rigid body (:func:`_body_motion`) where the 3 × 3 matrix
+#: of their stiffness along its rigid motions has its eigenvalues within this ratio
+BODY_HELD = 1e-10
 
 #: a warm start whose springs all changed: its set's minimiser is solved to this (relative, in
 #: the preconditioned norm) on the kept factor, to judge whether it moves more than LOWRANK_MAX rows
