@@ -58,10 +58,6 @@ ACCEPT = 1e-13
 #: flexibility B K⁻¹ Bᵀ dense (m × m): at most this many rows.
 CONDENSED_MAX = 2000
 
-#: The condensed mode keeps the answers K⁻¹f of this many loads, and takes a load within
-#: LOAD_SPAN (relative, max norm) of their span as that combination of them.
-LOADS, LOAD_SPAN = 4, 1e-14
-
 __all__ = ["HeldFactor"]
 
 
@@ -93,7 +89,6 @@ class HeldFactor:
         if self.condensed:
             self.M = np.zeros((self.rho.size, self.rho.size))  # B K⁻¹ Bᵀ, its columns filled as rows are held
             self.filled = np.zeros(self.rho.size, dtype=bool)
-            self.loads: list = []  # (f, K⁻¹f) of loads solved before (:meth:`_k_solve`)
 
     @staticmethod
     def col_sums(BH) -> float:
@@ -163,29 +158,10 @@ class HeldFactor:
         return correct
 
     def _k_solve(self, F: np.ndarray) -> np.ndarray:
-        """``K⁻¹F`` (condensed mode), a column at a time: nothing for a zero column (a unit gap's),
-        the combination of earlier answers for a load that is a combination of loads solved
-        before to rounding (a path's load at t is f + t df: its two columns, solved once), a
-        solve for the rest (kept, at most LOADS)."""
-        X = np.zeros_like(F)
-        todo = []
-        for j in range(F.shape[1]):
-            col = F[:, j]
-            size = np.abs(col).max(initial=0.0)
-            if size == 0.0:
-                continue
-            if self.loads:
-                basis = np.column_stack([f for f, _ in self.loads])
-                alpha = np.linalg.lstsq(basis, col, rcond=None)[0]
-                if np.abs(col - basis @ alpha).max() <= LOAD_SPAN * size:
-                    X[:, j] = np.column_stack([x for _, x in self.loads]) @ alpha
-                    continue
-            todo.append(j)
-        if todo:
-            Xt = self.fac.solve(F[:, todo])
-            X[:, todo] = Xt
-            self.loads = (self.loads + [(F[:, j].copy(), Xt[:, i].copy()) for i, j in enumerate(todo)])[-LOADS:]
-        return X
+        """``K⁻¹F`` (condensed mode), a column at a time on K's factor, recycling the loads solved
+        before (:meth:`plateqp.backends.pdas.factor.SpringFactor.solve_in_span`: a path's load at
+        t is f + t df, its two directions solved once; a zero column, a unit gap's, no solve)."""
+        return np.column_stack([self.fac.solve_in_span(F[:, j]) for j in range(F.shape[1])])
 
     def _condensed(self, H: np.ndarray, BH):
         """The correction of the condensed mode, exact: ``X = K⁻¹F``, ``(B_H K⁻¹ B_Hᵀ + ρ_H) dR =

@@ -86,8 +86,8 @@ def solve_active(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, A: np.ndarray,
     # load along V (the plate moved as a body); that part is corrected before the first check,
     # which then reads K once, not once before and once after it (where the columns H⁻¹V are at
     # hand: a load's value that moves many springs, the factor made anew, may not need them).
-    # The lifted residual's V-part
-    # needs no product with K: Vᵀ(I − V(VᵀV)⁻¹Vᵀ)K u = 0, so Vᵀ r_u = Vᵀ(f − BᵀΛ)
+    # The lifted residual's V-part needs no product with K: Vᵀ(I − V(VᵀV)⁻¹Vᵀ)K u = 0, so
+    # Vᵀ r_u = Vᵀ(f − BᵀΛ)
     Z = _lift_at_hand(pb, fac, lift, sigma, exact, null, solve=False)
     if Z is not None and not balanced(pb, V, BA.T @ lamA, absBA, lamA):
         r_A = BA @ u - gA - rhoA * lamA
