@@ -38,7 +38,7 @@ from pathlib import Path
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 from bench_fast import ACCURACY, make_scene, plate_matrix, raw_cholmod, to_cvxopt  # noqa: E402
-from bench_sweep_reuse import GOAL, parse_args, values_for, write_rows  # noqa: E402
+from bench_sweep_reuse import GOAL, parse_args, run_table, values_for  # noqa: E402
 
 from plateqp.model.assembly import build_model  # noqa: E402
 from plateqp.studies import exact_path, exact_sweep, homotopy  # noqa: E402
@@ -112,19 +112,12 @@ def row_for(kind: str, n: int, values: int, repeats: int, sweep_kind: str, watch
 def main():
     args, kinds = parse_args(__doc__, KINDS, 3, "exact-sweep.csv")
     watch = Watch()
-    rows = []
-    print("| scene | mesh | path | pieces | held | raw s | path s | per piece ÷ raw | **per value ÷ raw** "
-          f"| ≤ {GOAL} | KKT worst |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
-    for n in (int(x) for x in args.meshes.split(",")):
-        for kind in args.scenes.split(","):
-            for sweep_kind in kinds:
-                row = row_for(kind, n, args.values, args.repeats, sweep_kind, watch)
-                rows.append(row)
-                print(f"| {kind} | {n}² | {row['path']} | {row['pieces']} | {row['held_mode']} | {row['raw_s']:.3f} "
-                      f"| {row['path_s']:.2f} | {row['per_piece_ratio']:.2f} | **{row['per_value_ratio']:.2f}** "
-                      f"| {row['goal_met']} | {row['kkt_worst']:.1e} |", flush=True)
-    write_rows(rows, args.out)
+    run_table(args, kinds, lambda kind, n, sk: row_for(kind, n, args.values, args.repeats, sk, watch),
+              ["scene", "mesh", "path", "pieces", "held", "raw s", "path s", "per piece ÷ raw",
+               "**per value ÷ raw**", f"≤ {GOAL}", "KKT worst"],
+              lambda r: [r["path"], str(r["pieces"]), str(r["held_mode"]), f"{r['raw_s']:.3f}", f"{r['path_s']:.2f}",
+                         f"{r['per_piece_ratio']:.2f}", f"**{r['per_value_ratio']:.2f}**", str(r["goal_met"]),
+                         f"{r['kkt_worst']:.1e}"])
 
 
 if __name__ == "__main__":

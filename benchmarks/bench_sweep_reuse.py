@@ -157,21 +157,28 @@ def write_rows(rows: list, out: str) -> None:
     print(f"wrote {out}")
 
 
-def main():
-    args, kinds = parse_args(__doc__, KINDS, 5, "sweep-reuse.csv")
+def run_table(args, kinds: list, row_of, header: list, line) -> None:
+    """Every mesh × scene × kind of sweep asked: ``row_of(kind, n, sweep_kind)``, each printed as
+    a Markdown row (``line(row)``, under ``header``) as it comes, then all written to ``args.out``."""
     rows = []
-    print("| scene | mesh | path | route | raw s | first value ÷ raw | **per value after the first ÷ raw** "
-          f"| ≤ {GOAL} | KKT worst |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
     for n in (int(x) for x in args.meshes.split(",")):
         for kind in args.scenes.split(","):
             for sweep_kind in kinds:
-                row = row_for(kind, n, args.values, args.repeats, sweep_kind)
+                row = row_of(kind, n, sweep_kind)
                 rows.append(row)
-                print(f"| {kind} | {n}² | {row['path']} | {row['route']} | {row['raw_s']:.3f} "
-                      f"| {row['first_ratio']:.2f} | **{row['per_value_ratio']:.2f}** | {row['goal_met']} "
-                      f"| {row['kkt_worst']:.1e} |", flush=True)
+                print(f"| {kind} | {n}² | " + " | ".join(line(row)) + " |", flush=True)
     write_rows(rows, args.out)
+
+
+def main():
+    args, kinds = parse_args(__doc__, KINDS, 5, "sweep-reuse.csv")
+    run_table(args, kinds, lambda kind, n, sk: row_for(kind, n, args.values, args.repeats, sk),
+              ["scene", "mesh", "path", "route", "raw s", "first value ÷ raw", "**per value after the first ÷ raw**",
+               f"≤ {GOAL}", "KKT worst"],
+              lambda r: [r["path"], r["route"], f"{r['raw_s']:.3f}", f"{r['first_ratio']:.2f}",
+                         f"**{r['per_value_ratio']:.2f}**", str(r["goal_met"]), f"{r['kkt_worst']:.1e}"])
 
 
 if __name__ == "__main__":
