@@ -177,27 +177,48 @@ def balanced(pb: ReducedQP, V: np.ndarray, BtL: np.ndarray, absBA, lamA: np.ndar
 
 def line_search(pb: ReducedQP, W: np.ndarray, u: np.ndarray, du: np.ndarray) -> float:
     """Exact minimiser ``α ∈ (0, ALPHA_MAX]`` of the (convex, piecewise quadratic) energy
-    ``½uᵀKu − fᵀu + Σ ½ W_i max(0, B_i u − g_i)²`` along ``u + α du`` (bisection on its slope)."""
+    ``½uᵀKu − fᵀu + Σ ½ W_i max(0, B_i u − g_i)²`` along ``u + α du`` (∞ where the energy still
+    falls past ALPHA_MAX). Its slope is piecewise linear in α: between two of the rows'
+    breakpoints ``α_i = −r_i/s_i`` (``r = B u − g``, ``s = B du``) it is ``c₁ α + c₀``, with
+    ``c₁ = duᵀK du + Σ W_i s_i²`` and ``c₀ = duᵀ(K u − f) + Σ W_i s_i r_i`` over the rows acting
+    there. A first ``hi`` (1, doubled) where the slope is ≥ 0 bounds the root; the breakpoints
+    below it sorted, the coefficients are running sums, and the root is read on the first piece
+    whose end has a slope ≥ 0 (a sort of the few breakpoints before a Newton step's end, not a
+    bisection of 60 passes over every row)."""
     r = pb.B @ u - pb.g
     s = pb.B @ du
+    ws = W * s
     a2 = float(du @ (pb.K @ du))
     b = float(du @ (pb.K @ u - pb.f))
 
     def slope(al):
-        return al * a2 + b + float(np.sum(W * s * np.maximum(0.0, r + al * s)))
+        return al * a2 + b + float(ws @ np.maximum(0.0, r + al * s))
 
-    lo, hi = 0.0, 1.0
+    hi = 1.0
     while slope(hi) < 0:
-        lo, hi = hi, 2 * hi
+        hi *= 2
         if hi > ALPHA_MAX:
             return np.inf  # the energy falls without bound along du: left to the exact steps
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if slope(mid) < 0:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
+    # just after α = 0: the rows pressed (r > 0), or at their threshold and pressing further
+    on = (r > 0) | ((r == 0) & (s > 0))
+    c1 = a2 + float(ws[on] @ s[on])
+    c0 = b + float(ws[on] @ r[on])
+    # the breakpoints in (0, hi): a row starts to act there (s_i > 0) or lets go (s_i < 0)
+    j = np.flatnonzero(((s > 0) & (r < 0)) | ((s < 0) & (r > 0)))
+    at = -r[j] / s[j]
+    ahead = at < hi
+    j, at = j[ahead], at[ahead]
+    order = np.argsort(at, kind="stable")
+    j, at = j[order], at[order]
+    sign = np.where(s[j] > 0, 1.0, -1.0)
+    C1 = np.concatenate([[c1], c1 + np.cumsum(sign * (ws[j] * s[j]))])  # piece k: (at[k − 1], at[k])
+    C0 = np.concatenate([[c0], c0 + np.cumsum(sign * (ws[j] * r[j]))])
+    reached = C1[:-1] * at + C0[:-1] >= 0
+    k = int(np.argmax(reached)) if reached.any() else at.size  # else on the last piece, up to hi
+    lo, top = (at[k - 1] if k > 0 else 0.0), (at[k] if k < at.size else hi)
+    if not C1[k] > 0:  # a flat piece (rounding): its end
+        return float(top)
+    return float(min(max(-C0[k] / C1[k], lo), top))  # on its piece (rounding of the running sums)
 
 
 def newton_pcg(pb: ReducedQP, fac: SpringFactor, W: np.ndarray, sigma: float, steps,
