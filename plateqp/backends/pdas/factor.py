@@ -119,26 +119,49 @@ class SpringFactor:
     def _triangle(self, Ks, Kd, sigma, pr, pair_r, pair_c, pair_val) -> bool:
         """CHOLMOD's triangle of ``K + σ diag(K)`` equilibrated, and where each product of a
         row's entries adds in it, built on that triangle alone; False where ``B``'s pattern
-        does not lie in ``K``'s or the diagonal is not all stored (then :meth:`_whole`). One
-        mask over ``K``'s entries, no list of their positions (each array of the size of
-        ``K`` is paid for in time as well as memory: its pages are new)."""
+        does not lie in ``K``'s or the diagonal is not all stored (then :meth:`_whole`). ``K``'s
+        columns sorted, each column's part of the triangle is a run of it (up to its diagonal,
+        or from it): made a block of columns at a time (SCALE_BLOCK entries), so that no array of
+        ``K``'s size is made but the triangle's own (at 512², with ``K``'s masks and a copy of
+        its indices, 0.3 GB of fresh pages the kernel zeroed: a fifth of that size's CPU time
+        is the kernel's), its indices in CHOLMOD's width as they are copied."""
         n = Ks.shape[0]
-        counts = np.diff(Ks.indptr)
-        if np.any(counts == 0):
+        indptr, idx = Ks.indptr, Ks.indices
+        counts = np.diff(indptr)
+        if np.any(counts == 0) or not Ks.has_sorted_indices:
             return False
-        cols = np.repeat(np.arange(n, dtype=Ks.indices.dtype), counts)
         upper = self.chol.upper
-        # sorted columns: the triangle's part of each ends (starts) at its diagonal
-        on_diag = np.flatnonzero(Ks.indices == cols)
-        if (on_diag.size != n or np.any(on_diag < Ks.indptr[:-1]) or np.any(on_diag >= Ks.indptr[1:])
-                or not Ks.has_sorted_indices):
-            return False  # a column without its diagonal stored (or with it twice)
-        inside_k = Ks.indices <= cols if upper else Ks.indices >= cols
-        del cols
-        li = Ks.indices[inside_k]
-        lcount = on_diag - Ks.indptr[:-1] + 1 if upper else Ks.indptr[1:] - on_diag
-        indptr = np.concatenate([[0], np.cumsum(lcount)])
-        diag = indptr[1:] - 1 if upper else indptr[:-1]
+        step = max(1, int(n * SCALE_BLOCK // max(int(indptr[-1]), 1)))
+        blocks = [(j0, min(n, j0 + step)) for j0 in range(0, n, step)]
+        # each column's diagonal: where it is stored, once
+        on_diag = np.empty(n, dtype=np.int64)
+        for j0, j1 in blocks:
+            a, b = int(indptr[j0]), int(indptr[j1])
+            hit = np.flatnonzero(idx[a:b] == np.repeat(np.arange(j0, j1, dtype=idx.dtype), counts[j0:j1]))
+            if hit.size != j1 - j0:
+                return False  # a column without its diagonal stored (or with it twice)
+            on_diag[j0:j1] = hit + a
+        if np.any(on_diag < indptr[:-1]) or np.any(on_diag >= indptr[1:]):
+            return False
+        lcount = on_diag - indptr[:-1] + 1 if upper else indptr[1:] - on_diag
+        tptr = np.concatenate([[0], np.cumsum(lcount)])
+        diag = tptr[1:] - 1 if upper else tptr[:-1]
+        li = np.empty(int(tptr[-1]), dtype=np.int64)  # CHOLMOD's width: read, not widened again
+        base = np.empty(int(tptr[-1]))
+        for j0, j1 in blocks:
+            a, b = int(indptr[j0]), int(indptr[j1])
+            ta, tb = int(tptr[j0]), int(tptr[j1])
+            cols = np.repeat(np.arange(j0, j1, dtype=idx.dtype), counts[j0:j1])
+            part = idx[a:b] <= cols if upper else idx[a:b] >= cols
+            li[ta:tb] = idx[a:b][part]
+            vals = base[ta:tb]
+            vals[:] = Ks.data[a:b][part]
+            d = diag[j0:j1] - ta
+            vals[d] += sigma * Kd[j0:j1]
+            # s_i s_j first, as in _whole (to the bit)
+            scale = self.s.take(li[ta:tb])
+            scale *= np.repeat(self.s[j0:j1], lcount[j0:j1])
+            vals *= scale
         inside = pair_r <= pair_c if upper else pair_r >= pair_c  # each off-diagonal pair once
         if np.array_equal(pair_r, pair_c):  # one unknown a row (a bed, posts at nodes): all on the diagonal
             pos = diag[pair_r]
@@ -149,19 +172,7 @@ class SpringFactor:
             if keys.size == 0 or not np.all(keys[pos] == pk):
                 return False
             del keys
-        base = np.asarray(Ks.data[inside_k], dtype=float)
-        del inside_k
-        base[diag] += sigma * Kd
-        # s_i s_j first, as in _whole (to the bit), a block of columns at a time (no arrays of
-        # the triangle's size for the scales)
-        step = max(1, int(n * SCALE_BLOCK // max(base.size, 1)))
-        for j0 in range(0, n, step):
-            j1 = min(n, j0 + step)
-            a, b = indptr[j0], indptr[j1]
-            scale = self.s.take(li[a:b])
-            scale *= np.repeat(self.s[j0:j1], lcount[j0:j1])
-            base[a:b] *= scale
-        self.base, self.indices, self.indptr = base, li.astype(np.int64), indptr  # CHOLMOD's width
+        self.base, self.indices, self.indptr = base, li, tptr
         self.pair_row, self.pair_pos = pr[inside], pos
         self.pair_val = pair_val[inside] * (self.s[pair_r[inside]] * self.s[pair_c[inside]])
         self.nnz = base.size
