@@ -342,6 +342,33 @@ def floors_section(df, figdir):
     return "\n".join(lines) + "\n\n" + table(d[cols].astype(object).fillna(""))
 
 
+def _change(now: float, before: float) -> str:
+    """``now`` against ``before`` in words: "12% less", "3% more"."""
+    pct = 100.0 * (now / before - 1.0)
+    return f"{abs(pct):.0f}% {'more' if pct > 0 else 'less'}"
+
+
+def kernel_section(df, figdir):
+    d = df.copy()
+    if "setting" not in d or not (d["setting"] == "default").any():
+        return "*(not measured here: the settings are glibc's and Linux's)*"
+    lines = []
+    for (scene, mesh), g in d.groupby(["scene", "mesh"], sort=False):
+        base = g[g["setting"] == "default"].iloc[0]
+        line = (f"- {scene.capitalize()} {mesh}: the kernel's share of the CPU time, raw "
+                f"{100 * base['raw_sys_share']:.0f}%, pq.solve {100 * base['pq_sys_share']:.0f}%; pq.solve ÷ raw "
+                f"{base['ratio']:.2f}")
+        for setting in g["setting"]:
+            if setting == "default":
+                continue
+            k = g[g["setting"] == setting].iloc[0]
+            line += (f". {setting.capitalize()}: raw {_change(k['raw_cpu'], base['raw_cpu'])}, pq.solve "
+                     f"{_change(k['pq_cpu'], base['pq_cpu'])} CPU time, pq.solve ÷ raw {k['ratio']:.2f}")
+        lines.append(line + ".")
+    cols = ["scene", "mesh", "setting", "accuracy", "raw_user", "raw_sys", "pq_user", "pq_sys", "ratio"]
+    return "\n".join(lines) + "\n\n" + table(d[cols].astype(object).fillna(""))
+
+
 def parts() -> dict[str, Part]:
     p = {}
     p["goals"] = Part(
@@ -354,6 +381,10 @@ def parts() -> dict[str, Part]:
         "floors", "bench_floors", "floors.csv", "floors.csv", ["--out", "OUT"],
         ["--grid-meshes", "64", "--bed-mesh", "32", "--repeat", "1", "--out", "OUT"],
         floors_section, "What the goals not met are up against")
+    p["kernel"] = Part(
+        "kernel", "bench_kernel", "kernel.csv", "kernel.csv", ["--repeat", "2", "--out", "OUT"],
+        ["--scenes", "bed", "--meshes", "32", "--repeat", "1", "--rounds", "1", "--out", "OUT"],
+        kernel_section, "The kernel's share of a solve")
     p["work-precision"] = Part(
         "work-precision", "bench_work_precision", "work-precision.csv", "work_precision.csv",
         ["--sizes", "16", "--timeout", "60"],
