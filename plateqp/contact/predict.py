@@ -52,7 +52,7 @@ def soft_rows(data: Scaled) -> bool:
     """Every contact row is softer than the plate under it (``ρ_i k_i ≥ 1``, ``k_i`` the plate's
     diagonal stiffness along the row: pdas's test for its Newton first phase, which is where a
     predicted set pays; on stiff rows the exact steps would start from it directly)."""
-    k = row_stiffness(sp.diags(data.K.diagonal()), data.B, "diagonal")
+    k = row_stiffness(data.K, data.B, "diagonal")  # K's diagonal alone (remembered for the KKT report)
     return bool(np.all(data.rho * k >= 1.0))
 
 

