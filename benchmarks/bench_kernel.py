@@ -15,8 +15,8 @@ process starts:
 * "small pages": ``NUMPY_MADVISE_HUGEPAGE=0``. NumPy asks the kernel for huge pages for every
   array of 4 MB or more (``madvise(MADV_HUGEPAGE)``); where the kernel's transparent huge pages
   are set to ``madvise`` with ``defrag`` ``madvise`` (a common default), a page fault in such
-  memory may stall on a synchronous compaction of memory to find a huge page (NumPy's issue
-  31590), and the mark stays on the memory after NumPy frees it.
+  memory may stall on a synchronous compaction of memory to find a huge page (numpy/numpy#31590
+  on GitHub), and the mark stays on the memory after NumPy frees it.
 
 Neither is set by plateqp: both change the whole process (its other arrays, its memory kept
 after a solve); they are the user's choice, for a process that solves many times (a scripted

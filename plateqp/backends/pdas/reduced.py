@@ -149,7 +149,6 @@ class ReducedQP:
         self.k_penalty = penalty_stiffness(self.B, Kd, self.k)
         self.P, self.q = P, qp.q
         self._null, self._null_checked, self._lift = qp.null, False, None  # (:meth:`rigid`, :meth:`lift`)
-        self._rigid_rows = self._rigid_mass = None  # (:meth:`rigid_rows`, :meth:`rigid_mass`)
         self._src = (qp.P, qp.G, G, max_rows, qp.null)  # what :meth:`again` compares
         self._abs_K = None  # |K|, kept where the problem is read again (:meth:`abs_K_times`)
 
@@ -244,7 +243,7 @@ class ReducedQP:
         N = self.rigid()
         if N is None:
             return None
-        if self._rigid_rows is None:
+        if getattr(self, "_rigid_rows", None) is None:  # (made on first use, shared by :meth:`again`'s copies)
             self._rigid_rows = np.asarray(self.B @ N)
         return self._rigid_rows
 
@@ -254,7 +253,7 @@ class ReducedQP:
         N = self.rigid()
         if N is None:
             return None
-        if self._rigid_mass is None:
+        if getattr(self, "_rigid_mass", None) is None:
             self._rigid_mass = N.T @ (self.Kd[:, None] * N)
         return self._rigid_mass
 
