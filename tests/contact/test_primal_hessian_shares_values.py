@@ -30,3 +30,22 @@ def test_without_springs_the_hessian_is_k_itself():
     K = data.K
     form = Primal(data)
     assert form.qp.P is K or np.shares_memory(form.qp.P.data, K.data)
+
+
+def test_the_primal_rows_are_b_beside_the_springs_columns():
+    """``G = [B  T]`` with T's column j holding −√ρ at spring row j: against SciPy's hstack, on a
+    bed (every row a spring), on posts with some elastic (a few columns) and on rigid posts (none),
+    stored entries and their order included."""
+    scenes = [families.bed(10), families.grid_elastic(10, 3), families.grid_rigid(10, 3)]
+    mixed = families.grid_rigid(10, 3)
+    mixed.supports[1].stiffness = 1e6
+    mixed.supports[4].stiffness = 1e7
+    for scene in [*scenes, mixed]:
+        data = Scaled.from_model(build_model(scene))
+        el = np.flatnonzero(data.rho > 0)
+        T = sp.csr_matrix((-np.sqrt(data.rho[el]), (el, np.arange(el.size))), shape=(data.m, el.size))
+        want = sp.hstack([data.B, T], format="csc")
+        G = Primal(data).qp.G
+        assert G.shape == want.shape
+        assert np.array_equal(G.indptr, want.indptr) and np.array_equal(G.indices, want.indices)
+        assert np.array_equal(G.data, want.data)
