@@ -300,9 +300,18 @@ def goals_section(df, figdir):
     short = d[d["met"].notna()]
     hit = int((short["met"] == True).sum())  # noqa: E712 - a pandas column
     d["met"] = met
-    cols = [c for c in ("goal", "scene", "mesh", "route", "accuracy", "detail", "unit", "raw", "measured", "ratio", "limit",
-                        "met", "kkt_worst") if c in d]
-    return f"Goals met today: {hit} of {len(short)}.\n\n" + table(d[cols].astype(object).fillna(""))
+    edge = []
+    if "ratio_lo" in d:  # the repeats' spread (solve rows): a goal inside it is on the edge
+        spread = d["ratio_lo"].notna()
+        d["repeats"] = ""
+        d.loc[spread, "repeats"] = [f"{lo:.3g}–{hi:.3g}" for lo, hi in zip(d.loc[spread, "ratio_lo"], d.loc[spread, "ratio_hi"])]
+        inside = spread & d["limit"].notna() & (d["ratio_lo"] <= d["limit"]) & (d["limit"] <= d["ratio_hi"])
+        edge = [f"{r.scene} {r.mesh}" for r in d[inside].itertuples()]
+    cols = [c for c in ("goal", "scene", "mesh", "route", "accuracy", "detail", "unit", "raw", "measured", "ratio",
+                        "repeats", "limit", "met", "kkt_worst") if c in d]
+    said = (f" On the edge (the limit within the repeats' own ratios, met or missed by the machine's state): "
+            f"{', '.join(edge)}." if edge else "")
+    return f"Goals met today: {hit} of {len(short)}.{said}\n\n" + table(d[cols].astype(object).fillna(""))
 
 
 def floors_section(df, figdir):
