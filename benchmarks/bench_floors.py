@@ -1,6 +1,6 @@
 """What the speed goals not met are up against: the floors, measured.
 
-Three goals of the table in bench_goals.py stay out of reach; this script measures what bounds
+Some goals of the table in bench_goals.py stay out of reach; this script measures what bounds
 each from below, against the same "raw" (one cvxopt CHOLMOD symbolic analysis + numeric
 factorisation + solve of the plate's matrix, bench_fast.raw_cholmod; CPU time, one BLAS thread,
 medians of ``--repeat``):
@@ -19,8 +19,15 @@ medians of ``--repeat``):
   ``k`` springs (``cholmod_l_updown`` in cvxopt's CHOLMOD, called through ctypes: scikit-sparse's
   route, which cvxopt's binding does not expose), the first on a fresh factor apart (CHOLMOD turns
   its supernodal factor into a simplicial one then).
+* The whole ``pq.solve`` (the build included; every solve KKT-checked): on the grid by its default
+  route (the condensed method) and by the sparse method (``options={"method": "sparse"}``), the
+  two interleaved; on the bed at ``--small-bed-meshes`` with the coarse mesh's prediction of its
+  contact set timed alone; for each, the same kind of scene at 8² cells (the grid's with 3 × 3
+  posts), whose plate's linear algebra is a few per cent of its solve: what any solve costs
+  besides its plate (the build, the scaling, the checks, the answer's report).
 
-    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_floors.py [--grid-meshes 64,128] [--bed-mesh 128]
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_floors.py [--grid-meshes 64,128] [--bed-mesh 128] \\
+        [--small-bed-meshes 64]
 
 Writes benchmarks/results/floors.csv (one row a quantity: value, unit, and value ÷ raw where
 it is a time) and prints it.
@@ -45,7 +52,7 @@ import scipy.sparse as sp
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
-from bench_fast import ACCURACY, make_scene, plate_matrix, raw_cholmod, to_cvxopt, write_csv  # noqa: E402
+from bench_fast import ACCURACY, grid_rigid, make_scene, plate_matrix, raw_cholmod, to_cvxopt, write_csv  # noqa: E402
 from bench_sweep_reuse import values_for  # noqa: E402
 from timing import cpu  # noqa: E402
 
@@ -101,12 +108,63 @@ def grid_rows(n: int, repeat: int) -> list[dict]:
         warnings.simplefilter("ignore")
         res = pq.solve(scene, accuracy=ACCURACY)
     active = int(np.asarray(res.extras["active"]).sum())
+    routes = whole_solves(scene, {"condensed route (the default)": {},
+                                  "sparse method (option method='sparse')": {"method": "sparse"}}, repeat)
     return [row("grid", n, "numeric factorisation, CHOLMOD's order", statistics.median(times), "s", raw),
             row("grid", n, "numeric factorisation, posts last", statistics.median(last_t), "s", raw),
             row("grid", n, "multiply-adds, CHOLMOD's order", flops, "flop"),
             row("grid", n, "multiply-adds, posts last", last_flops, "flop"),
             row("grid", n, "posts", float(posts.size), "count"),
-            row("grid", n, "posts carrying the answer", float(active), "count")]
+            row("grid", n, "posts carrying the answer", float(active), "count"),
+            *(row("grid", n, f"pq.solve, {name}", t, "s", raw) for name, t in routes.items()),
+            row("grid", n, f"pq.solve of the same kind of scene at {SMALL}² (a solve's fixed cost)",
+                fixed_cost("grid", repeat), "s", raw)]
+
+
+#: the cells a side of the plate whose whole solve stands for a solve's fixed cost (its plate's
+#: linear algebra is a few per cent of it: raw 0.5 ms on the bed, 0.3 on the grid)
+SMALL = 8
+
+
+def whole_solves(scene, options: dict[str, dict], repeat: int) -> dict[str, float]:
+    """Median CPU time of the whole pq.solve (the build included) with each ``options``, the
+    options interleaved; each solve KKT-checked."""
+    times: dict[str, list[float]] = {name: [] for name in options}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for name, opts in options.items():  # the first call's imports paid
+            pq.solve(scene, accuracy=ACCURACY, options=opts)
+        for _ in range(repeat):
+            for name, opts in options.items():
+                dt, res = cpu(lambda: pq.solve(scene, accuracy=ACCURACY, options=opts))
+                if not res.kkt.ok:
+                    raise SystemExit(f"{scene.name} ({name}): the KKT check failed ({res.status.value})")
+                times[name].append(dt)
+    return {name: statistics.median(t) for name, t in times.items()}
+
+
+def fixed_cost(kind: str, repeat: int) -> float:
+    """The whole pq.solve of ``kind``'s scene at SMALL² cells (the grid's with 3 × 3 posts: 30 × 30
+    do not fit): what a solve costs besides its plate."""
+    return whole_solves(grid_rigid(SMALL, 3) if kind == "grid" else make_scene(kind, SMALL), {"": {}}, repeat)[""]
+
+
+def small_bed_rows(n: int, repeat: int) -> list[dict]:
+    """The bed at ``n``² (its goal is set on the whole solve): the whole solve, a solve's fixed cost
+    and the coarse mesh's prediction of its contact set (plateqp.contact.predict), against raw."""
+    from plateqp.contact.predict import predicted_set
+
+    scene = make_scene("bed", n)
+    model = build_model(scene)
+    A, f = plate_matrix("bed", model)
+    raw = median_raw(A, f, repeat)
+    whole = whole_solves(scene, {"": {}}, repeat)[""]
+    predicted_set(model)
+    predict = median_cpu(lambda: predicted_set(model), repeat)
+    return [row("bed", n, "pq.solve (the default route)", whole, "s", raw),
+            row("bed", n, f"pq.solve of the same kind of scene at {SMALL}² (a solve's fixed cost)", fixed_cost("bed", repeat),
+                "s", raw),
+            row("bed", n, "the coarse mesh's prediction of the contact set", predict, "s", raw)]
 
 
 def _updown(ch: Cholesky, C: sp.csc_matrix):
@@ -204,6 +262,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--grid-meshes", default="64,128")
     ap.add_argument("--bed-mesh", type=int, default=128)
+    ap.add_argument("--small-bed-meshes", default="64", help="the bed's whole solve, fixed cost and prediction")
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--out", default=str(HERE / "results" / "floors.csv"))
     a = ap.parse_args()
@@ -212,6 +271,8 @@ def main():
         rows += grid_rows(n, a.repeat)
     if a.bed_mesh:
         rows += bed_rows(a.bed_mesh, a.repeat)
+    for n in (int(x) for x in a.small_bed_meshes.split(",") if x.strip()):
+        rows += small_bed_rows(n, a.repeat)
     print("| scene | mesh | quantity | value | unit | ÷ raw |")
     print("|---|---|---|---|---|---|")
     for r in rows:

@@ -330,7 +330,7 @@ def floors_section(df, figdir):
             f"raw alone (in CHOLMOD's order: "
             f"{get('grid', mesh, 'numeric factorisation, CHOLMOD' + chr(39) + 's order', 'per_raw'):.2f}); "
             f"{get('grid', mesh, 'posts carrying the answer'):.0f} of {get('grid', mesh, 'posts'):.0f} posts carry "
-            "the answer.")
+            "the answer." + _whole_solves(get, "grid", mesh))
     for mesh in d[d["scene"] == "bed"]["mesh"].unique():
         q = d[(d["scene"] == "bed") & (d["mesh"] == mesh)]["quantity"]
         load = next((x for x in q if "loads" in x and "(median)" in x), None)
@@ -347,8 +347,30 @@ def floors_section(df, figdir):
             f"after {get('bed', mesh, 'in-place downdate of 1 spring on a fresh factor (its conversion)', 'per_raw'):.2f} "
             "to make its factor simplicial, on which a solve costs "
             f"{get('bed', mesh, 'one solve, simplicial factor (after an update)', 'per_raw'):.3f}.")
+    for mesh in d[d["scene"] == "bed"]["mesh"].unique():
+        if d[(d["scene"] == "bed") & (d["mesh"] == mesh) & (d["quantity"] == "pq.solve (the default route)")].empty:
+            continue
+        lines.append(f"- Bed {mesh}: the whole solve takes {get('bed', mesh, 'pq.solve (the default route)', 'per_raw'):.2f} "
+                     f"raw, of which the coarse mesh's prediction of its contact set "
+                     f"{get('bed', mesh, 'the coarse mesh' + chr(39) + 's prediction of the contact set', 'per_raw'):.2f}."
+                     + _whole_solves(get, "bed", mesh))
     cols = ["scene", "mesh", "quantity", "value", "unit", "raw_s", "per_raw"]
     return "\n".join(lines) + "\n\n" + table(d[cols].astype(object).fillna(""))
+
+
+def _whole_solves(get, scene: str, mesh) -> str:
+    """The floors' whole-solve rows of ``scene`` at ``mesh`` in words ("" where not measured)."""
+    fixed = get(scene, mesh, "pq.solve of the same kind of scene at 8² (a solve's fixed cost)", "per_raw")
+    out = ""
+    if scene == "grid":
+        cond = get("grid", mesh, "pq.solve, condensed route (the default)", "per_raw")
+        sparse = get("grid", mesh, "pq.solve, sparse method (option method='sparse')", "per_raw")
+        if cond == cond:  # not NaN: measured
+            out += f" The whole solve: {cond:.2f} raw by the condensed route, {sparse:.2f} by the sparse method."
+    if fixed == fixed:
+        out += (f" A solve of the same kind of scene at 8² cells (its plate's linear algebra a few per cent of it: "
+                f"what any solve costs besides its plate) takes {fixed:.2f} of this plate's raw.")
+    return out
 
 
 def _change(now: float, before: float) -> str:
