@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import json
+import math
 import os
 import platform
 import shlex
@@ -365,9 +366,9 @@ def _whole_solves(get, scene: str, mesh) -> str:
     if scene == "grid":
         cond = get("grid", mesh, "pq.solve, condensed route (the default)", "per_raw")
         sparse = get("grid", mesh, "pq.solve, sparse method (option method='sparse')", "per_raw")
-        if cond == cond:  # not NaN: measured
+        if not math.isnan(cond):  # measured
             out += f" The whole solve: {cond:.2f} raw by the condensed route, {sparse:.2f} by the sparse method."
-    if fixed == fixed:
+    if not math.isnan(fixed):
         out += (f" A solve of the same kind of scene at 8² cells (its plate's linear algebra a few per cent of it: "
                 f"what any solve costs besides its plate) takes {fixed:.2f} of this plate's raw.")
     return out
